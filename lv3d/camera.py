@@ -1,0 +1,71 @@
+"""Pinhole intrinsics. Pixel (u, v): u to the right, v down; camera frame: x right, y down, z forward (metres)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .errors import InputError
+
+
+@dataclass(frozen=True)
+class Intrinsics:
+    """Pinhole intrinsics of a ``width`` x ``height`` image, focal lengths and centre in pixels."""
+
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    width: int
+    height: int
+
+    @classmethod
+    def realsense_d435(cls, width: int = 640, height: int = 480) -> "Intrinsics":
+        """Intrinsics like a RealSense D435 colour/depth stream at 640x480 (fx about 615)."""
+        s = width / 640.0
+        return cls(fx=615.0 * s, fy=615.0 * s, cx=(width - 1) / 2, cy=(height - 1) / 2, width=width, height=height)
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "intrinsics") -> "Intrinsics":
+        """Build from a mapping with fx, fy, cx, cy, width, height; validate (InputError on absurd values)."""
+        try:
+            k = cls(
+                fx=float(d["fx"]), fy=float(d["fy"]), cx=float(d["cx"]), cy=float(d["cy"]),
+                width=int(d["width"]), height=int(d["height"]),
+            )
+        except KeyError as e:
+            raise InputError(where, f"intrinsics lack {e.args[0]!r} (need fx, fy, cx, cy, width, height)") from None
+        except (TypeError, ValueError) as e:
+            raise InputError(where, f"intrinsics are not numbers: {e}") from None
+        k.validate(where)
+        return k
+
+    def validate(self, where: str = "intrinsics") -> None:
+        vals = (self.fx, self.fy, self.cx, self.cy)
+        if not all(math.isfinite(v) for v in vals):
+            raise InputError(where, "intrinsics contain NaN or infinity")
+        if not (8 <= self.width <= 16384 and 8 <= self.height <= 16384):
+            raise InputError(where, f"absurd image size {self.width}x{self.height}")
+        if not (0.1 * self.width <= self.fx <= 20 * self.width and 0.1 * self.height <= self.fy <= 20 * self.height):
+            raise InputError(where, f"absurd focal length fx={self.fx}, fy={self.fy} for a {self.width}x{self.height} image")
+        if not (0 <= self.cx <= self.width and 0 <= self.cy <= self.height):
+            raise InputError(where, f"principal point ({self.cx}, {self.cy}) lies outside the {self.width}x{self.height} image")
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    def matrix(self) -> np.ndarray:
+        """The 3x3 camera matrix K."""
+        return np.array([[self.fx, 0, self.cx], [0, self.fy, self.cy], [0, 0, 1]], dtype=np.float64)
+
+    def project(self, points: np.ndarray) -> np.ndarray:
+        """Camera-frame points (n, 3) in metres to pixels (n, 2)."""
+        p = np.asarray(points, dtype=np.float64)
+        return np.stack([self.fx * p[:, 0] / p[:, 2] + self.cx, self.fy * p[:, 1] / p[:, 2] + self.cy], axis=1)
+
+    def rays(self, pixels: np.ndarray) -> np.ndarray:
+        """Pixels (n, 2) to camera-frame ray directions (n, 3) with z = 1."""
+        p = np.asarray(pixels, dtype=np.float64)
+        return np.stack([(p[:, 0] - self.cx) / self.fx, (p[:, 1] - self.cy) / self.fy, np.ones(len(p))], axis=1)

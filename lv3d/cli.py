@@ -1,0 +1,62 @@
+"""The ``lv3d`` command. Subcommands live beside the code they drive and are imported lazily, so
+that ``lv3d dataset`` does not pay for importing JAX or torch."""
+
+from __future__ import annotations
+
+import importlib
+import sys
+
+import click
+
+from .errors import InputError
+
+# command name -> "module:attribute" of a click command or group
+COMMANDS = {
+    "dataset": "lv3d.render.cli:dataset",
+    "extract": "lv3d.perception.cli:extract",
+    "mil": "lv3d.learn.cli:mil",
+    "learn": "lv3d.learn.cli:learn",
+    "experiment": "lv3d.experiment.cli:experiment",
+    "demo": "lv3d.experiment.demo:demo",
+}
+
+
+class LazyGroup(click.Group):
+    def list_commands(self, ctx):
+        return sorted(COMMANDS)
+
+    def get_command(self, ctx, name):
+        if name not in COMMANDS:
+            return None
+        module, attr = COMMANDS[name].split(":")
+        try:
+            return getattr(importlib.import_module(module), attr)
+        except (ImportError, AttributeError) as e:
+            raise click.ClickException(f"command {name!r} is not available: {e}") from None
+
+
+@click.group(cls=LazyGroup)
+def cli():
+    """lv3d: learn 3D shape concepts from a few RGB-D images, with an explanation for every answer."""
+
+
+def main(argv=None) -> int:
+    """Entry point: bad input becomes one line on stderr and exit code 2."""
+    try:
+        cli.main(args=argv, prog_name="lv3d", standalone_mode=False)
+    except InputError as e:
+        click.echo(f"lv3d: error: {e}", err=True)
+        return 2
+    except click.exceptions.Abort:
+        click.echo("lv3d: aborted", err=True)
+        return 130
+    except click.ClickException as e:
+        e.show()
+        return e.exit_code
+    except click.exceptions.Exit as e:
+        return e.exit_code
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,51 @@
+"""Planes in the camera frame: n . X + d = 0, with n a unit normal pointing towards the camera (so d > 0 is
+the distance from the camera centre to the plane, in metres)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Plane:
+    normal: tuple[float, float, float]
+    offset: float
+
+    @classmethod
+    def from_arrays(cls, normal, offset) -> "Plane":
+        n = np.asarray(normal, dtype=np.float64)
+        d = float(offset)
+        norm = np.linalg.norm(n)
+        n, d = n / norm, d / norm
+        if d < 0:  # orient towards the camera
+            n, d = -n, -d
+        return cls(tuple(float(x) for x in n), d)
+
+    @property
+    def n(self) -> np.ndarray:
+        return np.asarray(self.normal, dtype=np.float64)
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Signed distances (metres) of camera-frame points (m, 3) to the plane."""
+        return np.asarray(points, dtype=np.float64) @ self.n + self.offset
+
+    def intersect_rays(self, rays: np.ndarray) -> np.ndarray:
+        """Points where camera rays (m, 3) through the origin meet the plane."""
+        t = -self.offset / (np.asarray(rays) @ self.n)
+        return rays * t[:, None]
+
+    def to_dict(self) -> dict:
+        return {"normal": list(self.normal), "offset": self.offset}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Plane":
+        return cls.from_arrays(d["normal"], d["offset"])
+
+
+def dihedral_deg(outward_a: np.ndarray, outward_b: np.ndarray) -> float:
+    """Interior dihedral angle (degrees) of a convex solid between faces with the given outward normals:
+    90 for adjacent cube faces, 60 between lateral faces of an equilateral triangular prism."""
+    c = float(np.clip(np.dot(outward_a, outward_b) / (np.linalg.norm(outward_a) * np.linalg.norm(outward_b)), -1, 1))
+    return 180.0 - float(np.degrees(np.arccos(c)))

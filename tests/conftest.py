@@ -1,0 +1,18 @@
+"""Shared test settings: JAX in float64 on the CPU with a persistent compilation cache."""
+
+import os
+from pathlib import Path
+
+os.environ.setdefault("JAX_PLATFORMS", "cpu")
+os.environ.setdefault("LV3D_CACHE", str(Path(__file__).resolve().parent.parent / ".cache"))
+
+import pytest  # noqa: E402
+
+REAL_DIR = Path(__file__).resolve().parent.parent.parent / "shared" / "data" / "real" / "pcl-kinect"
+
+
+@pytest.fixture
+def real_dir():
+    if not REAL_DIR.is_dir():
+        pytest.skip(f"real Kinect frames not found at {REAL_DIR} (../shared/data/real/pcl-kinect)")
+    return REAL_DIR
