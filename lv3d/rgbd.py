@@ -1,0 +1,152 @@
+"""One registered RGB-D frame and its loaders: this project's data set format and real camera frames
+(PNG or 16-bit TIFF depth with a depth scale, intrinsics from JSON)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from .camera import Intrinsics
+from .errors import InputError
+
+
+@dataclass(frozen=True)
+class RGBD:
+    """``color``: (H, W, 3) uint8 RGB. ``depth``: (H, W) float32 metres, 0 where there is no reading.
+    Colour and depth share one pixel grid (registered)."""
+
+    color: np.ndarray
+    depth: np.ndarray
+    intrinsics: Intrinsics
+    name: str = "frame"
+    meta: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.depth.shape
+
+    def points(self) -> tuple[np.ndarray, np.ndarray]:
+        """Back-projected valid depth: camera-frame points (m, 3) in metres and their pixels (m, 2) as (u, v)."""
+        v, u = np.nonzero(self.depth > 0)
+        z = self.depth[v, u].astype(np.float64)
+        k = self.intrinsics
+        pts = np.stack([(u - k.cx) * z / k.fx, (v - k.cy) * z / k.fy, z], axis=1)
+        return pts, np.stack([u, v], axis=1)
+
+
+def read_color(path: Path) -> np.ndarray:
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(path, "colour image not found")
+    img = cv2.imread(str(path), cv2.IMREAD_COLOR)
+    if img is None:
+        raise InputError(path, "cannot read the colour image (corrupt or not an image)")
+    return cv2.cvtColor(img, cv2.COLOR_BGR2RGB)
+
+
+def read_depth(path: Path, depth_scale_m: float) -> np.ndarray:
+    """A 16-bit depth image (PNG or TIFF) times ``depth_scale_m`` -> float32 metres; 0 stays 'no reading'."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(path, "depth image not found")
+    raw = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if raw is None:
+        raise InputError(path, "cannot read the depth image (corrupt or not an image)")
+    if raw.ndim != 2:
+        raise InputError(path, f"depth must have one channel, this image has shape {raw.shape}")
+    if raw.dtype == np.uint16:
+        depth = raw.astype(np.float32) * np.float32(depth_scale_m)
+    elif raw.dtype == np.float32:
+        depth = np.nan_to_num(raw, nan=0.0, posinf=0.0, neginf=0.0) * np.float32(depth_scale_m)
+    else:
+        raise InputError(path, f"depth must be uint16 (or float32), not {raw.dtype}")
+    if not np.any(depth > 0):
+        raise InputError(path, "depth is all zero (no readings)")
+    return depth
+
+
+def load_frame(color_path: Path, depth_path: Path | None, intrinsics: Intrinsics | None,
+               depth_scale_m: float = 0.001, name: str | None = None, meta: dict | None = None) -> RGBD:
+    """Load and validate one frame. Without ``depth_path`` the depth is all zeros (rgb-only use)."""
+    color = read_color(color_path)
+    h, w = color.shape[:2]
+    if intrinsics is None:
+        raise InputError(color_path, "no intrinsics given for this frame")
+    if (intrinsics.width, intrinsics.height) != (w, h):
+        raise InputError(color_path, f"image is {w}x{h} but the intrinsics are for {intrinsics.width}x{intrinsics.height}")
+    if not (1e-6 < depth_scale_m < 1.0):
+        raise InputError(depth_path or color_path, f"absurd depth scale {depth_scale_m} m per unit")
+    if depth_path is None:
+        depth = np.zeros((h, w), np.float32)
+    else:
+        depth = read_depth(depth_path, depth_scale_m)
+        if depth.shape != (h, w):
+            raise InputError(depth_path, f"depth is {depth.shape[1]}x{depth.shape[0]} but colour is {w}x{h}")
+    return RGBD(color, depth, intrinsics, name or Path(color_path).stem, meta or {})
+
+
+def read_intrinsics(path: Path, frame: str | None = None) -> tuple[Intrinsics, float]:
+    """Intrinsics and depth scale from JSON. Accepts ``{"fx", "fy", "cx", "cy", "width", "height",
+    "depth_scale_m"?}`` or the real-data layout ``{"width", "height", "frames": {name: {...}}}``."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(path, "intrinsics file not found")
+    try:
+        d = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise InputError(path, f"not valid JSON: {e}") from None
+    if not isinstance(d, dict):
+        raise InputError(path, "intrinsics must be a JSON object")
+    if "intrinsics" in d and isinstance(d["intrinsics"], dict):  # a data set's meta.json
+        return Intrinsics.from_dict(d["intrinsics"], str(path)), float(d.get("depth_scale_m", 0.001))
+    if "frames" in d:
+        frames = d["frames"]
+        if frame is None or frame not in frames:
+            raise InputError(path, f"no intrinsics for frame {frame!r}; known: {', '.join(sorted(frames))}")
+        entry = {"width": d.get("width"), "height": d.get("height"), **frames[frame]}
+        return Intrinsics.from_dict(entry, str(path)), float(entry.get("depth_scale_m", 0.001))
+    return Intrinsics.from_dict(d, str(path)), float(d.get("depth_scale_m", 0.001))
+
+
+def load_item(item_dir: Path) -> RGBD:
+    """One item of an lv3d data set (color.png, depth.png, meta.json); ``meta`` holds the ground truth."""
+    item_dir = Path(item_dir)
+    meta_path = item_dir / "meta.json"
+    if not meta_path.is_file():
+        raise InputError(meta_path, "meta.json not found")
+    try:
+        meta = json.loads(meta_path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise InputError(meta_path, f"not valid JSON: {e}") from None
+    if "intrinsics" not in meta:
+        raise InputError(meta_path, "no intrinsics")
+    k = Intrinsics.from_dict(meta["intrinsics"], str(meta_path))
+    return load_frame(item_dir / "color.png", item_dir / "depth.png", k, float(meta.get("depth_scale_m", 0.001)),
+                      name=meta.get("id", item_dir.name), meta=meta)
+
+
+# Real frames in ../shared/data/real/pcl-kinect: name -> (colour file, depth file)
+def real_frame_files(folder: Path) -> dict[str, tuple[Path, Path]]:
+    folder = Path(folder)
+    out = {}
+    for c in sorted(folder.glob("*_rgb.*")):
+        stem = c.name.rsplit("_rgb.", 1)[0]
+        for cand in (f"{stem}_depth.tiff", f"{stem}_depth_mm.png", f"{stem}_depth.png"):
+            if (folder / cand).is_file():
+                out[stem] = (c, folder / cand)
+                break
+    return out
+
+
+def load_real(folder: Path, name: str) -> RGBD:
+    """A real frame from a folder laid out like ``../shared/data/real/pcl-kinect``."""
+    files = real_frame_files(folder)
+    if name not in files:
+        raise InputError(folder, f"no frame {name!r}; found: {', '.join(files) or 'none'}")
+    k, scale = read_intrinsics(Path(folder) / "intrinsics.json", name)
+    c, d = files[name]
+    return load_frame(c, d, k, scale, name=name)

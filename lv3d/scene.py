@@ -1,0 +1,93 @@
+"""What perception finds in one frame: objects, their faces, and which faces share an edge.
+
+Units: polygons in pixels (u right, v down); planes and points in the camera frame in metres
+(see :mod:`lv3d.plane`). Perception fills it; grounding refines it and reads facts off it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .camera import Intrinsics
+from .plane import Plane
+
+PROVENANCE = ("rgb", "depth", "rgbd")
+
+
+@dataclass
+class Face:
+    """One face. ``polygon``: (n, 2) float pixels, in order around the face. ``plane``: where depth
+    found one. ``points``: the camera-frame depth points (m, 3) the plane was fitted to (not serialised).
+    ``provenance``: which modality found it ('rgbd' = matched in both)."""
+
+    id: str
+    polygon: np.ndarray
+    provenance: str
+    plane: Plane | None = None
+    points: np.ndarray | None = None
+    edge_support: float | None = None  # fraction of the polygon's perimeter on image edges, in [0, 1]
+    plane_rms_m: float | None = None   # RMS point-to-plane residual of the fit, metres
+
+    @property
+    def sides(self) -> int:
+        return int(len(self.polygon))
+
+    def to_dict(self) -> dict:
+        return {"id": self.id, "sides": self.sides, "provenance": self.provenance,
+                "polygon": np.round(np.asarray(self.polygon, float), 2).tolist(),
+                "plane": self.plane.to_dict() if self.plane else None,
+                "n_points": 0 if self.points is None else int(len(self.points)),
+                "edge_support": self.edge_support, "plane_rms_m": self.plane_rms_m}
+
+
+@dataclass
+class SceneObject:
+    """One segmented object: its faces and the pairs of them that share an edge."""
+
+    id: str
+    faces: list[Face] = field(default_factory=list)
+    adjacency: list[tuple[str, str]] = field(default_factory=list)
+    pixel_count: int = 0
+    centroid_px: tuple[float, float] = (0.0, 0.0)
+
+    def face(self, face_id: str) -> Face:
+        return next(f for f in self.faces if f.id == face_id)
+
+    def to_dict(self) -> dict:
+        return {"id": self.id, "pixel_count": self.pixel_count, "centroid_px": list(self.centroid_px),
+                "faces": [f.to_dict() for f in self.faces], "adjacency": [list(p) for p in self.adjacency]}
+
+
+@dataclass
+class Scene:
+    """Perception's result for one frame and one modality."""
+
+    id: str
+    modality: str
+    intrinsics: Intrinsics
+    objects: list[SceneObject] = field(default_factory=list)
+    support_plane: Plane | None = None
+    timings_ms: dict[str, float] = field(default_factory=dict)
+
+    def target(self) -> SceneObject | None:
+        """The object a label speaks of: the largest, preferring those near the image centre."""
+        if not self.objects:
+            return None
+        k = self.intrinsics
+        diag = np.hypot(k.width, k.height)
+
+        def score(o: SceneObject) -> float:
+            off = np.hypot(o.centroid_px[0] - k.width / 2, o.centroid_px[1] - k.height / 2) / diag
+            return o.pixel_count * (1.0 - off)
+
+        return max(self.objects, key=score)
+
+    def to_dict(self) -> dict:
+        t = self.target()
+        return {"schema": "lv3d.extract/1", "id": self.id, "modality": self.modality,
+                "intrinsics": self.intrinsics.to_dict(),
+                "support_plane": self.support_plane.to_dict() if self.support_plane else None,
+                "target": t.id if t else None, "objects": [o.to_dict() for o in self.objects],
+                "timings_ms": self.timings_ms}
