@@ -1,0 +1,166 @@
+"""The padded, fixed-shape description of one object that every grounding program takes.
+
+Shapes are fixed (``MAX_FACES`` faces of at most ``MAX_SIDES`` vertices, ``MAX_VERTICES`` distinct
+vertices, ``MAX_POINTS`` depth points per face, ``MAX_LINKS`` shared-vertex links) so that one compiled
+program serves every object and nothing recompiles between frames; masks say which slots are real.
+
+Frames and units: pixels (u right, v down, pixel centres at integers) for vertices; the camera frame
+(x right, y down, z forward, metres) for planes and points. A plane is ``(n, d)`` with
+``n . X + d = 0`` and ``n`` a unit normal towards the camera.
+"""
+
+from __future__ import annotations
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, Bool, Float, Int
+
+MAX_FACES = 8
+MAX_SIDES = 8
+MAX_VERTICES = 32
+MAX_POINTS = 256
+MAX_LINKS = 32
+EDGE_SAMPLES = 12  # points sampled along each polygon edge
+
+
+class Settings(eqx.Module):
+    """Noise models and robust scales. Plain floats: they are traced, so changing them does not recompile."""
+
+    depth_sigma_a_m: float = 0.001     # depth noise sigma(z) = a + b z^2, metres
+    depth_sigma_b_per_m: float = 0.0015
+    edge_sigma_px: float = 0.7        # a priori spread of a well-localised edge around the edge field's zero
+    edge_cauchy_px: float = 2.0       # Cauchy scale of edge residuals (pixels)
+    depth_cauchy: float = 3.0         # Cauchy scale of depth residuals (in units of sigma(z))
+    link_sigma_factor: float = 2.0    # shared-vertex links are this many sigma(z) loose
+    support_px: float = 1.5           # an edge sample within this distance of an image edge counts as supported
+
+
+class ObjectProblem(eqx.Module):
+    """One object, padded. ``F = MAX_FACES``, ``S = MAX_SIDES``, ``U = MAX_VERTICES``, ``P = MAX_POINTS``,
+    ``L = MAX_LINKS``."""
+
+    vertices: Float[Array, "U 2"]          # union of the faces' vertices, pixels
+    vertex_mask: Bool[Array, " U"]
+    vertex_sigma_px: Float[Array, " U"]    # prior spread of each vertex around its first guess, pixels
+    face_index: Int[Array, "F S"]          # vertex ids in order around each face
+    face_vmask: Bool[Array, "F S"]
+    face_mask: Bool[Array, " F"]
+    use_edges: Bool[Array, " F"]           # the face's sides are pulled onto the edge field
+    edge_support_prior: Float[Array, " F"]  # edge support from perception, used where use_edges is False
+    has_plane: Bool[Array, " F"]
+    planes: Float[Array, "F 4"]            # first-guess planes (n, d), camera frame, metres
+    points: Float[Array, "F P 3"]          # the face's depth points, camera frame, metres
+    point_weight: Float[Array, "F P"]      # 1 for a real point, 0 for padding
+    links: Int[Array, "L 3"]               # (vertex, face a, face b): the vertex on plane a must lie on plane b
+    link_mask: Bool[Array, " L"]
+    adjacency: Bool[Array, "F F"]          # faces sharing an edge (symmetric)
+    support_plane: Float[Array, " 4"]      # (n, d) of the support plane, camera frame, metres
+    has_support: Bool[Array, ""]
+    intrinsics: Float[Array, " 4"]         # fx, fy, cx, cy in pixels
+
+
+def _take(points: np.ndarray, n: int, seed: int) -> np.ndarray:
+    """At most ``n`` rows of ``points``, an even random subset chosen with ``seed``."""
+    if len(points) <= n:
+        return points
+    idx = np.random.default_rng(seed).choice(len(points), n, replace=False)
+    return points[np.sort(idx)]
+
+
+def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, float, float],
+                planes: list[np.ndarray | None] | None = None, points: list[np.ndarray | None] | None = None,
+                use_edges: list[bool] | None = None, edge_support: list[float | None] | None = None,
+                adjacency: list[tuple[int, int]] = (), support_plane: np.ndarray | None = None,
+                merge_px: float = 4.0, boundary_sigma_px: float = 2.0, free_sigma_px: float = 20.0,
+                seed: int = 0) -> tuple[ObjectProblem, np.ndarray]:
+    """Pad one object's faces into an :class:`ObjectProblem` (numpy, outside jit).
+
+    ``polygons``: per face an (n, 2) array of pixel vertices in order (3 <= n <= MAX_SIDES).
+    Vertices of different faces closer than ``merge_px`` become one shared vertex (greedy, in order).
+    ``planes``: per face (4,) (n, d) or None; ``points``: per face (m, 3) camera-frame metres or None.
+    ``use_edges``: per face whether an edge field guides its sides (default all True); a vertex that
+    no edge-guided face uses keeps the prior spread ``boundary_sigma_px`` (perception's own error),
+    the others a weak ``free_sigma_px``. Returns the problem and the (F, S) map from each face's
+    polygon slot to its union vertex id.
+    """
+    nf = len(polygons)
+    if not 1 <= nf <= MAX_FACES:
+        raise ValueError(f"an object needs 1..{MAX_FACES} faces, got {nf}")
+    planes = planes or [None] * nf
+    points = points or [None] * nf
+    use_edges = [True] * nf if use_edges is None else list(use_edges)
+    edge_support = edge_support or [None] * nf
+    verts: list[np.ndarray] = []
+    guided: list[bool] = []
+    face_index = np.zeros((MAX_FACES, MAX_SIDES), np.int32)
+    face_vmask = np.zeros((MAX_FACES, MAX_SIDES), bool)
+    for f, poly in enumerate(polygons):
+        poly = np.asarray(poly, np.float64).reshape(-1, 2)
+        if not 3 <= len(poly) <= MAX_SIDES:
+            raise ValueError(f"face {f} has {len(poly)} vertices; need 3..{MAX_SIDES}")
+        for j, p in enumerate(poly):
+            d = [np.hypot(*(p - q)) for q in verts]
+            k = int(np.argmin(d)) if d else -1
+            if k < 0 or d[k] > merge_px or k in face_index[f, :j][face_vmask[f, :j]]:
+                if len(verts) >= MAX_VERTICES:
+                    raise ValueError(f"an object has more than {MAX_VERTICES} distinct vertices")
+                verts.append(p)
+                guided.append(False)
+                k = len(verts) - 1
+            else:
+                verts[k] = (verts[k] + p) / 2  # merged vertices meet halfway
+            guided[k] = guided[k] or bool(use_edges[f])
+            face_index[f, j] = k
+            face_vmask[f, j] = True
+    vertices = np.zeros((MAX_VERTICES, 2))
+    vertices[: len(verts)] = verts
+    vmask = np.zeros(MAX_VERTICES, bool)
+    vmask[: len(verts)] = True
+    vsig = np.ones(MAX_VERTICES)
+    vsig[: len(verts)] = [free_sigma_px if g else boundary_sigma_px for g in guided]
+
+    plane_arr = np.tile(np.array([0.0, 0.0, -1.0, 1.0]), (MAX_FACES, 1))
+    has_plane = np.zeros(MAX_FACES, bool)
+    pts = np.zeros((MAX_FACES, MAX_POINTS, 3))
+    pts[..., 2] = 1.0  # padding sits in front of the camera so that no division meets zero
+    pw = np.zeros((MAX_FACES, MAX_POINTS))
+    for f in range(nf):
+        if planes[f] is not None and points[f] is not None and len(points[f]) >= 3:
+            plane_arr[f] = np.asarray(planes[f], np.float64)
+            has_plane[f] = True
+            p = _take(np.asarray(points[f], np.float64), MAX_POINTS, seed + f)
+            pts[f, : len(p)] = p
+            pw[f, : len(p)] = 1.0
+    adj = np.zeros((MAX_FACES, MAX_FACES), bool)
+    links = np.zeros((MAX_LINKS, 3), np.int32)
+    lmask = np.zeros(MAX_LINKS, bool)
+    nl = 0
+    for a, b in adjacency:
+        adj[a, b] = adj[b, a] = True
+        if not (has_plane[a] and has_plane[b]):
+            continue
+        shared = set(face_index[a][face_vmask[a]]) & set(face_index[b][face_vmask[b]])
+        for u in sorted(shared):
+            for fa, fb in ((a, b), (b, a)):
+                if nl < MAX_LINKS:
+                    links[nl] = (u, fa, fb)
+                    lmask[nl] = True
+                    nl += 1
+    fmask = np.zeros(MAX_FACES, bool)
+    fmask[:nf] = True
+    ue = np.zeros(MAX_FACES, bool)
+    ue[:nf] = use_edges
+    es = np.ones(MAX_FACES)
+    es[:nf] = [1.0 if s is None else float(s) for s in edge_support]
+    sp = np.array([0.0, -1.0, 0.0, 1.0]) if support_plane is None else np.asarray(support_plane, np.float64)
+    f32 = jnp.float32
+    prob = ObjectProblem(
+        vertices=jnp.asarray(vertices, f32), vertex_mask=jnp.asarray(vmask), vertex_sigma_px=jnp.asarray(vsig, f32),
+        face_index=jnp.asarray(face_index), face_vmask=jnp.asarray(face_vmask), face_mask=jnp.asarray(fmask),
+        use_edges=jnp.asarray(ue), edge_support_prior=jnp.asarray(es, f32), has_plane=jnp.asarray(has_plane),
+        planes=jnp.asarray(plane_arr, f32), points=jnp.asarray(pts, f32), point_weight=jnp.asarray(pw, f32),
+        links=jnp.asarray(links), link_mask=jnp.asarray(lmask), adjacency=jnp.asarray(adj),
+        support_plane=jnp.asarray(sp, f32), has_support=jnp.asarray(support_plane is not None),
+        intrinsics=jnp.asarray(intrinsics, f32))
+    return prob, face_index[:nf]

@@ -1,0 +1,106 @@
+"""Small polygon helpers. A polygon is an (n, 2) float array of pixel vertices (u right, v down), in order,
+not closed (the last vertex joins the first)."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+
+def signed_area(poly: np.ndarray) -> float:
+    """Shoelace area in pixels^2; positive when the vertices run clockwise in the image (v down)."""
+    p = np.asarray(poly, dtype=np.float64)
+    x, y = p[:, 0], p[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def area(poly: np.ndarray) -> float:
+    return abs(signed_area(poly))
+
+
+def perimeter(poly: np.ndarray) -> float:
+    p = np.asarray(poly, dtype=np.float64)
+    return float(np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1).sum())
+
+
+def _segments_cross(a, b, c, d) -> bool:
+    """Proper crossing of segments ab and cd (touching at a shared end does not count)."""
+    def orient(p, q, r):
+        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+    o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
+    return (o1 * o2 < 0) and (o3 * o4 < 0)
+
+
+def is_simple(poly: np.ndarray) -> bool:
+    """True when no two non-neighbouring sides cross and no vertex repeats."""
+    p = np.asarray(poly, dtype=np.float64)
+    n = len(p)
+    if n < 3:
+        return False
+    if len(np.unique(np.round(p, 3), axis=0)) != n:
+        return False
+    for i in range(n):
+        a, b = p[i], p[(i + 1) % n]
+        for j in range(i + 2, n):
+            if i == 0 and j == n - 1:
+                continue  # neighbours through the closing side
+            if _segments_cross(a, b, p[j], p[(j + 1) % n]):
+                return False
+    return True
+
+
+def simplify(poly: np.ndarray, rel_tol: float = 0.06, abs_tol: float = 2.0, min_turn_deg: float = 12.0) -> np.ndarray:
+    """Drop nearly-collinear vertices until only the true corners remain: repeatedly remove the vertex that
+    deviates least from the chord of its neighbours while that deviation is under
+    ``max(abs_tol px, rel_tol * chord)`` or the direction turns there by less than ``min_turn_deg``."""
+    p = [np.asarray(v, dtype=np.float64) for v in poly]
+    while len(p) > 3:
+        best, best_score = -1, np.inf
+        n = len(p)
+        for i in range(n):
+            a, b, c = p[i - 1], p[i], p[(i + 1) % n]
+            chord = c - a
+            L = float(np.hypot(*chord))
+            if L < 1e-9:
+                dev, turn = 0.0, 0.0
+            else:
+                dev = abs(chord[0] * (b[1] - a[1]) - chord[1] * (b[0] - a[0])) / L
+                d1, d2 = b - a, c - b
+                n1, n2 = np.hypot(*d1), np.hypot(*d2)
+                turn = 0.0 if n1 < 1e-9 or n2 < 1e-9 else float(
+                    np.degrees(np.arccos(np.clip(np.dot(d1, d2) / (n1 * n2), -1, 1))))
+            ok = dev < max(abs_tol, rel_tol * L) or turn < min_turn_deg
+            score = dev / max(L, 1e-9)
+            if ok and score < best_score:
+                best, best_score = i, score
+        if best < 0:
+            break
+        p.pop(best)
+    return np.array(p, dtype=np.float64)
+
+
+def clockwise(poly: np.ndarray) -> np.ndarray:
+    """The same polygon with its vertices clockwise in the image (v down), starting at the top-left-most."""
+    p = np.asarray(poly, dtype=np.float64)
+    if signed_area(p) < 0:
+        p = p[::-1]
+    start = int(np.lexsort((p[:, 0], p[:, 1]))[0])
+    return np.roll(p, -start, axis=0)
+
+
+def rasterize(poly: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """Boolean (H, W) mask of the pixels inside the polygon."""
+    m = np.zeros(shape, np.uint8)
+    cv2.fillPoly(m, [np.round(np.asarray(poly)).astype(np.int32)], 1)
+    return m.astype(bool)
+
+
+def sample_boundary(poly: np.ndarray, step: float = 1.0) -> np.ndarray:
+    """Points (m, 2) every ``step`` pixels along the closed boundary."""
+    p = np.asarray(poly, dtype=np.float64)
+    out = []
+    for a, b in zip(p, np.roll(p, -1, axis=0)):
+        k = max(1, int(np.ceil(np.hypot(*(b - a)) / step)))
+        t = np.arange(k)[:, None] / k
+        out.append(a + t * (b - a))
+    return np.concatenate(out, axis=0)

@@ -1,0 +1,99 @@
+"""Faces from colour alone: edges -> segments -> planar graph -> bounded minimal cycles -> validated polygons,
+grouped into objects by shared edges."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .edges import edge_distance, edge_map, edge_support, to_gray
+from .faces import bounded_faces, build_graph
+from .polygons import area, clockwise, is_simple, simplify
+from .segments import detect_segments, merge_collinear, union_find_labels
+
+
+@dataclass(frozen=True)
+class RGBFace:
+    """A validated colour face: ``polygon`` (n, 2) pixels, clockwise, simplified to its corners;
+    ``edges``: the planar-graph edges it is bounded by (for adjacency); ``edge_support`` in [0, 1]."""
+
+    polygon: np.ndarray
+    edges: frozenset[tuple[int, int]]
+    edge_support: float
+    area_px: float
+
+
+@dataclass(frozen=True)
+class RGBResult:
+    faces: list[RGBFace]
+    groups: list[list[int]]           # indices into faces, one list per object, largest first
+    adjacency: list[tuple[int, int]]  # pairs of face indices sharing a graph edge, i < j
+    timings_ms: dict[str, float]
+
+
+def _touches_frame(poly: np.ndarray, box: tuple[int, int, int, int], tol: float = 3.0) -> float:
+    """Fraction of the polygon's vertices within ``tol`` px of the box (u0, v0, u1, v1) border."""
+    u0, v0, u1, v1 = box
+    p = poly
+    near = (np.abs(p[:, 0] - u0) < tol) | (np.abs(p[:, 0] - u1) < tol) | \
+           (np.abs(p[:, 1] - v0) < tol) | (np.abs(p[:, 1] - v1) < tol)
+    return float(np.mean(near))
+
+
+def _contains(outer: np.ndarray, inner: np.ndarray) -> bool:
+    c = outer.astype(np.float32).reshape(-1, 1, 2)
+    return all(cv2.pointPolygonTest(c, (float(x), float(y)), False) >= 0 for x, y in inner)
+
+
+def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, min_area_px: float = 150.0,
+              max_area_frac: float = 0.35, min_support: float = 0.55) -> RGBResult:
+    """Faces in the colour image (H, W, 3) uint8 RGB, or only inside ``box`` = (u0, v0, u1, v1) pixels
+    (a crop around an object found in depth). Faces smaller than ``min_area_px``, larger than ``max_area_frac``
+    of the searched area, hugging its frame, non-simple, poorly supported by edges (< ``min_support`` of the
+    perimeter), or containing another face (a background region around an object) are dropped."""
+    import time
+
+    t0 = time.perf_counter()
+    h, w = color.shape[:2]
+    u0, v0, u1, v1 = box if box is not None else (0, 0, w, h)
+    crop = np.ascontiguousarray(color[v0:v1, u0:u1])
+    gray = to_gray(crop)
+    edges = edge_map(gray)
+    dist = edge_distance(edges)
+    t1 = time.perf_counter()
+    segs = merge_collinear(detect_segments(gray))
+    t2 = time.perf_counter()
+    g = build_graph(segs)
+    cw, ch = u1 - u0, v1 - v0
+    frame = (0, 0, cw - 1, ch - 1)
+    cands = []
+    for f in bounded_faces(g):
+        a = area(f.polygon)
+        if a < min_area_px or a > max_area_frac * cw * ch:
+            continue
+        poly = clockwise(simplify(f.polygon))
+        if len(poly) < 3 or not is_simple(poly) or area(poly) < min_area_px:
+            continue
+        if _touches_frame(poly, frame) > 0.5:
+            continue
+        sup = edge_support(poly, dist)
+        if sup < min_support:
+            continue
+        cands.append((poly, f.edges, sup, area(poly)))
+    # a face that contains another kept face is a region around it (table, wall), not an object face
+    keep = [not any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
+                    for j in range(len(cands))) for i in range(len(cands))]
+    faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for (p, e, s, a), k in zip(cands, keep) if k]
+    faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
+    adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
+                 if faces[i].edges & faces[j].edges]
+    lab = union_find_labels(len(faces), np.array(adjacency, int).reshape(-1, 2))
+    groups: dict[int, list[int]] = {}
+    for i, l in enumerate(lab):
+        groups.setdefault(int(l), []).append(i)
+    ordered = sorted(groups.values(), key=lambda idx: (-sum(faces[i].area_px for i in idx), idx[0]))
+    t3 = time.perf_counter()
+    timings = {"edges": (t1 - t0) * 1e3, "segments": (t2 - t1) * 1e3, "faces": (t3 - t2) * 1e3}
+    return RGBResult(faces, ordered, adjacency, timings)

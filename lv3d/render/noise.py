@@ -1,0 +1,127 @@
+"""Sensor and scene nuisances as named presets of independent knobs, and the functions that apply them.
+
+Depth noise follows a stereo camera like the RealSense D435: sigma(z) = depth_sigma_base_m +
+depth_sigma_k * z^2 (metres), about 1.5 mm at 0.5 m and 5 mm at 1.5 m with ``realsense``.
+Every preset keeps the millimetre quantisation of a uint16 depth PNG.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields, replace
+
+import cv2
+import numpy as np
+
+from ..errors import InputError
+
+PRESETS = ("clean", "mild", "realsense", "hard")
+
+
+@dataclass(frozen=True)
+class NoiseConfig:
+    """Knobs of one noise setting. Lengths in metres, sizes in pixels, intensities in uint8 levels."""
+
+    preset: str = "clean"
+    depth_sigma_base_m: float = 0.0    # depth noise sigma at z = 0 (metres)
+    depth_sigma_k: float = 0.0         # depth noise grows as k * z^2 (1/metre)
+    hole_blobs: int = 0                # number of random blobs without a depth reading
+    hole_radius_px: float = 6.0        # mean blob radius at 640x480 (pixels; scaled with the image)
+    grazing_deg: float = 90.0          # no depth where the view ray meets the surface beyond this angle
+    flying_pixels: float = 0.0         # fraction of depth-edge pixels given a depth between fore and background
+    color_sigma: float = 0.0           # additive Gaussian colour noise (uint8 levels)
+    blur_px: float = 0.0               # Gaussian blur sigma of the colour image at 640x480 (pixels)
+    jpeg_quality: int = 0              # JPEG round trip of the colour image; 0 = none
+    exposure: float = 0.0              # log-normal sigma of a global brightness gain
+    occluder: float = 0.0              # probability of a foreground object partly hiding the target
+    clutter: int = 0                   # number of other solids beside the target (never touching it)
+    distractor_lines: int = 0          # painted lines on the table
+    texture: float = 0.0               # strength of blotchy texture on the table and the objects, 0..1
+    table_grain: float = 0.15          # contrast of the table's wood grain (part of every scene)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+_PRESET_KNOBS = {
+    "clean": {},
+    "mild": dict(depth_sigma_base_m=0.0005, depth_sigma_k=0.0008, hole_blobs=2, grazing_deg=85.0,
+                 flying_pixels=0.1, color_sigma=2.0, blur_px=0.5, jpeg_quality=95, exposure=0.05,
+                 clutter=1, table_grain=0.2),
+    "realsense": dict(depth_sigma_base_m=0.001, depth_sigma_k=0.0018, hole_blobs=5, grazing_deg=78.0,
+                      flying_pixels=0.3, color_sigma=4.0, blur_px=0.8, jpeg_quality=90, exposure=0.12,
+                      occluder=0.3, clutter=2, distractor_lines=1, texture=0.15, table_grain=0.25),
+    "hard": dict(depth_sigma_base_m=0.002, depth_sigma_k=0.004, hole_blobs=12, hole_radius_px=9.0,
+                 grazing_deg=70.0, flying_pixels=0.6, color_sigma=8.0, blur_px=1.3, jpeg_quality=70,
+                 exposure=0.25, occluder=0.7, clutter=4, distractor_lines=4, texture=0.4, table_grain=0.4),
+}
+
+
+def noise_config(preset: str = "clean", **overrides) -> NoiseConfig:
+    """The knobs of ``preset`` with any of them overridden, e.g. ``noise_config("clean", clutter=2)``."""
+    if preset not in PRESETS:
+        raise InputError("noise", f"unknown noise preset {preset!r}; known: {', '.join(PRESETS)}")
+    names = {f.name for f in fields(NoiseConfig)} - {"preset"}
+    bad = sorted(set(overrides) - names)
+    if bad:
+        raise InputError("noise", f"unknown noise knob {bad[0]!r}; known: {', '.join(sorted(names))}")
+    cfg = replace(NoiseConfig(preset=preset), **_PRESET_KNOBS[preset])
+    return replace(cfg, **overrides)
+
+
+def as_config(noise: str | NoiseConfig) -> NoiseConfig:
+    """A preset name or a NoiseConfig -> NoiseConfig."""
+    if isinstance(noise, NoiseConfig):
+        return noise
+    if isinstance(noise, str):
+        return noise_config(noise)
+    raise InputError("noise", f"expected a preset name or NoiseConfig, got {type(noise).__name__}")
+
+
+def noisy_depth(depth: np.ndarray, cos_incidence: np.ndarray, cfg: NoiseConfig,
+                rng: np.random.Generator) -> np.ndarray:
+    """Apply depth nuisances to ideal depth (H, W) float metres (0 = no hit); returns float32 metres
+    quantised to whole millimetres. ``cos_incidence``: (H, W) cosine between view ray and surface normal."""
+    h, w = depth.shape
+    z = depth.astype(np.float64)
+    valid = z > 0
+    if cfg.flying_pixels > 0:
+        # pixels on depth discontinuities take a mix of fore- and background, as stereo matching does
+        zf = np.where(valid, z, 0.0).astype(np.float32)
+        hi = cv2.dilate(zf, np.ones((3, 3), np.uint8))
+        lo = cv2.erode(np.where(valid, zf, np.float32(1e3)), np.ones((3, 3), np.uint8))
+        edge = valid & (hi - lo > 0.03) & (lo < 1e3) & (rng.random((h, w)) < cfg.flying_pixels)
+        mix = rng.random((h, w))
+        z = np.where(edge, lo + mix * (hi - lo), z)
+    sigma = cfg.depth_sigma_base_m + cfg.depth_sigma_k * z * z
+    if np.any(sigma > 0):
+        z = z + rng.standard_normal((h, w)) * sigma
+    if cfg.grazing_deg < 90.0:
+        valid &= cos_incidence > np.cos(np.radians(cfg.grazing_deg))
+    if cfg.hole_blobs > 0:
+        holes = np.zeros((h, w), np.uint8)
+        scale = w / 640.0
+        for _ in range(cfg.hole_blobs):
+            c = (int(rng.integers(0, w)), int(rng.integers(0, h)))
+            ax = tuple(max(1, int(cfg.hole_radius_px * scale * rng.uniform(0.4, 1.8))) for _ in range(2))
+            cv2.ellipse(holes, c, ax, float(rng.uniform(0, 180)), 0, 360, 1, -1)
+        valid &= holes == 0
+    z = np.where(valid & (z > 0), np.round(z * 1000.0) / 1000.0, 0.0)
+    return np.clip(z, 0.0, 65.535).astype(np.float32)
+
+
+def noisy_color(color: np.ndarray, cfg: NoiseConfig, rng: np.random.Generator) -> np.ndarray:
+    """Apply colour nuisances (exposure, blur, sensor noise, JPEG) to an (H, W, 3) float image in 0..255;
+    returns uint8 RGB."""
+    img = color.astype(np.float32)
+    if cfg.exposure > 0:
+        img = img * np.float32(np.exp(rng.normal(0.0, cfg.exposure)))
+    if cfg.blur_px > 0:
+        s = cfg.blur_px * img.shape[1] / 640.0
+        img = cv2.GaussianBlur(img, (0, 0), s)
+    if cfg.color_sigma > 0:
+        img = img + rng.standard_normal(img.shape).astype(np.float32) * np.float32(cfg.color_sigma)
+    out = np.clip(np.round(img), 0, 255).astype(np.uint8)
+    if cfg.jpeg_quality > 0:
+        ok, buf = cv2.imencode(".jpg", out[:, :, ::-1], [cv2.IMWRITE_JPEG_QUALITY, int(cfg.jpeg_quality)])
+        out = cv2.imdecode(buf, cv2.IMREAD_COLOR)[:, :, ::-1].copy()
+    return out

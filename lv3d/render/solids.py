@@ -1,0 +1,132 @@
+"""The solids of the data set as convex polyhedra with explicit faces.
+
+Object frame: metres, z up; the solid's resting faces are listed so that a sampler can stand it on
+the table. Each face is a loop of vertex indices ordered counter-clockwise seen from outside, so the
+right-hand rule gives its outward normal. Face ids are the positions in ``faces`` and are fixed per
+class (prisms: 0 = bottom base, 1 = top base, 2.. = lateral faces; pyramids: 0 = base, 1.. = lateral).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+
+CLASSES = ("cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
+           "tetrahedron")
+
+EDGE_RANGE_M = (0.06, 0.14)
+
+
+@dataclass(frozen=True)
+class Solid:
+    """A convex polyhedron. ``vertices``: (n, 3) metres, object frame. ``faces``: vertex-index loops,
+    counter-clockwise seen from outside. ``resting``: ids of faces the solid may stand on.
+    ``size_m``: the sizes it was built from (named per class, metres)."""
+
+    cls: str
+    vertices: np.ndarray
+    faces: tuple[tuple[int, ...], ...]
+    resting: tuple[int, ...]
+    size_m: dict = field(default_factory=dict)
+
+    def normals(self) -> np.ndarray:
+        """Outward unit normals (f, 3) of the faces, object frame (Newell's method, robust for any loop)."""
+        out = np.zeros((len(self.faces), 3))
+        for i, f in enumerate(self.faces):
+            p = self.vertices[list(f)]
+            q = np.roll(p, -1, axis=0)
+            n = np.stack([((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])).sum(),
+                          ((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])).sum(),
+                          ((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1])).sum()])
+            out[i] = n / np.linalg.norm(n)
+        return out
+
+    def triangles(self) -> tuple[np.ndarray, np.ndarray]:
+        """Fan triangulation: triangles (t, 3) vertex indices and the face id of each triangle (t,)."""
+        tris, ids = [], []
+        for i, f in enumerate(self.faces):
+            for k in range(1, len(f) - 1):
+                tris.append((f[0], f[k], f[k + 1]))
+                ids.append(i)
+        return np.asarray(tris, np.int32), np.asarray(ids, np.int32)
+
+    def edges(self) -> dict[tuple[int, int], tuple[int, int]]:
+        """Each edge (sorted vertex pair) -> the two faces that share it."""
+        seen: dict[tuple[int, int], list[int]] = {}
+        for i, f in enumerate(self.faces):
+            for a, b in zip(f, f[1:] + f[:1]):
+                seen.setdefault((min(a, b), max(a, b)), []).append(i)
+        return {e: (fs[0], fs[1]) for e, fs in seen.items()}
+
+    def radius_xy(self) -> float:
+        """Largest horizontal distance of a vertex from the z axis (metres)."""
+        return float(np.hypot(self.vertices[:, 0], self.vertices[:, 1]).max())
+
+
+def prism(n: int, edge: float, length: float, cls: str) -> Solid:
+    """Right prism over a regular ``n``-gon with side ``edge``, ``length`` tall along z, centred at the origin."""
+    r = edge / (2 * np.sin(np.pi / n))
+    a = 2 * np.pi * np.arange(n) / n
+    ring = np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+    v = np.concatenate([np.c_[ring, np.full(n, -length / 2)], np.c_[ring, np.full(n, length / 2)]])
+    bottom = tuple(range(n - 1, -1, -1))        # seen from below: clockwise from above
+    top = tuple(range(n, 2 * n))
+    sides = tuple((i, (i + 1) % n, n + (i + 1) % n, n + i) for i in range(n))
+    return Solid(cls, v, (bottom, top, *sides), tuple(range(n + 2)), {"base_edge": edge, "length": length})
+
+
+def box(x: float, y: float, z: float, cls: str) -> Solid:
+    """Axis-aligned box with sides ``x``, ``y``, ``z`` (metres), centred at the origin."""
+    v = np.array([[sx * x / 2, sy * y / 2, sz * z / 2]
+                  for sz in (-1, 1) for sy in (-1, 1) for sx in (-1, 1)])
+    # vertex index = 4*(z>0) + 2*(y>0) + (x>0)
+    faces = ((0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5))
+    return Solid(cls, v, faces, tuple(range(6)), {"x": x, "y": y, "z": z})
+
+
+def pyramid(n: int, edge: float, height: float, cls: str) -> Solid:
+    """Right pyramid over a regular ``n``-gon with side ``edge``; base at z = 0, apex at z = ``height``."""
+    r = edge / (2 * np.sin(np.pi / n))
+    a = 2 * np.pi * np.arange(n) / n + np.pi / n
+    v = np.concatenate([np.stack([r * np.cos(a), r * np.sin(a), np.zeros(n)], axis=1), [[0, 0, height]]])
+    base = tuple(range(n - 1, -1, -1))
+    sides = tuple((i, (i + 1) % n, n) for i in range(n))
+    return Solid(cls, v, (base, *sides), (0,), {"base_edge": edge, "height": height})
+
+
+def tetrahedron(edge: float) -> Solid:
+    """Regular tetrahedron with side ``edge``: any face can be the base."""
+    s = pyramid(3, edge, edge * np.sqrt(2.0 / 3.0), "tetrahedron")
+    return Solid("tetrahedron", s.vertices, s.faces, tuple(range(4)), {"edge": edge})
+
+
+def make_solid(cls: str, rng: np.random.Generator, scale: float = 1.0) -> Solid:
+    """A solid of class ``cls`` with sizes drawn from this data set's ranges (edges 6-14 cm, times ``scale``)."""
+    lo, hi = EDGE_RANGE_M[0] * scale, EDGE_RANGE_M[1] * scale
+
+    def edge() -> float:
+        return float(rng.uniform(lo, hi))
+
+    if cls == "cube":
+        e = edge()
+        s = box(e, e, e, cls)
+        return Solid(cls, s.vertices, s.faces, s.resting, {"edge": e})
+    if cls == "cuboid":
+        while True:  # clearly not a cube: some pair of sides differs by a factor >= 1.4
+            x, y, z = (edge() for _ in range(3))
+            if max(x, y, z) / min(x, y, z) >= 1.4:
+                return box(x, y, z, cls)
+    if cls == "square_pyramid":
+        e = edge()
+        return pyramid(4, e, e * float(rng.uniform(0.6, 1.2)), cls)
+    if cls in ("triangular_prism", "pentagonal_prism", "hexagonal_prism"):
+        n = {"triangular_prism": 3, "pentagonal_prism": 5, "hexagonal_prism": 6}[cls]
+        # wide bases would dwarf the frame: keep the circumradius of the base within 10 cm
+        e_max = max(lo, min(hi, 0.10 * scale * 2 * np.sin(np.pi / n)))
+        return prism(n, float(rng.uniform(lo, e_max)), edge(), cls)
+    if cls == "tetrahedron":
+        return tetrahedron(edge())
+    raise InputError("class", f"unknown class {cls!r}; known: {', '.join(CLASSES)}")
