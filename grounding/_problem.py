@@ -12,23 +12,22 @@ Frames and units: pixels (u right, v down, pixel centres at integers) for vertic
 from __future__ import annotations
 
 import equinox as eqx
-import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Bool, Float, Int
 
-MAX_FACES = 8
+MAX_FACES = 6
 MAX_SIDES = 8
-MAX_VERTICES = 32
-MAX_POINTS = 256
-MAX_LINKS = 32
-EDGE_SAMPLES = 12  # points sampled along each polygon edge
+MAX_VERTICES = 24
+MAX_POINTS = 128
+MAX_LINKS = 24
+EDGE_SAMPLES = 8  # points sampled along each polygon edge
 
 
 class Settings(eqx.Module):
     """Noise models and robust scales. Plain floats: they are traced, so changing them does not recompile."""
 
     depth_sigma_a_m: float = 0.001     # depth noise sigma(z) = a + b z^2, metres
-    depth_sigma_b_per_m: float = 0.0015
+    depth_sigma_b_per_m: float = 0.0018
     edge_sigma_px: float = 0.7        # a priori spread of a well-localised edge around the edge field's zero
     edge_cauchy_px: float = 2.0       # Cauchy scale of edge residuals (pixels)
     depth_cauchy: float = 3.0         # Cauchy scale of depth residuals (in units of sigma(z))
@@ -154,13 +153,12 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
     es = np.ones(MAX_FACES)
     es[:nf] = [1.0 if s is None else float(s) for s in edge_support]
     sp = np.array([0.0, -1.0, 0.0, 1.0]) if support_plane is None else np.asarray(support_plane, np.float64)
-    f32 = jnp.float32
     prob = ObjectProblem(
-        vertices=jnp.asarray(vertices, f32), vertex_mask=jnp.asarray(vmask), vertex_sigma_px=jnp.asarray(vsig, f32),
-        face_index=jnp.asarray(face_index), face_vmask=jnp.asarray(face_vmask), face_mask=jnp.asarray(fmask),
-        use_edges=jnp.asarray(ue), edge_support_prior=jnp.asarray(es, f32), has_plane=jnp.asarray(has_plane),
-        planes=jnp.asarray(plane_arr, f32), points=jnp.asarray(pts, f32), point_weight=jnp.asarray(pw, f32),
-        links=jnp.asarray(links), link_mask=jnp.asarray(lmask), adjacency=jnp.asarray(adj),
-        support_plane=jnp.asarray(sp, f32), has_support=jnp.asarray(support_plane is not None),
-        intrinsics=jnp.asarray(intrinsics, f32))
+        vertices=np.asarray(vertices, np.float32), vertex_mask=np.asarray(vmask), vertex_sigma_px=np.asarray(vsig, np.float32),
+        face_index=np.asarray(face_index), face_vmask=np.asarray(face_vmask), face_mask=np.asarray(fmask),
+        use_edges=np.asarray(ue), edge_support_prior=np.asarray(es, np.float32), has_plane=np.asarray(has_plane),
+        planes=np.asarray(plane_arr, np.float32), points=np.asarray(pts, np.float32), point_weight=np.asarray(pw, np.float32),
+        links=np.asarray(links), link_mask=np.asarray(lmask), adjacency=np.asarray(adj),
+        support_plane=np.asarray(sp, np.float32), has_support=np.asarray(support_plane is not None),
+        intrinsics=np.asarray(intrinsics, np.float32))
     return prob, face_index[:nf]

@@ -17,6 +17,24 @@ def to_gray(color: np.ndarray) -> np.ndarray:
     return cv2.GaussianBlur(gray, (3, 3), 0)
 
 
+def channels(color: np.ndarray) -> list[np.ndarray]:
+    """The three colour channels, lightly denoised: edges between faces of equal brightness but different hue
+    vanish in a grey image, so lines and edges are looked for in each channel."""
+    if color.ndim != 3 or color.shape[2] != 3 or color.dtype != np.uint8:
+        raise ValueError(f"colour must be (H, W, 3) uint8, got {color.shape} {color.dtype}")
+    blurred = cv2.GaussianBlur(color, (3, 3), 0)
+    return [np.ascontiguousarray(blurred[:, :, c]) for c in range(3)]
+
+
+def color_edge_map(color: np.ndarray) -> np.ndarray:
+    """Union of the per-channel Canny edges (H, W) uint8 in {0, 255}."""
+    out = None
+    for ch in channels(color):
+        e = edge_map(ch)
+        out = e if out is None else np.maximum(out, e)
+    return out
+
+
 def edge_map(gray: np.ndarray, low_ratio: float = 0.5) -> np.ndarray:
     """Canny edges (H, W) uint8 in {0, 255}. The high threshold is the 90th percentile of the gradient
     magnitude (clipped to [40, 400]), so that it adapts to contrast; the low one is ``low_ratio`` of it."""

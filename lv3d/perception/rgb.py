@@ -8,10 +8,10 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .edges import edge_distance, edge_map, edge_support, to_gray
+from .edges import channels, edge_distance, edge_map, edge_support
 from .faces import bounded_faces, build_graph
 from .polygons import area, clockwise, is_simple, simplify
-from .segments import detect_segments, merge_collinear, union_find_labels
+from .segments import detect_color_segments, union_find_labels
 
 
 @dataclass(frozen=True)
@@ -59,11 +59,11 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     h, w = color.shape[:2]
     u0, v0, u1, v1 = box if box is not None else (0, 0, w, h)
     crop = np.ascontiguousarray(color[v0:v1, u0:u1])
-    gray = to_gray(crop)
-    edges = edge_map(gray)
+    chans = channels(crop)
+    edges = np.maximum.reduce([edge_map(c) for c in chans])
     dist = edge_distance(edges)
     t1 = time.perf_counter()
-    segs = merge_collinear(detect_segments(gray))
+    segs = detect_color_segments(chans)
     t2 = time.perf_counter()
     g = build_graph(segs)
     cw, ch = u1 - u0, v1 - v0
@@ -71,7 +71,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     cands = []
     for f in bounded_faces(g):
         a = area(f.polygon)
-        if a < min_area_px or a > max_area_frac * cw * ch:
+        if a < min_area_px or a > max_area_frac * w * h:
             continue
         poly = clockwise(simplify(f.polygon))
         if len(poly) < 3 or not is_simple(poly) or area(poly) < min_area_px:

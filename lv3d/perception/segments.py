@@ -21,6 +21,12 @@ def detect_segments(gray: np.ndarray, min_len_px: float = 8.0) -> np.ndarray:
     return segs[np.lexsort((segs[:, 1], segs[:, 0]))]
 
 
+def detect_color_segments(channels: list[np.ndarray], min_len_px: float = 8.0) -> np.ndarray:
+    """Segments (n, 4) found in any of the given grey channels, collinear duplicates merged."""
+    segs = np.concatenate([detect_segments(c, min_len_px) for c in channels], axis=0)
+    return merge_collinear(segs)
+
+
 class _UnionFind:
     def __init__(self, n: int):
         self.parent = np.arange(n)

@@ -37,6 +37,7 @@ class NoiseConfig:
     distractor_lines: int = 0          # painted lines on the table
     texture: float = 0.0               # strength of blotchy texture on the table and the objects, 0..1
     table_grain: float = 0.15          # contrast of the table's wood grain (part of every scene)
+    shadows: bool = False              # cast shadows of the directional light (edges that are no face edges)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -46,13 +47,13 @@ _PRESET_KNOBS = {
     "clean": {},
     "mild": dict(depth_sigma_base_m=0.0005, depth_sigma_k=0.0008, hole_blobs=2, grazing_deg=85.0,
                  flying_pixels=0.1, color_sigma=2.0, blur_px=0.5, jpeg_quality=95, exposure=0.05,
-                 clutter=1, table_grain=0.2),
+                 clutter=1, table_grain=0.2, shadows=True),
     "realsense": dict(depth_sigma_base_m=0.001, depth_sigma_k=0.0018, hole_blobs=5, grazing_deg=78.0,
                       flying_pixels=0.3, color_sigma=4.0, blur_px=0.8, jpeg_quality=90, exposure=0.12,
-                      occluder=0.3, clutter=2, distractor_lines=1, texture=0.15, table_grain=0.25),
+                      occluder=0.3, clutter=2, distractor_lines=1, texture=0.15, table_grain=0.25, shadows=True),
     "hard": dict(depth_sigma_base_m=0.002, depth_sigma_k=0.004, hole_blobs=12, hole_radius_px=9.0,
                  grazing_deg=70.0, flying_pixels=0.6, color_sigma=8.0, blur_px=1.3, jpeg_quality=70,
-                 exposure=0.25, occluder=0.7, clutter=4, distractor_lines=4, texture=0.4, table_grain=0.4),
+                 exposure=0.25, occluder=0.7, clutter=4, distractor_lines=4, texture=0.4, table_grain=0.4, shadows=True),
 }
 
 

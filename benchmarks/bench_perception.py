@@ -1,0 +1,173 @@
+"""Perception accuracy and speed on rendered scenes with exact ground truth.
+
+    .venv/bin/python benchmarks/bench_perception.py            # 10 scenes per class, every noise preset
+    .venv/bin/python benchmarks/bench_perception.py --quick    # 2 per class, clean and realsense
+
+Per preset and modality: face recall and precision (a face is found when its polygon, rasterised, has
+IoU >= 0.5 with the ground-truth mask of a visible target face of at least --min-face-px pixels), side-count
+accuracy and vertex error (px) of found faces, plane normal error and dihedral error (deg) where depth gave a
+plane, and how often Scene.target() is the object that covers the true target. Then the median time per stage
+of a 640x480 rgbd frame. Targets from the issue are printed beside the figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from lv3d.perception import perceive  # noqa: E402
+from lv3d.perception.polygons import rasterize  # noqa: E402
+from lv3d.plane import dihedral_deg  # noqa: E402
+from lv3d.render import render_scene  # noqa: E402
+
+CLASSES = ["cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
+           "tetrahedron"]
+TARGETS = {  # preset -> metric -> (comparison, value)
+    "clean": {"recall": (">=", 0.95), "sides": (">=", 0.95), "dihedral_med": ("<=", 2.0)},
+    "realsense": {"recall": (">=", 0.85), "dihedral_med": ("<=", 5.0)},
+}
+TIME_TARGET_MS = 60.0
+
+
+def _angle(a, b) -> float:
+    return float(np.degrees(np.arccos(np.clip(abs(np.dot(a, b)) / (np.linalg.norm(a) * np.linalg.norm(b)), 0, 1))))
+
+
+def evaluate(scene, frame, faces_mask, min_face_px: int) -> dict:
+    """Per-scene counts and errors against the truth in ``frame.meta['truth']`` and ``faces_mask``."""
+    truth = frame.meta["truth"]
+    h, w = faces_mask.shape
+    gt = [f for f in truth["faces"] if f.get("visible", True) and np.count_nonzero(faces_mask == f["id"] + 1) >= min_face_px]
+    gt_masks = {f["id"]: faces_mask == f["id"] + 1 for f in gt}
+    target_px = faces_mask > 0
+    # the object of the scene that covers the target best
+    best_obj, best_cover = None, 0
+    for o in scene.objects:
+        union = np.zeros((h, w), bool)
+        for f in o.faces:
+            union |= rasterize(f.polygon, (h, w))
+        cover = np.count_nonzero(union & target_px)
+        if cover > best_cover:
+            best_obj, best_cover = o, cover
+    out = {"gt_faces": len(gt), "found": 0, "det_faces": 0, "det_ok": 0, "sides_ok": 0, "vertex_err": [],
+           "normal_err": [], "dihedral_err": [], "target_hit": 0}
+    if best_obj is None:
+        return out
+    t = scene.target()
+    out["target_hit"] = int(t is not None and t.id == best_obj.id)
+    det = best_obj.faces
+    out["det_faces"] = len(det)
+    iou = np.zeros((len(det), len(gt)))
+    for i, f in enumerate(det):
+        m = rasterize(f.polygon, (h, w))
+        for j, g in enumerate(gt):
+            inter = np.count_nonzero(m & gt_masks[g["id"]])
+            if inter:
+                iou[i, j] = inter / np.count_nonzero(m | gt_masks[g["id"]])
+    out["det_ok"] = int(np.sum(iou.max(axis=1, initial=0) >= 0.5)) if len(gt) else 0
+    matched: dict[int, int] = {}  # gt id -> det index
+    for j, g in enumerate(gt):
+        if len(det) and iou[:, j].max() >= 0.5:
+            i = int(np.argmax(iou[:, j]))
+            matched[g["id"]] = i
+            out["found"] += 1
+            f = det[i]
+            if f.sides == g["sides"]:
+                out["sides_ok"] += 1
+                gp = np.asarray(g["polygon"], float)
+                d = np.linalg.norm(gp[:, None, :] - f.polygon[None, :, :], axis=2)
+                out["vertex_err"].append(float(d.min(axis=1).mean()))
+            if f.plane is not None:
+                out["normal_err"].append(_angle(f.plane.n, g["plane"]["normal"]))
+    with_pts = [f for f in det if f.plane is not None and f.points is not None and len(f.points)]
+    if with_pts:
+        centroid = np.concatenate([f.points for f in with_pts]).mean(axis=0)
+        for adj in truth.get("adjacency", []):
+            a, b = adj["faces"]
+            if a in matched and b in matched and matched[a] != matched[b]:
+                fa, fb = det[matched[a]], det[matched[b]]
+                if fa.plane is None or fb.plane is None:
+                    continue
+                outs = []
+                for f in (fa, fb):
+                    c = f.points.mean(axis=0) if f.points is not None and len(f.points) else centroid
+                    n = f.plane.n
+                    outs.append(n if n @ (c - centroid) >= 0 else -n)
+                out["dihedral_err"].append(abs(dihedral_deg(*outs) - adj["dihedral_deg"]))
+    return out
+
+
+def summarise(rows: list[dict]) -> dict:
+    s = {k: sum(r[k] for r in rows) for k in ("gt_faces", "found", "det_faces", "det_ok", "sides_ok", "target_hit")}
+    cat = {k: [x for r in rows for x in r[k]] for k in ("vertex_err", "normal_err", "dihedral_err")}
+    med = lambda xs: float(np.median(xs)) if xs else float("nan")  # noqa: E731
+    return {"recall": s["found"] / max(1, s["gt_faces"]), "precision": s["det_ok"] / max(1, s["det_faces"]),
+            "sides": s["sides_ok"] / max(1, s["found"]), "vertex_med": med(cat["vertex_err"]),
+            "normal_med": med(cat["normal_err"]), "dihedral_med": med(cat["dihedral_err"]),
+            "dihedral_n": len(cat["dihedral_err"]), "target": s["target_hit"] / max(1, len(rows)),
+            "scenes": len(rows)}
+
+
+def _fmt_target(preset: str, key: str, value: float) -> str:
+    if preset not in TARGETS or key not in TARGETS[preset]:
+        return ""
+    op, t = TARGETS[preset][key]
+    ok = value >= t if op == ">=" else value <= t
+    return f" (target {op} {t}: {'met' if ok else 'NOT met'})"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--quick", action="store_true", help="2 scenes per class, clean and realsense only")
+    ap.add_argument("--per-class", type=int, default=10)
+    ap.add_argument("--presets", default="clean,mild,realsense,hard")
+    ap.add_argument("--modalities", default="rgb,depth,rgbd")
+    ap.add_argument("--seed", type=int, default=1000)
+    ap.add_argument("--min-face-px", type=int, default=200, help="ignore true faces with fewer visible pixels")
+    args = ap.parse_args(argv)
+    per_class, presets = args.per_class, args.presets.split(",")
+    if args.quick:
+        per_class, presets = 2, ["clean", "realsense"]
+    modalities = args.modalities.split(",")
+    timings: dict[str, list[float]] = {}
+    for preset in presets:
+        rows: dict[str, list[dict]] = {m: [] for m in modalities}
+        t0 = time.perf_counter()
+        for cls in CLASSES:
+            for i in range(per_class):
+                frame, faces_mask = render_scene(cls, args.seed + i, noise=preset)
+                for m in modalities:
+                    scene = perceive(frame, m, scene_id=f"s{i:06d}")
+                    rows[m].append(evaluate(scene, frame, faces_mask, args.min_face_px))
+                    if m == "rgbd" and frame.shape == (480, 640):
+                        for k, v in scene.timings_ms.items():
+                            timings.setdefault(k, []).append(v)
+                        timings.setdefault("total", []).append(sum(scene.timings_ms.values()))
+        print(f"\n== preset {preset}: {per_class} scenes x {len(CLASSES)} classes ({time.perf_counter() - t0:.0f} s)")
+        print(f"{'modality':8} {'recall':>7} {'prec':>6} {'sides':>6} {'vert_px':>8} {'normal':>7} {'dihedral':>8}"
+              f" {'n_dih':>5} {'target':>6}")
+        for m in modalities:
+            s = summarise(rows[m])
+            print(f"{m:8} {s['recall']:7.3f} {s['precision']:6.3f} {s['sides']:6.3f} {s['vertex_med']:8.2f}"
+                  f" {s['normal_med']:7.2f} {s['dihedral_med']:8.2f} {s['dihedral_n']:5d} {s['target']:6.2f}")
+            keys = ("recall", "sides") if m == "rgb" else ("recall", "sides", "dihedral_med")  # rgb has no planes
+            notes = "".join(f" {k}" + _fmt_target(preset, k, s[k]) for k in keys if _fmt_target(preset, k, s[k]))
+            if notes:
+                print(f"{'':8} {m}:{notes}")
+    if timings:
+        print("\n== median time per 640x480 rgbd frame (ms; wall clock on this machine, which may be shared)")
+        for k, v in timings.items():
+            print(f"{k:10} {np.median(v):8.1f}")
+        tot = float(np.median(timings["total"]))
+        print(f"total {tot:.1f} ms (target <= {TIME_TARGET_MS:.0f} ms: {'met' if tot <= TIME_TARGET_MS else 'NOT met'})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

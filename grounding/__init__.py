@@ -1,0 +1,22 @@
+"""grounding: refine perceived polygons and planes in JAX (optimistix least squares) and turn their
+uncertainty into the confidences of facts. Pure functions over arrays; knows nothing of lv3d."""
+
+from ._cache import enable_cache as enable_cache
+from ._confidence import Confidences as Confidences
+from ._confidence import Floors as Floors
+from ._confidence import SUPPORT_FULL as SUPPORT_FULL
+from ._confidence import interval as interval
+from ._field import edge_distance_field as edge_distance_field
+from ._field import normal_edge_field as normal_edge_field
+from ._ground import Grounding as Grounding
+from ._ground import fit_plane as fit_plane
+from ._ground import ground_object as ground_object
+from ._ground import refine_polygon as refine_polygon
+from ._problem import MAX_FACES as MAX_FACES
+from ._problem import MAX_POINTS as MAX_POINTS
+from ._problem import MAX_SIDES as MAX_SIDES
+from ._problem import MAX_VERTICES as MAX_VERTICES
+from ._problem import ObjectProblem as ObjectProblem
+from ._problem import Settings as Settings
+from ._problem import pack_object as pack_object
+from ._uncertainty import Quantities as Quantities

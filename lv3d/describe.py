@@ -1,0 +1,173 @@
+"""Scene + frame -> facts with confidences: the only place where lv3d meets the ``grounding`` package.
+
+For each object, its faces become one padded problem (polygons, the faces' depth points, their planes,
+the support plane, an edge field), ``grounding.ground_object`` refines it and turns its uncertainty into
+the probability of every predicate, and each predicate the faces support becomes a fact
+(docs/facts.md, docs/grounding.md). Facts below ``MIN_CONF`` are dropped, not emitted with a small confidence.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .facts import PREDICATES, Fact, SceneFacts
+from .rgbd import RGBD
+from .scene import Face, Scene, SceneObject
+
+MIN_CONF = 0.05
+SIDE_NAMES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
+
+
+@dataclass
+class FaceResult:
+    """Grounding of one face, kept for inspection and benchmarks."""
+
+    face: Face
+    polygon: np.ndarray          # refined polygon (n, 2), pixels
+    plane: np.ndarray | None     # refined plane (n, d), camera frame, metres
+    vertex_std_px: np.ndarray    # (n,) largest standard deviation of each vertex, pixels
+
+
+@dataclass
+class ObjectResult:
+    obj: SceneObject
+    faces: list[FaceResult]
+    dihedral_deg: dict[tuple[str, str], float]  # measured interior dihedral of each pair with planes
+    status: int
+
+
+def _simplify(poly: np.ndarray, max_sides: int) -> np.ndarray:
+    """A polygon with at most ``max_sides`` vertices (Douglas-Peucker with a growing tolerance)."""
+    poly = np.asarray(poly, np.float64).reshape(-1, 2)
+    eps = 1.0
+    while len(poly) > max_sides:
+        approx = cv2.approxPolyDP(poly.astype(np.float32).reshape(-1, 1, 2), eps, True).reshape(-1, 2)
+        if len(approx) >= 3:
+            poly = approx.astype(np.float64)
+        eps *= 1.5
+    return poly
+
+
+def edge_field(frame: RGBD, modality: str) -> np.ndarray:
+    """The edge-distance field a system that sees ``modality`` may use: colour edges for rgb and rgbd,
+    edges of the depth image's surface normals and depth steps for depth."""
+    import grounding
+
+    if modality == "depth":
+        k = frame.intrinsics
+        return grounding.normal_edge_field(frame.depth, (k.fx, k.fy, k.cx, k.cy))
+    return grounding.edge_distance_field(frame.color)
+
+
+def _chunks(faces: list[Face], size: int) -> list[list[Face]]:
+    return [faces[i: i + size] for i in range(0, len(faces), size)] or [[]]
+
+
+def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray | None = None):
+    """Ground every object of ``scene``: (candidate facts with their probabilities, before any is dropped;
+    per-object results). Candidates are ``(pred, args, probability, value)``."""
+    import grounding
+    import jax.numpy as jnp
+
+    grounding.enable_cache()
+    k = scene.intrinsics
+    intr = (k.fx, k.fy, k.cx, k.cy)
+    if field is None:
+        field = edge_field(frame, scene.modality)
+    field_j = jnp.asarray(field, jnp.float32)
+    support = None if scene.support_plane is None else np.r_[scene.support_plane.n, scene.support_plane.offset]
+    cands: list[tuple[str, tuple[str, ...], float, float | None]] = []
+    results: list[ObjectResult] = []
+    for obj in scene.objects:
+        usable = [f for f in obj.faces if len(f.polygon) >= 3]
+        face_conf: dict[str, float] = {}
+        face_results: list[FaceResult] = []
+        dihedrals: dict[tuple[str, str], float] = {}
+        status = 0
+        for chunk in _chunks(usable, grounding.MAX_FACES):
+            if not chunk:
+                continue
+            ids = [f.id for f in chunk]
+            pos = {fid: i for i, fid in enumerate(ids)}
+            polys = [_simplify(f.polygon, grounding.MAX_SIDES) for f in chunk]
+            has_plane = [f.plane is not None and f.points is not None and len(f.points) >= 3 for f in chunk]
+            prob, index = grounding.pack_object(
+                polys, intrinsics=intr,
+                planes=[np.r_[f.plane.n, f.plane.offset] if hp else None for f, hp in zip(chunk, has_plane)],
+                points=[f.points if hp else None for f, hp in zip(chunk, has_plane)],
+                adjacency=[(pos[a], pos[b]) for a, b in obj.adjacency if a in pos and b in pos],
+                support_plane=support)
+            g = grounding.ground_object(prob, field_j, refine)
+            g = _to_numpy(g)
+            status = max(status, int(g["status"]))
+            c = g["conf"]
+            for i, f in enumerate(chunk):
+                n = len(polys[i])
+                ids_i = index[i, :n]
+                vstd = np.sqrt(np.linalg.eigvalsh(g["vertex_cov"][ids_i]).max(-1).clip(0))
+                face_results.append(FaceResult(f, g["vertices"][ids_i], g["planes"][i] if has_plane[i] else None, vstd))
+                support_term = float(np.clip(c["edge_support"][i] / grounding.SUPPORT_FULL, 0.0, 1.0))
+                face_conf[f.id] = support_term
+                cands.append(("face_of", (obj.id, f.id), support_term, None))
+                if n in SIDE_NAMES:
+                    cands.append((SIDE_NAMES[n], (f.id,), float(c["p_sides"][i]), float(n)))
+                if n == 4:
+                    cands.append(("parallelogram", (f.id,), float(c["p_parallelogram"][i]), float(c["para_dev_deg"][i])))
+                if has_plane[i]:
+                    if n == 4:
+                        cands.append(("square", (f.id,), float(c["p_square"][i]), float(c["side_ratio"][i])))
+                        cands.append(("rectangle", (f.id,), float(c["p_rectangle"][i]), float(c["right_dev_deg"][i])))
+                    cands.append(("regular", (f.id,), float(c["p_regular"][i]), float(c["side_ratio"][i])))
+                    if support is not None:
+                        tilt = float(g["quantities"]["tilt_deg"][i])
+                        cands.append(("horizontal", (f.id,), float(c["p_horizontal"][i]), tilt))
+                        cands.append(("vertical", (f.id,), float(c["p_vertical"][i]), tilt))
+            adjacent = {(a, b) for a, b in obj.adjacency} | {(b, a) for a, b in obj.adjacency}
+            for i, fi in enumerate(chunk):
+                for j, fj in enumerate(chunk):
+                    if i == j or not (has_plane[i] and has_plane[j]):
+                        continue
+                    dih = float(g["quantities"]["dihedral_deg"][i, j])
+                    dihedrals[(fi.id, fj.id)] = dih
+                    args = (fi.id, fj.id)
+                    cands.append(("perpendicular", args, float(c["p_perpendicular"][i, j]), dih))
+                    cands.append(("parallel", args, float(c["p_parallel"][i, j]), float(g["quantities"]["parallel_deg"][i, j])))
+                    if args in adjacent:
+                        cands.append(("acute", args, float(c["p_acute"][i, j]), dih))
+                        cands.append(("obtuse", args, float(c["p_obtuse"][i, j]), dih))
+        for a, b in obj.adjacency:
+            if a in face_conf and b in face_conf:
+                p = min(face_conf[a], face_conf[b])  # the shared edge is as real as the weaker face
+                cands.append(("adjacent", (a, b), p, None))
+                cands.append(("adjacent", (b, a), p, None))
+        cands.append(("object", (obj.id,), max(face_conf.values(), default=0.0), None))
+        results.append(ObjectResult(obj, face_results, dihedrals, status))
+    return cands, results
+
+
+def _to_numpy(tree) -> dict:
+    """A grounding result (equinox modules of arrays) as nested dicts of numpy arrays."""
+    import dataclasses
+
+    if dataclasses.is_dataclass(tree):
+        return {f.name: _to_numpy(getattr(tree, f.name)) for f in dataclasses.fields(tree)}
+    return np.asarray(tree)
+
+
+def describe(scene: Scene, frame: RGBD, *, refine: bool = True) -> SceneFacts:
+    """Facts of ``scene`` (perceived in ``frame``) with confidences, for the scene's modality.
+
+    ``refine=False`` keeps perception's polygons and planes but still computes their covariances and
+    the confidences from them. Facts whose probability is below ``MIN_CONF`` are absent.
+    """
+    cands, _ = ground(scene, frame, refine=refine)
+    facts = []
+    for pred, args, p, value in cands:
+        if scene.modality not in PREDICATES[pred][1] or not np.isfinite(p) or p < MIN_CONF:
+            continue
+        facts.append(Fact(pred, tuple(args), float(min(p, 1.0)), None if value is None else round(float(value), 4)))
+    target = scene.target()
+    return SceneFacts(scene.id, scene.modality, facts, target.id if target else None)

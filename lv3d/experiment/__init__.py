@@ -1,0 +1,1 @@
+"""The experiment runner: study configs, folds, the systems compared, statistics and the report."""

@@ -1,0 +1,199 @@
+"""Run a study: for every condition, system and fold, train each class task (and the multi-class
+task) on the training folds and test on the held-out fold; one JSON per (condition, system, fold)
+under ``<out>/folds/``, skipped on a rerun when it was made from the same settings.
+
+Every system sees the same images, folds and training samples: the samples are drawn from seeds
+that depend on (study seed, fold, class) only, never on the system.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import yaml
+from tqdm import tqdm
+
+from . import data as data_mod
+from .config import LOGIC_SYSTEMS, conditions, digest, load_config
+from .folds import Item, class_task, multiclass_task, split, stratified_folds
+from .systems import make_system, modality_of, negative_label
+
+
+def task_seed(seed: int, fold: int, task: int) -> int:
+    """A seed for one (fold, task) cell, independent of the system."""
+    return int(np.random.SeedSequence([seed, fold, task]).generate_state(1)[0])
+
+
+def fold_path(out: Path, condition: str, system: str, fold: int) -> Path:
+    return Path(out) / "folds" / condition / system / f"fold{fold}.json"
+
+
+def result_key(cfg: dict, system: str, fold: int) -> str:
+    """What a fold result depends on: a finished result with another key is recomputed."""
+    relevant = {k: cfg[k] for k in ("seed", "folds", "data", "train")}
+    relevant["system"] = system
+    relevant["fold"] = fold
+    if system in LOGIC_SYSTEMS:
+        relevant["settings"] = {k: v for k, v in cfg["lv3d"].items() if k != "workers"}  # workers: speed only
+    else:
+        relevant["settings"] = cfg["baselines"]
+    relevant["data"] = data_mod.data_key(cfg)
+    return digest(relevant)
+
+
+def score_binary(preds: list[tuple[str, float]], test: list[Item], cls: str) -> dict:
+    """Accuracy of one class task on the test fold: a prediction is positive iff its label is ``cls``."""
+    tp = fp = tn = fn = 0
+    for (label, _), it in zip(preds, test):
+        pos_pred, pos_true = label == cls, it.cls == cls
+        tp += pos_pred and pos_true
+        fp += pos_pred and not pos_true
+        tn += (not pos_pred) and (not pos_true)
+        fn += (not pos_pred) and pos_true
+    n = tp + fp + tn + fn
+    tpr = tp / (tp + fn) if tp + fn else float("nan")
+    tnr = tn / (tn + fp) if tn + fp else float("nan")
+    return {"accuracy": (tp + tn) / n if n else float("nan"), "balanced_accuracy": (tpr + tnr) / 2,
+            "tp": tp, "fp": fp, "tn": tn, "fn": fn, "n": n}
+
+
+def run_fold(system, cfg: dict, train: list[Item], test: list[Item], fold: int,
+             programs: Path | None) -> dict:
+    """Train and test every task of one fold for one bound system; returns the fold's record."""
+    t = cfg["train"]
+    classes = list(cfg["data"]["classes"])
+    test_ids = [it.id for it in test]
+    record: dict = {"tasks": {}, "predictions": {}}
+    for j, cls in enumerate(classes):
+        seed = task_seed(cfg["seed"], fold, j)
+        examples, positive = class_task(train, cls, t["positives"], t["negatives_per_positive"], seed)
+        labels = [cls if p else negative_label(cls) for p in positive]
+        t0 = time.perf_counter()
+        fitted = system.fit([it.id for it in examples], labels, seed, positive=cls)
+        preds = fitted.predict(test_ids)
+        score = score_binary(preds, test, cls)
+        score.update(n_pos=sum(positive), n_neg=len(positive) - sum(positive),
+                     seconds=round(time.perf_counter() - t0, 3))
+        record["tasks"][cls] = score
+        record["predictions"][cls] = [[i, str(l), float(c)] for i, (l, c) in zip(test_ids, preds)]
+        if programs is not None:
+            fitted.save(programs / cls)
+    if t["multiclass"]:
+        seed = task_seed(cfg["seed"], fold, len(classes))
+        examples = multiclass_task(train, t["positives"], seed)
+        t0 = time.perf_counter()
+        fitted = system.fit([it.id for it in examples], [it.cls for it in examples], seed)
+        preds = fitted.predict(test_ids)
+        correct = [label == it.cls for (label, _), it in zip(preds, test)]
+        record["tasks"]["multiclass"] = {"accuracy": float(np.mean(correct)), "n": len(correct),
+                                         "n_train": len(examples), "seconds": round(time.perf_counter() - t0, 3)}
+        record["predictions"]["multiclass"] = [[i, str(l), float(c)] for i, (l, c) in zip(test_ids, preds)]
+        if programs is not None:
+            fitted.save(programs / "multiclass")
+    return record
+
+
+class _Inputs:
+    """What each system sees, computed on first use (facts per modality, pixels once)."""
+
+    def __init__(self, cfg: dict, out: Path, data: Path, items: list[Item]):
+        self.cfg, self.out, self.data, self.items = cfg, out, data, items
+        self._facts: dict[str, dict] = {}
+        self._pixels = None
+        self.errors: dict[str, dict[str, str]] = {}
+
+    def for_system(self, name: str) -> dict:
+        if name in LOGIC_SYSTEMS:
+            m = modality_of(name)
+            if m not in self._facts:
+                lv = self.cfg["lv3d"]
+                self._facts[m], self.errors[m] = data_mod.ensure_facts(
+                    self.cfg, self.out, self.data, self.items, m, lv["refine"], lv["confidences"], lv["workers"])
+            return self._facts[m]
+        if self._pixels is None:
+            self._pixels = data_mod.ensure_pixels(self.data, self.items, self.cfg["baselines"]["image_size"])
+        return self._pixels
+
+
+def _write_json(path: Path, obj) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(obj, indent=1))
+    os.replace(tmp, path)  # a fold file is complete or absent, never half-written
+
+
+def run_study(config: Path, out: Path, overrides: list[str] = (), progress: bool = True) -> dict:
+    """Run (or resume) the study of ``config`` into ``out``; writes the fold files and the report.
+    Returns ``{"ran": n, "skipped": n, "report": summary}``."""
+    from .report import write_report
+
+    config, out = Path(config), Path(out)
+    cfg = load_config(config, list(overrides))
+    conds = conditions(cfg, config)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
+    jobs = [(c, s, k) for c in conds for s in conds[c]["systems"] for k in range(conds[c]["folds"])]
+    ran = skipped = 0
+    done = _finished_keys(out)
+    bar = tqdm(total=len(jobs), desc=cfg["name"], disable=not progress)
+    for cname, ccfg in conds.items():
+        pending = []
+        for s in ccfg["systems"]:
+            for k in range(ccfg["folds"]):
+                path, key = fold_path(out, cname, s, k), result_key(ccfg, s, k)
+                if _finished(path, key):
+                    continue
+                if key in done:  # same system, data and settings in another condition (a baseline in an ablation)
+                    record = json.loads(done[key].read_text())
+                    _write_json(path, {**record, "condition": cname, "reused_from": str(done[key].relative_to(out))})
+                    continue
+                pending.append((s, k))
+        skipped += ccfg["folds"] * len(ccfg["systems"]) - len(pending)
+        bar.update(ccfg["folds"] * len(ccfg["systems"]) - len(pending))
+        if not pending:
+            continue
+        data = data_mod.ensure_dataset(ccfg, out)
+        items = data_mod.read_items(data)
+        folds = stratified_folds(items, ccfg["folds"], ccfg["seed"])
+        inputs = _Inputs(ccfg, out, data, items)
+        for sname, k in pending:
+            bar.set_postfix_str(f"{cname} {sname} fold {k}")
+            system = make_system(sname, ccfg, inputs.for_system(sname))
+            train, test = split(folds, k)
+            programs = out / "programs" / cname / sname / f"fold{k}" if sname in LOGIC_SYSTEMS else None
+            t0 = time.perf_counter()
+            record = run_fold(system, ccfg, train, test, k, programs)
+            record.update(key=result_key(ccfg, sname, k), condition=cname, system=sname, fold=k,
+                          test_ids=[it.id for it in test], seconds=round(time.perf_counter() - t0, 3),
+                          pipeline_errors=inputs.errors.get(modality_of(sname), {}) if sname in LOGIC_SYSTEMS else {})
+            _write_json(fold_path(out, cname, sname, k), record)
+            done.setdefault(record["key"], fold_path(out, cname, sname, k))
+            ran += 1
+            bar.update(1)
+    bar.close()
+    summary = write_report(out, cfg, conds)
+    return {"ran": ran, "skipped": skipped, "report": summary}
+
+
+def _finished_keys(out: Path) -> dict[str, Path]:
+    """key -> fold file, over every finished fold file of the run folder."""
+    keys = {}
+    for p in sorted((Path(out) / "folds").glob("*/*/fold*.json")):
+        try:
+            keys.setdefault(json.loads(p.read_text())["key"], p)
+        except (OSError, json.JSONDecodeError, KeyError):
+            continue
+    return keys
+
+
+def _finished(path: Path, key: str) -> bool:
+    if not path.is_file():
+        return False
+    try:
+        return json.loads(path.read_text()).get("key") == key
+    except (OSError, json.JSONDecodeError):
+        return False

@@ -1,0 +1,116 @@
+"""The systems a study compares, behind one small interface.
+
+``make_system(name, cfg, inputs)`` binds a system to what it sees of every image (``inputs``: id ->
+SceneFacts for lv3d-*, id -> (4, S, S) pixel tensor for the baselines). ``fit(ids, labels, seed)``
+returns a fitted system whose ``predict(ids)`` gives (label, confidence) per image and whose
+``save(folder)`` writes what it learned that a person can read (the lv3d programs; nothing for
+the baselines). Labels are strings: class names, or ``not_<class>`` for the negatives of a class task.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+from .config import LOGIC_SYSTEMS
+
+
+class Fitted(Protocol):
+    def predict(self, ids: list[str]) -> list[tuple[str, float]]: ...
+
+    def save(self, folder: Path) -> None: ...
+
+
+def negative_label(cls: str) -> str:
+    return f"not_{cls}"
+
+
+def modality_of(system: str) -> str:
+    """'lv3d-rgbd' -> 'rgbd', 'cnn-rgbd-2s' -> 'rgbd', 'tree-depth' -> 'depth'."""
+    return system.split("-")[1]
+
+
+class LogicSystem:
+    """The lv3d learner over the facts of one modality, with the study's learner settings (a dict of
+    mil options, see lv3d.learn)."""
+
+    def __init__(self, name: str, facts: dict, settings: dict):
+        self.name, self.facts, self.settings = name, facts, dict(settings or {})
+
+    def fit(self, ids: list[str], labels: list[str], seed: int, positive: str | None = None) -> "FittedLogic":
+        """``positive``: the class of a binary class task (one program, for it; every other label is a
+        negative); None: a program per label. Scenes where perception found no object cannot be
+        examples (they have no target to speak of) and are left out of training."""
+        from ..learn import Model
+
+        keep = [(self.facts[i], y) for i, y in zip(ids, labels) if self.facts[i].target is not None]
+        model = Model.fit([f for f, _ in keep], [y for _, y in keep], settings=self.settings or None, seed=seed,
+                          classes=[positive] if positive else None)
+        return FittedLogic(model, self.facts)
+
+
+class FittedLogic:
+    def __init__(self, model, facts: dict):
+        self.model, self.facts = model, facts
+
+    def predict(self, ids: list[str]) -> list[tuple[str, float]]:
+        """(label, confidence of the best proof); "unknown" where no program proves the target (or
+        perception found no object)."""
+        out = []
+        for i in ids:
+            scene = self.facts[i]
+            out.append(("unknown", 0.0) if scene.target is None else tuple(self.model.predict(scene)))
+        return out
+
+    def explain(self, scene_id: str):
+        return self.model.explain(self.facts[scene_id])
+
+    def save(self, folder: Path) -> None:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        self.model.save(Path(folder))
+
+
+class PixelSystem:
+    """A CNN or a decision tree over the pixel tensors of one modality."""
+
+    def __init__(self, name: str, pixels: dict[str, np.ndarray], baselines: dict):
+        self.name, self.pixels, self.b = name, pixels, baselines
+        self.modality = modality_of(name)
+        self.channels = {"rgb": slice(0, 3), "depth": slice(3, 4), "rgbd": slice(0, 4)}[self.modality]
+
+    def _x(self, ids: list[str]) -> np.ndarray:
+        return np.stack([self.pixels[i][self.channels] for i in ids])
+
+    def fit(self, ids: list[str], labels: list[str], seed: int, positive: str | None = None) -> "FittedPixels":
+        """Train on the labels as given (a binary task's negatives share one label per task)."""
+        from ..baselines import CNNClassifier, CNNSettings, PixelTree
+
+        b = self.b
+        if self.name.startswith("tree-"):
+            model = PixelTree(cells=b["tree_cells"], min_samples_leaf=b["tree_min_samples_leaf"])
+        else:
+            settings = CNNSettings(epochs=b["epochs"], batch_size=b["batch_size"], lr=b["lr"],
+                                   weight_decay=b["weight_decay"], augment=b["augment"], width=b["width"],
+                                   threads=b["threads"])
+            model = CNNClassifier(self.modality, "twostream" if self.name.endswith("-2s") else "early", settings)
+        model.fit(self._x(ids), labels, seed=seed)
+        return FittedPixels(model, self)
+
+
+class FittedPixels:
+    def __init__(self, model, system: PixelSystem):
+        self.model, self.system = model, system
+
+    def predict(self, ids: list[str]) -> list[tuple[str, float]]:
+        return self.model.predict(self.system._x(ids))
+
+    def save(self, folder: Path) -> None:
+        """Nothing a person can read: the baselines' weights are not kept."""
+
+
+def make_system(name: str, cfg: dict, inputs: dict):
+    if name in LOGIC_SYSTEMS:
+        return LogicSystem(name, inputs, cfg["lv3d"]["settings"])
+    return PixelSystem(name, inputs, cfg["baselines"])

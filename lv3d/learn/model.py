@@ -1,0 +1,208 @@
+"""Learning shape concepts from scenes' facts: one program per class, classification by the most
+confident proof, and the proof as the explanation. Depends on the fact contract only."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import InputError
+from ..facts import PREDICATES, SceneFacts
+from . import engine
+from .engine import LearnError
+from .program import Program
+
+# Metarules for shape concepts, in search order: a part with a property, a part with two, a
+# conjunction on the object, then a part in a relation with another part.
+SHAPE_METARULES = ("part", "part2", "part_pair")
+SHAPE_SETTINGS = {"max_clauses": 1, "max_inventions": 0, "time_limit": 20}
+FIT_MODULE, SCENE_MODULE = "lv3d_fit", "lv3d_scene"
+
+
+# Search order of the body predicates, which decides among equally good hypotheses (the first
+# found wins): what a face is (sides, metric shape), then how faces meet, then the 2D outline, and
+# last the face's orientation to the table, which depends on how the solid happens to rest.
+BODY_ORDER = ("face_of", "triangle", "quadrilateral", "pentagon", "hexagon", "square", "rectangle", "regular",
+              "perpendicular_neighbour", "acute_neighbour", "obtuse_neighbour", "triangle_neighbour",
+              "quadrilateral_neighbour", "square_neighbour", "right_corner",
+              "adjacent", "perpendicular", "acute", "obtuse", "parallel", "parallelogram", "horizontal", "vertical")
+
+
+def body_preds(modality: str) -> list[tuple[str, int]]:
+    """The body predicates a system seeing ``modality`` learns with, in search order: the contract's
+    (but object/1, true of every target) and the derived ones of prolog/shape_bk.pl."""
+    own = [(p, a) for p, (a, mods) in PREDICATES.items() if modality in mods and p != "object"]
+    preds = own + list(engine.derived_preds())
+    rank = {p: i for i, p in enumerate(BODY_ORDER)}
+    return sorted(preds, key=lambda pa: rank.get(pa[0], len(rank)))
+
+
+def _facts_text(scene: SceneFacts) -> list[str]:
+    return [f"{f.pred}({','.join(f.args)},{f.conf:.6g})" for f in scene.facts]
+
+
+def _load(module: str, scenes: list[SceneFacts]) -> str:
+    facts = [t for s in scenes for t in _facts_text(s)]
+    return f"lv3d_bridge:load_scene({module}, {engine.fact_pred_specs()}, {engine.plist(facts)})"
+
+
+def _check_scenes(scenes: list[SceneFacts]) -> str:
+    if not scenes:
+        raise InputError("scenes", "no scenes to learn from")
+    modalities = {s.modality for s in scenes}
+    if len(modalities) != 1:
+        raise InputError("scenes", f"scenes of several modalities {sorted(modalities)}; learn one at a time")
+    targets = [s.target for s in scenes]
+    for s in scenes:
+        if s.target is None:
+            raise InputError(s.scene, "scene has no target object")
+    if len(set(targets)) != len(targets):
+        raise InputError("scenes", "two scenes share a target object id; scene ids must be unique")
+    return modalities.pop()
+
+
+def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: dict | None = None,
+        seed: int = 0) -> Program:
+    """Learn ``target(O)`` from the scenes' target objects: positives where label == target,
+    negatives the rest. ``settings`` override SHAPE_SETTINGS and mil's defaults (docs/learner.md).
+    LearnError when no hypothesis covers any sample or the search runs out of time."""
+    if len(scenes) != len(labels):
+        raise InputError("labels", f"{len(labels)} labels for {len(scenes)} scenes")
+    modality = _check_scenes(scenes)
+    pos = [s.target for s, y in zip(scenes, labels) if y == target]
+    neg = [s.target for s, y in zip(scenes, labels) if y != target]
+    if not pos:
+        raise InputError("labels", f"no scene is labelled {target!r}")
+    opts = {**SHAPE_SETTINGS, **(settings or {}), "seed": int(seed)}
+    preds = engine.plist(f"{p}/{a}" for p, a in body_preds(modality))
+    mrs = engine.plist(opts.pop("metarules", SHAPE_METARULES))
+    goal = (f"{_load(FIT_MODULE, scenes)}, "
+            f"lv3d_bridge:fit({FIT_MODULE}, {target}, {preds}, {mrs}, {engine.plist(pos)}, {engine.plist(neg)}, "
+            f"{engine.settings_term(opts)}, result(Texts, J, Soft, TP, NP, FP, NN)), "
+            f"lv3d_bridge:drop_scene({FIT_MODULE})")
+    try:
+        ans = engine.query(goal, where=f"learning {target}")
+    finally:
+        engine.query(f"lv3d_bridge:drop_scene({FIT_MODULE})")
+    if not ans:
+        raise LearnError(f"learning {target}: no program covers any sample of the positives")
+    a = ans[0]
+    score = {"j": float(a["J"]), "soft": float(a["Soft"]), "tp": int(a["TP"]), "n_pos": int(a["NP"]),
+             "fp": int(a["FP"]), "n_neg": int(a["NN"])}
+    return Program(target, tuple(str(t) for t in a["Texts"]), score, modality, opts)
+
+
+@dataclass
+class Explanation:
+    """Why a scene got its label: the best proof's clauses and the facts it used."""
+
+    label: str
+    confidence: float
+    target: str | None
+    clauses: list[str] = field(default_factory=list)
+    facts: list[tuple[str, float]] = field(default_factory=list)
+    derived: list[str] = field(default_factory=list)
+    others: dict[str, float] = field(default_factory=dict)
+
+    def __str__(self) -> str:
+        if self.label == "unknown":
+            return f"{self.target}: unknown (no class's program proves it)"
+        lines = [f"{self.target} is a {self.label} (confidence {self.confidence:.3f}) because"]
+        lines += ["  " + c.replace("\n", "\n  ") for c in self.clauses]
+        lines += [f"  with {a} ({c:.3f})" for a, c in self.facts]
+        lines += [f"  where {d} (background)" for d in self.derived]
+        if self.others:
+            lines.append("  also proved: " + ", ".join(f"{k} {v:.3f}" for k, v in self.others.items()))
+        return "\n".join(lines)
+
+
+class Model:
+    """One program per class. ``predict`` names the class whose program proves the scene's target
+    with the highest confidence (ties: the program with the higher training J), "unknown" if none."""
+
+    def __init__(self, programs: dict[str, Program], settings: dict | None = None):
+        self.programs = dict(programs)
+        self.settings = dict(settings or {})
+
+    @classmethod
+    def fit(cls, scenes: list[SceneFacts], labels: list[str], settings: dict | None = None, seed: int = 0,
+            classes: list[str] | None = None) -> "Model":
+        """A program for each class in ``classes`` (default: every label). A class whose search finds
+        nothing gets no program (it is never predicted)."""
+        programs = {}
+        for c in classes or sorted(set(labels)):
+            try:
+                programs[c] = fit(scenes, labels, c, settings=settings, seed=seed)
+            except LearnError:
+                continue
+        return cls(programs, settings)
+
+    def _proofs(self, scene: SceneFacts) -> list[dict]:
+        if scene.target is None:
+            raise InputError(scene.scene, "scene has no target object")
+        progs = engine.plist(f"{p.target}-{engine.plist(engine.quote(c) for c in p.clauses)}"
+                             for p in self.programs.values())
+        preds = engine.plist(f"{p}/{a}" for p, a in body_preds(scene.modality))
+        opts = {k: v for k, v in {**SHAPE_SETTINGS, **self.settings}.items() if k != "metarules"}
+        goal = (f"{_load(SCENE_MODULE, [scene])}, lv3d_bridge:classify({SCENE_MODULE}, {progs}, {preds}, "
+                f"{scene.target}, {engine.settings_term(opts)}, Rs), lv3d_bridge:drop_scene({SCENE_MODULE})")
+        ans = engine.query(goal, where=f"classifying {scene.scene}")
+        out = []
+        for r in ans[0]["Rs"] if ans else []:
+            label, conf, trace = _result_parts(r)
+            out.append({"label": label, "conf": conf, "trace": trace})
+        j = {k: p.score.get("j", 0.0) for k, p in self.programs.items()}
+        out.sort(key=lambda r: (r["conf"], j.get(r["label"], 0.0)), reverse=True)
+        return out
+
+    def predict(self, scene: SceneFacts) -> tuple[str, float]:
+        proofs = self._proofs(scene)
+        return (proofs[0]["label"], proofs[0]["conf"]) if proofs else ("unknown", 0.0)
+
+    def explain(self, scene: SceneFacts) -> Explanation:
+        proofs = self._proofs(scene)
+        if not proofs:
+            return Explanation("unknown", 0.0, scene.target)
+        best = proofs[0]
+        prog = self.programs[best["label"]]
+        used = sorted({int(i) for k, i, _ in best["trace"] if k == "clause"})
+        return Explanation(
+            best["label"], best["conf"], scene.target,
+            clauses=[prog.clauses[i - 1] for i in used if 0 < i <= len(prog.clauses)],
+            facts=[(a, c) for k, a, c in best["trace"] if k == "fact"],
+            derived=[a for k, a, _ in best["trace"] if k == "derived"],
+            others={p["label"]: p["conf"] for p in proofs[1:]})
+
+    def save(self, out_dir: Path) -> Path:
+        out_dir = Path(out_dir)
+        out_dir.mkdir(parents=True, exist_ok=True)
+        for p in self.programs.values():
+            p.save(out_dir / f"{p.target}.pl")
+        (out_dir / "model.json").write_text(json.dumps(
+            {"classes": sorted(self.programs), "settings": self.settings,
+             "scores": {k: p.score for k, p in self.programs.items()}}, indent=1))
+        return out_dir
+
+    @classmethod
+    def load(cls, in_dir: Path) -> "Model":
+        in_dir = Path(in_dir)
+        index = in_dir / "model.json"
+        if not index.is_file():
+            raise InputError(in_dir, "not a model directory (no model.json)")
+        try:
+            meta = json.loads(index.read_text())
+            classes = list(meta["classes"])
+        except (json.JSONDecodeError, KeyError, TypeError) as e:
+            raise InputError(index, f"malformed: {e}") from None
+        programs = {}
+        for c in classes:
+            p = Program.load(in_dir / f"{c}.pl", target=c)
+            programs[c] = Program(p.target, p.clauses, meta.get("scores", {}).get(c, {}), p.modality)
+        return cls(programs, meta.get("settings", {}))
+
+
+def _result_parts(r) -> tuple[str, float, list[tuple[str, str, float]]]:
+    """[Label, Conf, [[Kind, Atom, Conf], ...]] as lv3d_bridge:classify/6 hands it back."""
+    label, conf, trace = r
+    return str(label), float(conf), [(str(k), str(a), float(c)) for k, a, c in trace]

@@ -1,0 +1,51 @@
+"""A plane's boundary as an image polygon: grid mask -> pixel mask -> outer contour -> convex hull (faces of
+the solids are convex; the hull bridges holes and ragged noise) -> corners only."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from .polygons import clockwise, simplify
+
+
+def mask_polygon(grid_mask: np.ndarray, stride: int, image_shape: tuple[int, int], eps_frac: float = 0.035,
+                 convex: bool = True) -> np.ndarray | None:
+    """Polygon (n, 2) pixels, clockwise, of the largest piece of ``grid_mask`` (h, w) bool on a point grid of
+    step ``stride``; None when nothing is left. ``eps_frac``: Douglas-Peucker tolerance as a fraction of the
+    perimeter."""
+    m = grid_mask.astype(np.uint8)
+    m = cv2.morphologyEx(m, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8))
+    contours, _ = cv2.findContours(m, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    if not contours:
+        return None
+    c = max(contours, key=cv2.contourArea)
+    if convex:
+        c = cv2.convexHull(c)
+    # grid cell (i, j) covers pixels [stride*j - stride/2, stride*j + stride/2): scale, then centre the cells
+    pts = c.reshape(-1, 2).astype(np.float64) * stride
+    peri = cv2.arcLength(pts.astype(np.float32).reshape(-1, 1, 2), True)
+    # a thin face (seen at a grazing angle) must not collapse: the tolerance stays under a fifth of its width
+    short_side = min(cv2.minAreaRect(pts.astype(np.float32).reshape(-1, 1, 2))[1])
+    eps = max(1.0, min(eps_frac * peri, 0.2 * short_side))
+    approx = cv2.approxPolyDP(pts.astype(np.float32).reshape(-1, 1, 2), eps, True).reshape(-1, 2)
+    if len(approx) < 3:
+        return None
+    poly = simplify(approx.astype(np.float64))
+    h, w = image_shape
+    poly[:, 0] = np.clip(poly[:, 0], 0, w - 1)
+    poly[:, 1] = np.clip(poly[:, 1], 0, h - 1)
+    return clockwise(poly) if len(poly) >= 3 else None
+
+
+def grid_to_pixels(grid_mask: np.ndarray, stride: int, box: tuple[int, int, int, int]) -> np.ndarray:
+    """The pixel mask (v1 - v0, u1 - u0) bool of grid mask (h, w) inside ``box`` = (u0, v0, u1, v1) pixels;
+    grid cell (i, j) covers pixels [stride*i, stride*i + stride) x [stride*j, stride*j + stride)."""
+    u0, v0, u1, v1 = box
+    v = np.arange(v0, v1) // stride
+    u = np.arange(u0, u1) // stride
+    h, w = grid_mask.shape
+    inside_v, inside_u = v < h, u < w
+    out = np.zeros((v1 - v0, u1 - u0), bool)
+    out[np.ix_(inside_v, inside_u)] = grid_mask[np.ix_(v[inside_v], u[inside_u])]
+    return out

@@ -1,0 +1,78 @@
+"""``lv3d extract``: perceive one frame and write scene.json and overlay.png (and facts with --facts)."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import click
+import cv2
+
+from ..errors import InputError
+
+
+@click.command()
+@click.argument("color", type=click.Path(path_type=Path))
+@click.option("--depth", type=click.Path(path_type=Path), default=None, help="16-bit depth image (PNG or TIFF).")
+@click.option("--intrinsics", type=click.Path(path_type=Path), default=None,
+              help="Intrinsics JSON (plain, a data set's meta.json, or the real-data layout with 'frames').")
+@click.option("--depth-scale", type=float, default=None, help="Metres per depth unit (default: from the intrinsics "
+              "file, else 0.001).")
+@click.option("--modality", type=click.Choice(["rgb", "depth", "rgbd"]), default="rgbd", show_default=True)
+@click.option("--scene-id", default="s000000", show_default=True, help="Scene id, a Prolog atom like s000123.")
+@click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder.")
+@click.option("--facts", is_flag=True, help="Also ground the scene and write facts.json and facts.pl.")
+def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scale: float | None, modality: str,
+            scene_id: str, out_dir: Path, facts: bool) -> None:
+    """Find objects, faces and planes in one frame COLOR; write OUT/scene.json and OUT/overlay.png."""
+    from ..rgbd import load_frame, read_intrinsics
+    from .overlay import draw_overlay
+    from .perceive import perceive
+
+    if modality in ("depth", "rgbd") and depth is None:
+        raise InputError("--depth", f"modality {modality!r} needs a depth image")
+    if intrinsics is None:
+        raise InputError("--intrinsics", "an intrinsics JSON file is required")
+    frame_name = Path(color).stem.removesuffix("_rgb")
+    k, scale = read_intrinsics(intrinsics, frame_name)
+    frame = load_frame(color, depth if modality != "rgb" else None, k,
+                       depth_scale if depth_scale is not None else scale, name=frame_name)
+    scene = perceive(frame, modality, scene_id=scene_id)
+    if not scene.objects:
+        raise InputError(color, "no object found in this frame")
+    facts_obj = None
+    if facts:
+        from ..describe import describe  # written beside grounding; imported only when asked for
+
+        facts_obj = describe(scene, frame)
+    _write_atomically(Path(out_dir), scene, draw_overlay(frame.color, scene), facts_obj)
+    click.echo(f"{out_dir}: {len(scene.objects)} objects, "
+               f"{sum(len(o.faces) for o in scene.objects)} faces, target {scene.target().id}")
+
+
+def _write_atomically(out_dir: Path, scene, overlay_rgb, facts_obj) -> None:
+    """Write everything into a temporary folder beside ``out_dir``, then move it into place, so that an
+    error never leaves half the outputs behind."""
+    out_dir = out_dir.resolve()
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+    try:
+        (tmp / "scene.json").write_text(json.dumps(scene.to_dict(), indent=1, default=float))
+        if not cv2.imwrite(str(tmp / "overlay.png"), cv2.cvtColor(overlay_rgb, cv2.COLOR_RGB2BGR)):
+            raise InputError(out_dir, "cannot write overlay.png")
+        if facts_obj is not None:
+            facts_obj.write(tmp)
+        if out_dir.exists():
+            # replace an earlier run's outputs: move the old folder aside first, drop it after the rename
+            old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old.", dir=out_dir.parent))
+            os.replace(out_dir, old / "x")
+            os.replace(tmp, out_dir)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, out_dir)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise

@@ -1,0 +1,108 @@
+"""The depth image as an organised point grid: back-projection on a strided pixel grid, per-point normals from
+neighbouring points, and removal of isolated (flying) points.
+
+A grid is (h, w, 3) camera-frame metres for pixels (u, v) = (stride * j + off, stride * i + off); invalid
+points are zero with ``valid`` False. Working on a strided grid keeps every depth stage within its time budget.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from ..camera import Intrinsics
+
+
+@dataclass(frozen=True)
+class PointGrid:
+    """``xyz``: (h, w, 3) float32 metres; ``normals``: (h, w, 3) unit, towards the camera (zero where unknown);
+    ``valid``: (h, w) bool; ``stride``: pixel step of the grid; grid cell (i, j) is pixel (stride*j, stride*i)."""
+
+    xyz: np.ndarray
+    normals: np.ndarray
+    valid: np.ndarray
+    stride: int
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.valid.shape
+
+    def pixels(self, ij: np.ndarray) -> np.ndarray:
+        """Grid cells (m, 2) as (i, j) -> pixels (m, 2) as (u, v)."""
+        return np.stack([ij[:, 1] * self.stride, ij[:, 0] * self.stride], axis=1).astype(np.float64)
+
+
+def back_project(depth: np.ndarray, k: Intrinsics, stride: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """Depth (H, W) metres -> points (h, w, 3) float32 and valid (h, w) on the strided grid."""
+    z = np.ascontiguousarray(depth[::stride, ::stride]).astype(np.float32)
+    h, w = z.shape
+    u = (np.arange(w, dtype=np.float32) * stride - k.cx) / k.fx
+    v = (np.arange(h, dtype=np.float32) * stride - k.cy) / k.fy
+    xyz = np.empty((h, w, 3), np.float32)
+    xyz[..., 0] = u[None, :] * z
+    xyz[..., 1] = v[:, None] * z
+    xyz[..., 2] = z
+    return xyz, np.isfinite(z) & (z > 0)
+
+
+def remove_flying(xyz: np.ndarray, valid: np.ndarray, rel_jump: float = 0.03, min_neighbours: int = 4) -> np.ndarray:
+    """Valid mask without isolated points: a point needs ``min_neighbours`` of its 8 grid neighbours within
+    ``rel_jump`` * depth of it (flying pixels between a foreground edge and the background have none)."""
+    z = np.where(valid, xyz[..., 2], 0).astype(np.float32)
+    zp = np.pad(z, 1)
+    count = np.zeros(z.shape, np.int32)
+    h, w = z.shape
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            if di == 0 and dj == 0:
+                continue
+            nb = zp[1 + di:1 + di + h, 1 + dj:1 + dj + w]
+            count += ((nb > 0) & (np.abs(nb - z) <= rel_jump * z)).astype(np.int32)
+    return valid & (count >= min_neighbours)
+
+
+def grid_normals(xyz: np.ndarray, valid: np.ndarray, smooth: int = 5) -> np.ndarray:
+    """Unit normals (h, w, 3) from the cross product of the smoothed grid's horizontal and vertical
+    differences, oriented towards the camera; zero where a neighbour is missing."""
+    m = valid.astype(np.float32)
+    ksize = (smooth, smooth)
+    wsum = cv2.boxFilter(m, -1, ksize, normalize=False)
+    sm = cv2.boxFilter(xyz * m[..., None], -1, ksize, normalize=False) / np.maximum(wsum, 1e-6)[..., None]
+    du = np.zeros_like(sm)
+    dv = np.zeros_like(sm)
+    du[:, 1:-1] = sm[:, 2:] - sm[:, :-2]
+    dv[1:-1, :] = sm[2:, :] - sm[:-2, :]
+    n = np.empty_like(sm)  # du x dv, written out: np.cross is slow on images
+    n[..., 0] = du[..., 1] * dv[..., 2] - du[..., 2] * dv[..., 1]
+    n[..., 1] = du[..., 2] * dv[..., 0] - du[..., 0] * dv[..., 2]
+    n[..., 2] = du[..., 0] * dv[..., 1] - du[..., 1] * dv[..., 0]
+    norm = np.sqrt((n * n).sum(axis=2, keepdims=True))
+    n /= np.maximum(norm, 1e-12)
+    flip = (n * xyz).sum(axis=2) > 0  # towards the camera: n . X < 0
+    n[flip] *= -1
+    ok = valid & (wsum >= 0.6 * smooth * smooth)
+    ok[:, :1] = ok[:, -1:] = False
+    ok[:1, :] = ok[-1:, :] = False
+    n[~ok] = 0
+    return n.astype(np.float32)
+
+
+def point_grid(depth: np.ndarray, k: Intrinsics, stride: int = 2, normals: bool = True) -> PointGrid:
+    """Back-project and drop flying points; estimate normals unless ``normals`` is False (then they are zero,
+    and :func:`crop_normals` gives them where they are needed)."""
+    xyz, valid = back_project(depth, k, stride)
+    valid = remove_flying(xyz, valid)
+    xyz[~valid] = 0
+    nrm = grid_normals(xyz, valid) if normals else np.zeros_like(xyz)
+    return PointGrid(xyz, nrm, valid, stride)
+
+
+def crop_normals(grid: PointGrid, i0: int, j0: int, i1: int, j1: int, margin: int = 3) -> np.ndarray:
+    """Normals (i1 - i0, j1 - j0, 3) of grid rows i0:i1 and columns j0:j1, computed on the crop plus a margin
+    (objects are small: normals of the whole grid would cost more than everything else)."""
+    h, w = grid.shape
+    a0, b0, a1, b1 = max(0, i0 - margin), max(0, j0 - margin), min(h, i1 + margin), min(w, j1 + margin)
+    n = grid_normals(np.ascontiguousarray(grid.xyz[a0:a1, b0:b1]), grid.valid[a0:a1, b0:b1])
+    return n[i0 - a0:i1 - a0, j0 - b0:j1 - b0]

@@ -1,0 +1,73 @@
+"""Faces from depth alone: point grid -> support plane -> objects above it -> planes per object -> boundary
+polygons, plane adjacency."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..plane import Plane
+from ..rgbd import RGBD
+from .boundary import mask_polygon
+from .cloud import PointGrid, point_grid
+from .objects import DepthObject, segment_objects
+from .planes import DepthPlane, object_planes, plane_adjacency
+
+
+@dataclass(frozen=True)
+class DepthObjectResult:
+    """One object: its grid ``mask``, ``planes`` (largest first), their image ``polygons`` (None where the
+    mask gave none), ``adjacency`` (i, j) between planes, and the object's point centroid (metres)."""
+
+    obj: DepthObject
+    planes: list[DepthPlane]
+    polygons: list[np.ndarray | None]
+    adjacency: list[tuple[int, int]]
+    centroid_m: np.ndarray
+    box_px: tuple[int, int, int, int]  # (u0, v0, u1, v1), end exclusive
+
+
+@dataclass
+class DepthResult:
+    grid: PointGrid
+    support: Plane | None
+    objects: list[DepthObjectResult]
+    timings_ms: dict[str, float] = field(default_factory=dict)
+
+
+def depth_scene(frame: RGBD, stride: int = 2, seed: int = 0, max_objects: int = 8) -> DepthResult:
+    """Run the depth stages on one frame; at most ``max_objects`` objects (largest first) get planes."""
+    t0 = time.perf_counter()
+    grid = point_grid(frame.depth, frame.intrinsics, stride, normals=False)
+    t1 = time.perf_counter()
+    support = _support(grid, seed)
+    t2 = time.perf_counter()
+    objs = segment_objects(grid, support)[:max_objects]
+    t3 = time.perf_counter()
+    h, w = frame.shape
+    results = []
+    t_planes = t_boundary = 0.0
+    for k, o in enumerate(objs):
+        ta = time.perf_counter()
+        planes = object_planes(grid, o.mask, seed=seed + k)
+        adj = plane_adjacency(planes)
+        tb = time.perf_counter()
+        polys = [mask_polygon(p.mask, stride, (h, w)) for p in planes]
+        t_boundary += time.perf_counter() - tb
+        t_planes += tb - ta
+        ij = np.argwhere(o.mask)
+        (i0, j0), (i1, j1) = ij.min(axis=0), ij.max(axis=0)
+        box = (int(j0 * stride), int(i0 * stride), min(w, int((j1 + 1) * stride)), min(h, int((i1 + 1) * stride)))
+        results.append(DepthObjectResult(o, planes, polys, adj, grid.xyz[o.mask].mean(axis=0).astype(np.float64), box))
+    timings = {"cloud": (t1 - t0) * 1e3, "support": (t2 - t1) * 1e3, "objects": (t3 - t2) * 1e3,
+               "planes": t_planes * 1e3, "boundary": t_boundary * 1e3}
+    return DepthResult(grid, support, results, timings)
+
+
+def _support(grid: PointGrid, seed: int) -> Plane | None:
+    from .support import support_plane
+
+    # every other grid point is plenty for the support plane
+    return support_plane(grid.xyz[::2, ::2][grid.valid[::2, ::2]].astype(np.float64), seed=seed)

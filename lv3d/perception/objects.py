@@ -1,0 +1,77 @@
+"""Objects on the support plane: the points above it, split into connected pieces of the image grid where
+neither the mask nor the depth breaks."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from ..plane import Plane
+from .cloud import PointGrid
+from .support import noise_threshold
+
+
+@dataclass(frozen=True)
+class DepthObject:
+    """One object: ``mask`` (h, w) bool on the point grid; ``height_m``: its highest point above the support."""
+
+    mask: np.ndarray
+    height_m: float
+
+    @property
+    def size(self) -> int:
+        return int(self.mask.sum())
+
+
+def border_contact(mask: np.ndarray) -> float:
+    """Length of the mask's outline on the grid border over its whole outline length (grid cells)."""
+    edge = np.count_nonzero(mask[0]) + np.count_nonzero(mask[-1]) + np.count_nonzero(mask[:, 0]) + \
+        np.count_nonzero(mask[:, -1])
+    inner = mask & ~cv2.erode(mask.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_REPLICATE
+                              ).astype(bool)
+    return edge / max(1, np.count_nonzero(inner))
+
+
+def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60, min_height_m: float = 0.015,
+                    rel_jump: float = 0.02, max_border: float = 0.12) -> list[DepthObject]:
+    """Objects above ``support`` on the grid, largest first. Points within the noise band of the support plane
+    or below it are removed; the rest splits at depth jumps larger than ``rel_jump`` * depth; pieces with fewer
+    than ``min_points`` grid points, lower than ``min_height_m``, or cut by the image border along more than
+``max_border`` of their outline (walls, furniture, the floor beyond a table: scenery, not objects) are dropped. Without a support plane every
+    valid point counts as foreground."""
+    valid = grid.valid
+    if support is not None:
+        h_above = np.where(valid, grid.xyz @ support.n.astype(np.float32) + np.float32(support.offset), 0)
+        z_med = float(np.median(grid.xyz[..., 2][valid])) if valid.any() else 1.0
+        band = 1.5 * noise_threshold(z_med)
+        fg = valid & (h_above > band)
+    else:
+        h_above = np.where(valid, 1.0, 0)
+        fg = valid.copy()
+    z = grid.xyz[..., 2]
+    # cut the grid where depth jumps between neighbours: touching-in-the-image objects at different depths
+    jump = np.zeros_like(fg)
+    dz_u = np.abs(np.diff(z, axis=1)) > rel_jump * z[:, 1:]
+    dz_v = np.abs(np.diff(z, axis=0)) > rel_jump * z[1:, :]
+    jump[:, 1:] |= dz_u
+    jump[1:, :] |= dz_v
+    fg_cut = fg & ~jump
+    fg_cut = cv2.morphologyEx(fg_cut.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)).astype(bool)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(fg_cut.astype(np.uint8), connectivity=4)
+    out = []
+    for lab in range(1, n):
+        if stats[lab, cv2.CC_STAT_AREA] < min_points:
+            continue
+        m = labels == lab
+        if border_contact(m) > max_border:
+            continue
+        height = float(np.percentile(h_above[m], 95)) if support is not None else np.inf
+        if height < min_height_m:
+            continue
+        # give back the cut pixels that touch this piece and sit at its depth
+        grown = cv2.dilate(m.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool) & fg & ~fg_cut
+        out.append(DepthObject(m | grown, height))
+    out.sort(key=lambda o: (-o.size, int(np.argmax(o.mask))))
+    return out

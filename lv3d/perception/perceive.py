@@ -1,0 +1,152 @@
+"""``perceive``: one frame and a modality in, a :class:`lv3d.scene.Scene` out."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..errors import InputError
+from ..facts import MODALITIES, face_id, object_id
+from ..rgbd import RGBD
+from ..scene import Face, Scene, SceneObject
+from .depth import DepthObjectResult, DepthResult, depth_scene
+from .fuse import inside_fraction, match_faces
+from .polygons import area
+from .rgb import RGBFace, rgb_faces
+
+_CROP_MARGIN_PX = 12
+
+
+def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 0) -> Scene:
+    """Objects and faces of ``frame`` as a system that sees ``modality`` ('rgb', 'depth', 'rgbd') finds them.
+
+    Object ids are ``<scene>_o<k>`` and face ids ``<scene>_o<k>_f<j>``, k and j from 1, objects largest first.
+    ``Scene.timings_ms`` holds the time of each stage. Deterministic for a given ``seed``."""
+    if modality not in MODALITIES:
+        raise InputError("--modality", f"unknown modality {modality!r}; choose one of {', '.join(MODALITIES)}")
+    _check_frame(frame, modality)
+    if modality == "rgb":
+        res = rgb_faces(frame.color)
+        scene = Scene(scene_id, modality, frame.intrinsics, timings_ms=dict(res.timings_ms))
+        scene.objects = _rgb_objects(scene_id, res.faces, res.groups, res.adjacency)
+        return scene
+    dres = depth_scene(frame, seed=seed)
+    scene = Scene(scene_id, modality, frame.intrinsics, support_plane=dres.support, timings_ms=dict(dres.timings_ms))
+    if modality == "depth":
+        scene.objects = [_depth_object(scene_id, k + 1, o, dres) for k, o in enumerate(dres.objects)]
+        return scene
+    scene.objects = _fused_objects(frame, scene_id, dres, scene.timings_ms)
+    return scene
+
+
+def _check_frame(frame: RGBD, modality: str) -> None:
+    h, w = frame.color.shape[:2]
+    if frame.color.ndim != 3 or frame.color.shape[2] != 3 or frame.color.dtype != np.uint8:
+        raise InputError(frame.name, f"colour must be (H, W, 3) uint8, got {frame.color.shape} {frame.color.dtype}")
+    if frame.depth.shape != (h, w):
+        raise InputError(frame.name, f"depth is {frame.depth.shape} but colour is {(h, w)}")
+    if modality != "rgb" and not np.any(np.isfinite(frame.depth) & (frame.depth > 0)):
+        raise InputError(frame.name, f"modality {modality!r} needs depth, but the depth has no reading")
+
+
+def _centroid(polys: list[np.ndarray]) -> tuple[float, float]:
+    w = np.array([area(p) for p in polys])
+    c = np.array([p.mean(axis=0) for p in polys])
+    return tuple(float(x) for x in (c * w[:, None]).sum(0) / max(w.sum(), 1e-9))
+
+
+def _rgb_objects(scene_id: str, faces: list[RGBFace], groups: list[list[int]],
+                 adjacency: list[tuple[int, int]]) -> list[SceneObject]:
+    out = []
+    for k, idx in enumerate(groups, start=1):
+        oid = object_id(scene_id, k)
+        ids = {i: face_id(scene_id, k, j) for j, i in enumerate(idx, start=1)}
+        obj_faces = [Face(ids[i], faces[i].polygon, "rgb", edge_support=faces[i].edge_support) for i in idx]
+        adj = [(ids[a], ids[b]) for a, b in adjacency if a in ids and b in ids]
+        out.append(SceneObject(oid, obj_faces, adj, int(round(sum(faces[i].area_px for i in idx))),
+                               _centroid([faces[i].polygon for i in idx])))
+    return out
+
+
+def _object_pixels(o: DepthObjectResult, stride: int) -> tuple[int, tuple[float, float]]:
+    ij = np.argwhere(o.obj.mask)
+    return int(len(ij) * stride * stride), (float(ij[:, 1].mean() * stride), float(ij[:, 0].mean() * stride))
+
+
+def _depth_object(scene_id: str, k: int, o: DepthObjectResult, dres: DepthResult) -> SceneObject:
+    stride = dres.grid.stride
+    faces, index = [], {}
+    for i, (p, poly) in enumerate(zip(o.planes, o.polygons)):
+        if poly is None:
+            continue
+        index[i] = face_id(scene_id, k, len(faces) + 1)
+        faces.append(Face(index[i], poly, "depth", plane=p.plane, points=p.points, plane_rms_m=p.rms_m))
+    adj = [(index[a], index[b]) for a, b in o.adjacency if a in index and b in index]
+    count, centroid = _object_pixels(o, stride)
+    return SceneObject(object_id(scene_id, k), faces, adj, count, centroid)
+
+
+def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[str, float]) -> list[SceneObject]:
+    """Colour faces searched only in a crop around each depth object, matched to its planes."""
+    stride = dres.grid.stride
+    h, w = frame.shape
+    for key in ("edges", "segments", "faces", "fuse"):
+        timings.setdefault(key, 0.0)
+    out = []
+    for k, o in enumerate(dres.objects, start=1):
+        u0, v0, u1, v1 = o.box_px
+        box = (max(0, u0 - _CROP_MARGIN_PX), max(0, v0 - _CROP_MARGIN_PX),
+               min(w, u1 + _CROP_MARGIN_PX), min(h, v1 + _CROP_MARGIN_PX))
+        res = rgb_faces(frame.color, box=box)
+        for key, v in res.timings_ms.items():
+            timings[key] += v
+        t0 = time.perf_counter()
+        # colour faces of this object: mostly on its depth mask (the crop also holds table and neighbours)
+        grown = _dilate(o.obj.mask)
+        mine = [i for i, f in enumerate(res.faces) if inside_fraction(f.polygon, grown, stride, box) >= 0.6]
+        polys = [res.faces[i].polygon for i in mine]
+        match = match_faces(polys, [p.mask for p in o.planes], stride, box, min_iou=0.5)
+        faces: list[Face] = []
+        plane_face: dict[int, int] = {}
+        colour_face: dict[int, int] = {}
+        on_plane = [max((inside_fraction(p_, q.mask, stride, box) for q in o.planes), default=0.0) for p_ in polys]
+        for a, i in enumerate(mine):
+            f = res.faces[i]
+            if a not in match and on_plane[a] >= 0.5:
+                continue  # a patch of print or shadow on a plane that depth already has: not a face
+            if a in match:
+                p = o.planes[match[a]]
+                face = Face("", f.polygon, "rgbd", plane=p.plane, points=p.points, edge_support=f.edge_support,
+                            plane_rms_m=p.rms_m)
+                plane_face[match[a]] = len(faces)
+            else:
+                face = Face("", f.polygon, "rgb", edge_support=f.edge_support)
+            colour_face[i] = len(faces)
+            faces.append(face)
+        for j, (p, poly) in enumerate(zip(o.planes, o.polygons)):
+            if j not in plane_face and poly is not None:
+                plane_face[j] = len(faces)
+                faces.append(Face("", poly, "depth", plane=p.plane, points=p.points, plane_rms_m=p.rms_m))
+        pairs = {tuple(sorted((plane_face[a], plane_face[b]))) for a, b in o.adjacency
+                 if a in plane_face and b in plane_face}
+        pairs |= {tuple(sorted((colour_face[a], colour_face[b]))) for a, b in res.adjacency
+                  if a in colour_face and b in colour_face}
+        # stable ids: faces largest first
+        order = sorted(range(len(faces)), key=lambda i: (-area(faces[i].polygon), float(faces[i].polygon[0, 0])))
+        rank = {i: r for r, i in enumerate(order)}
+        for i, f in enumerate(faces):
+            f.id = face_id(scene_id, k, rank[i] + 1)
+        faces = [faces[i] for i in order]
+        adj = sorted((min(faces[rank[a]].id, faces[rank[b]].id), max(faces[rank[a]].id, faces[rank[b]].id))
+                     for a, b in pairs)
+        count, centroid = _object_pixels(o, stride)
+        out.append(SceneObject(object_id(scene_id, k), faces, adj, count, centroid))
+        timings["fuse"] += (time.perf_counter() - t0) * 1e3
+    return out
+
+
+def _dilate(mask: np.ndarray) -> np.ndarray:
+    import cv2
+
+    return cv2.dilate(mask.astype(np.uint8), np.ones((3, 3), np.uint8), iterations=2).astype(bool)

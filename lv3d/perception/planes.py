@@ -1,0 +1,125 @@
+"""Planes of one object: seeded RANSAC on points and normals, peeled off one at a time, each kept as one
+connected piece of the image grid and refitted by least squares; then every object point goes to the plane it
+fits best, so that neighbouring planes' masks meet along their shared edge."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from ..plane import Plane
+from .cloud import PointGrid, crop_normals
+from .support import noise_threshold, ransac_plane, refine
+
+
+@dataclass(frozen=True)
+class DepthPlane:
+    """``plane`` in the camera frame; ``mask`` (h, w) bool on the point grid; ``points`` (m, 3) metres;
+    ``rms_m``: RMS point-to-plane distance of those points."""
+
+    plane: Plane
+    mask: np.ndarray
+    points: np.ndarray
+    rms_m: float
+
+
+def _largest_piece(mask: np.ndarray) -> np.ndarray:
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
+    if n <= 1:
+        return mask
+    best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    return lab == best
+
+
+def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_planes: int = 6,
+                  min_frac: float = 0.06, min_points: int = 25, max_angle_deg: float = 20.0) -> list[DepthPlane]:
+    """Planes of the object whose grid cells are ``obj_mask`` (h, w) bool, largest first. A plane needs at least
+    ``max(min_points, min_frac * object size)`` points in one connected piece."""
+    rng = np.random.default_rng(seed)
+    full_shape = obj_mask.shape
+    ij = np.argwhere(obj_mask)
+    if len(ij) == 0:
+        return []
+    # work on the object's bounding box of the grid: connected components there are cheap
+    (i0, j0), (i1, j1) = ij.min(axis=0), ij.max(axis=0) + 1
+    ij = ij - np.array([i0, j0])
+    obj_mask = obj_mask[i0:i1, j0:j1]
+    pts = grid.xyz[i0:i1, j0:j1][obj_mask].astype(np.float64)
+    nrm_grid = grid.normals[i0:i1, j0:j1]
+    if not nrm_grid.any():
+        nrm_grid = crop_normals(grid, i0, j0, i1, j1)
+    nrm = nrm_grid[obj_mask].astype(np.float64)
+    if len(pts) < min_points:
+        return []
+    dist_m = noise_threshold(float(np.median(pts[:, 2])))
+    need = max(min_points, int(min_frac * len(pts)))
+    free = np.ones(len(pts), bool)
+    h, w = obj_mask.shape
+    planes: list[Plane] = []
+    for _ in range(max_planes):
+        idx = np.nonzero(free)[0]
+        if len(idx) < need:
+            break
+        plane, inl = ransac_plane(pts[idx], dist_m, rng, iterations=96, normals=nrm[idx], max_angle_deg=max_angle_deg)
+        m = np.zeros((h, w), bool)
+        m[ij[idx[inl], 0], ij[idx[inl], 1]] = True
+        piece = _largest_piece(m)
+        sel = piece[ij[:, 0], ij[:, 1]] & free
+        if sel.sum() < need:
+            break
+        plane = refine(pts[sel])
+        planes.append(plane)
+        free &= ~sel
+    if not planes:
+        return []
+    # each point to its best plane (distance, with normals that disagree counted as far)
+    cos = np.abs(nrm @ np.array([p.n for p in planes]).T)
+    dist = np.abs(pts @ np.array([p.n for p in planes]).T + np.array([p.offset for p in planes])[None, :])
+    known = np.linalg.norm(nrm, axis=1) > 0
+    score = dist / dist_m + np.where(known[:, None], 2.0 * (1.0 - cos) / (1 - np.cos(np.radians(max_angle_deg))), 0)
+    best = np.argmin(score, axis=1)
+    ok = dist[np.arange(len(pts)), best] <= 3 * dist_m
+    out = []
+    for k, plane in enumerate(planes):
+        m = np.zeros((h, w), bool)
+        sel = ok & (best == k)
+        m[ij[sel, 0], ij[sel, 1]] = True
+        m = _largest_piece(m)
+        sel = m[ij[:, 0], ij[:, 1]]
+        if sel.sum() < need:
+            continue
+        p = refine(pts[sel])
+        rms = float(np.sqrt(np.mean(p.distance(pts[sel]) ** 2)))
+        full = np.zeros(full_shape, bool)
+        full[i0:i1, j0:j1] = m
+        out.append(DepthPlane(p, full, pts[sel].astype(np.float32), rms))
+    out.sort(key=lambda d: -int(d.mask.sum()))
+    return out
+
+
+def plane_adjacency(planes: list[DepthPlane], min_contact: int = 4, min_angle_deg: float = 15.0) -> list[tuple[int, int]]:
+    """Pairs (i, j), i < j, of planes whose masks touch along at least ``min_contact`` grid cells and whose
+    normals differ by at least ``min_angle_deg`` (two parallel touching pieces are one face, not an edge)."""
+    out = []
+    grown = [cv2.dilate(p.mask.astype(np.uint8), np.ones((3, 3), np.uint8), iterations=2).astype(bool)
+             for p in planes]
+    for i in range(len(planes)):
+        for j in range(i + 1, len(planes)):
+            contact = int((grown[i] & planes[j].mask).sum())
+            ang = np.degrees(np.arccos(np.clip(abs(planes[i].plane.n @ planes[j].plane.n), -1, 1)))
+            if contact >= min_contact and ang >= min_angle_deg:
+                out.append((i, j))
+    return out
+
+
+def outward_normal(plane: DepthPlane, centroid: np.ndarray) -> np.ndarray:
+    """The plane's normal turned away from the object's centroid (metres, camera frame): outward for a convex
+    object. Visible faces of a convex object face the camera too, which breaks ties."""
+    n = plane.plane.n
+    c = plane.points.mean(axis=0)
+    s = float(n @ (c - centroid))
+    if abs(s) < 1e-4:
+        return n  # centroid on the plane (one face seen): towards the camera is outward
+    return n if s > 0 else -n

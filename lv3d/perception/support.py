@@ -1,0 +1,93 @@
+"""The support plane (table, desk, floor): seeded RANSAC, preferring a large plane that faces up in the image
+over a wall or a cabinet front, then a least-squares refit.
+
+RANSAC is done here in numpy rather than with open3d's ``segment_plane``: open3d draws its samples in parallel
+threads, so even seeded (``o3d.utility.random.seed``) its model changes slightly from run to run, and perception
+must be reproducible bit for bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..plane import Plane
+
+
+def refine(points: np.ndarray) -> Plane:
+    """Least-squares plane through points (m, 3): the smallest principal direction of their scatter."""
+    c = points.mean(axis=0)
+    q = points - c
+    _, vecs = np.linalg.eigh(q.T @ q)  # 3x3 scatter: cheaper than an SVD of all the points
+    n = vecs[:, 0]
+    return Plane.from_arrays(n, -float(n @ c))
+
+
+def ransac_plane(points: np.ndarray, dist_m: float, rng: np.random.Generator, iterations: int = 128,
+                 normals: np.ndarray | None = None, max_angle_deg: float = 25.0,
+                 score_points: int = 600) -> tuple[Plane, np.ndarray]:
+    """The plane with most inliers among ``iterations`` random triples of points (m, 3) metres, refitted by
+    least squares until its inlier set is stable. Inliers lie within ``dist_m``; with ``normals`` (m, 3) their
+    normal must also be within ``max_angle_deg`` of the plane's (zero normals never count).
+    Returns the plane and the boolean inlier mask (m,)."""
+    m = len(points)
+    tri = rng.integers(0, m, size=(iterations, 3))
+    a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
+    n = np.cross(b - a, c - a)
+    norm = np.linalg.norm(n, axis=1)
+    good = norm > 1e-12
+    n = n[good] / norm[good, None]
+    d = -np.einsum("ij,ij->i", n, a[good])
+    if len(n) == 0:
+        return refine(points), np.ones(m, bool)
+    # score the hypotheses on a fixed subset of at most score_points points (preemptive RANSAC)
+    sub = np.arange(m) if m <= score_points else np.sort(rng.choice(m, score_points, replace=False))
+    dist = np.abs(points[sub] @ n.T + d[None, :])                # (s, k)
+    inl = dist <= dist_m
+    if normals is not None:
+        cos_min = np.cos(np.radians(max_angle_deg))
+        inl &= np.abs(normals[sub] @ n.T) >= cos_min
+    best = int(np.argmax(inl.sum(axis=0)))
+    plane = Plane.from_arrays(n[best], d[best])
+    mask = np.zeros(m, bool)
+    for _ in range(4):
+        mask = np.abs(plane.distance(points)) <= dist_m
+        if normals is not None:
+            mask &= np.abs(normals @ plane.n) >= np.cos(np.radians(max_angle_deg))
+        if mask.sum() < 3:
+            break
+        plane = refine(points[mask])
+    return plane, mask
+
+
+def noise_threshold(z_m: float) -> float:
+    """Inlier distance (metres) at depth ``z_m``: depth noise of consumer sensors grows about as z^2."""
+    return float(np.clip(0.004 + 0.004 * z_m ** 2, 0.005, 0.03))
+
+
+def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up: float = 0.3,
+                  min_frac: float = 0.08, max_points: int = 4000) -> Plane | None:
+    """The support plane of camera-frame points (m, 3) metres, or None if no plane holds ``min_frac`` of them.
+
+    Up to ``max_planes`` planes are peeled off by RANSAC. Among those whose normal points up in the image
+    (``-n_y >= min_up``, camera y is down) the one nearest the camera wins: a table stands above the floor it
+    is on. Without an upward plane the largest plane wins."""
+    rng = np.random.default_rng(seed)
+    if len(points) > max_points:
+        points = points[np.sort(rng.choice(len(points), max_points, replace=False))]
+    if len(points) < 50:
+        return None
+    dist_m = noise_threshold(float(np.median(points[:, 2])))
+    remaining = points
+    found: list[Plane] = []
+    for _ in range(max_planes):
+        if len(remaining) < min_frac * len(points):
+            break
+        plane, mask = ransac_plane(remaining, dist_m, rng, iterations=200)
+        if mask.sum() < min_frac * len(points):
+            break
+        found.append(plane)
+        remaining = remaining[~mask]
+    up = [p for p in found if -p.normal[1] >= min_up]
+    if up:
+        return min(up, key=lambda p: p.offset)
+    return found[0] if found else None

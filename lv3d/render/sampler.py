@@ -1,0 +1,184 @@
+"""Random scene layouts: a solid resting on a table, a camera looking down at it, and optional clutter
+and occluder. World frame: metres, z up, the table top is the plane z = 0."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..camera import Intrinsics
+from .noise import NoiseConfig
+from .solids import CLASSES, Solid, box, make_solid, prism
+
+FLOOR_Z_M = -0.75
+TABLE_THICKNESS_M = 0.03
+
+
+@dataclass(frozen=True)
+class Placed:
+    """A solid and its pose: ``to_world`` (4, 4) maps object-frame points (metres) to the world frame."""
+
+    solid: Solid
+    to_world: np.ndarray
+    resting_face: int
+
+    def world_vertices(self) -> np.ndarray:
+        v = self.solid.vertices
+        return v @ self.to_world[:3, :3].T + self.to_world[:3, 3]
+
+    def centre_xy(self) -> np.ndarray:
+        return self.to_world[:2, 3]
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Everything placed in one scene. ``world_to_camera``: (4, 4) rigid transform into the camera frame
+    (x right, y down, z forward). ``table_to_world``: the table's frame (its top is z = 0);
+    ``table_half``: half-extents (metres) of the table top along its x and y; ``wall``: a point on and the
+    normal (towards the scene) of the background wall, world frame."""
+
+    target: Placed
+    clutter: tuple[Placed, ...]
+    occluder: Placed | None
+    world_to_camera: np.ndarray
+    elevation_deg: float
+    azimuth_deg: float
+    distance_m: float
+    table_to_world: np.ndarray
+    table_half: tuple[float, float]
+    wall_point: np.ndarray
+    wall_normal: np.ndarray
+
+
+def rotation_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The smallest rotation (3, 3) taking unit vector ``a`` to unit vector ``b``."""
+    v = np.cross(a, b)
+    c = float(np.dot(a, b))
+    if c < -1 + 1e-9:  # opposite: turn half a circle about any axis perpendicular to a
+        axis = np.cross(a, [1.0, 0, 0]) if abs(a[0]) < 0.9 else np.cross(a, [0, 1.0, 0])
+        axis /= np.linalg.norm(axis)
+        return 2 * np.outer(axis, axis) - np.eye(3)
+    vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    return np.eye(3) + vx + vx @ vx / (1 + c)
+
+
+def rot_z(angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+
+
+def rest(solid: Solid, face: int, yaw: float, xy: np.ndarray) -> Placed:
+    """Stand ``solid`` on its face ``face`` on the table (z = 0), turned by ``yaw`` about the vertical,
+    with the centre of its footprint's bounding vertices at ``xy``."""
+    r = rot_z(yaw) @ rotation_between(solid.normals()[face], np.array([0, 0, -1.0]))
+    v = solid.vertices @ r.T
+    centre = np.array([(v[:, 0].max() + v[:, 0].min()) / 2, (v[:, 1].max() + v[:, 1].min()) / 2])
+    t = np.array([xy[0] - centre[0], xy[1] - centre[1], -v[:, 2].min()])
+    m = np.eye(4)
+    m[:3, :3], m[:3, 3] = r, t
+    return Placed(solid, m, face)
+
+
+def footprint_radius(p: Placed) -> float:
+    """Horizontal radius (metres) of a placed solid about its centre: a circle that contains it."""
+    v = p.world_vertices()
+    return float(np.hypot(v[:, 0] - p.centre_xy()[0], v[:, 1] - p.centre_xy()[1]).max())
+
+
+def look_at(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """World-to-camera (4, 4) for a camera at ``eye`` looking at ``target`` with world z up on screen."""
+    z = target - eye
+    z /= np.linalg.norm(z)
+    x = np.cross(z, [0, 0, 1.0])
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    r = np.stack([x, y, z])
+    m = np.eye(4)
+    m[:3, :3], m[:3, 3] = r, -r @ eye
+    return m
+
+
+def _in_view(points_world: np.ndarray, w2c: np.ndarray, k: Intrinsics, margin: float) -> bool:
+    p = points_world @ w2c[:3, :3].T + w2c[:3, 3]
+    if np.any(p[:, 2] < 0.1):
+        return False
+    uv = k.project(p)
+    mu, mv = margin * k.width, margin * k.height
+    return bool(np.all((uv[:, 0] >= mu) & (uv[:, 0] <= k.width - 1 - mu)
+                       & (uv[:, 1] >= mv) & (uv[:, 1] <= k.height - 1 - mv)))
+
+
+def _stand(solid: Solid, rng: np.random.Generator, xy: np.ndarray) -> Placed:
+    face = int(rng.choice(solid.resting))
+    return rest(solid, face, float(rng.uniform(0, 2 * np.pi)), xy)
+
+
+def sample_layout(cls: str, cfg: NoiseConfig, k: Intrinsics, rng: np.random.Generator) -> Layout:
+    """A random scene: the target solid of class ``cls`` near the world origin, the camera at 20-60 degrees
+    elevation and 0.5-1.5 m away with the whole target in the image, then clutter and an occluder as
+    ``cfg`` asks."""
+    target = _stand(make_solid(cls, rng), rng, rng.uniform(-0.05, 0.05, 2))
+    tv = target.world_vertices()
+    centre = tv.mean(axis=0)
+    r3 = float(np.linalg.norm(tv - centre, axis=1).max())
+    for attempt in range(50):
+        el = np.radians(rng.uniform(20, 60))
+        az = rng.uniform(0, 2 * np.pi)
+        lo = min(1.5, max(0.5, 3.2 * r3))
+        dist = lo + (1.5 - lo) * rng.random() ** 2  # nearer views more often: more pixels on the target
+        aim = centre + rng.normal(0, 0.15 * r3, 3) * (attempt < 40)
+        eye = aim + dist * np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+        w2c = look_at(eye, aim)
+        if _in_view(tv, w2c, k, 0.04):
+            break
+    r_t = footprint_radius(target)
+    toward_cam = np.array([np.cos(az), np.sin(az)])
+    side = np.array([-toward_cam[1], toward_cam[0]])
+
+    placed: list[Placed] = [target]
+    clutter = []
+    for _ in range(cfg.clutter):
+        solid = make_solid(str(rng.choice(CLASSES)), rng, scale=float(rng.uniform(0.5, 0.9)))
+        for _try in range(20):
+            # beside or behind the target as the camera sees it, so clutter does not hide it
+            ang = az + np.pi + rng.uniform(-0.7, 0.7) * np.pi
+            c = _stand(solid, rng, np.zeros(2))
+            r_c = footprint_radius(c)
+            d = r_t + r_c + rng.uniform(0.02, 0.15)
+            xy = target.centre_xy() + d * np.array([np.cos(ang), np.sin(ang)])
+            c = rest(solid, c.resting_face, float(rng.uniform(0, 2 * np.pi)), xy)
+            gaps = [np.linalg.norm(c.centre_xy() - q.centre_xy()) - footprint_radius(q) - r_c for q in placed]
+            if min(gaps) > 0.01:
+                placed.append(c)
+                clutter.append(c)
+                break
+
+    occluder = None
+    if cfg.occluder > 0 and rng.random() < cfg.occluder:
+        r_o = float(rng.uniform(0.025, 0.05))
+        s = r_t + r_o + float(rng.uniform(0.02, 0.08))
+        lat = float(rng.choice([-1, 1])) * (r_o + r_t * float(rng.uniform(0.1, 0.8)))
+        height_on_ray = centre[2] + s * np.tan(el)
+        h = max(0.04, height_on_ray * float(rng.uniform(0.8, 1.1)))
+        solid = prism(10, 2 * r_o * np.sin(np.pi / 10), h, "occluder") if rng.random() < 0.5 \
+            else box(2 * r_o * 0.7, 2 * r_o * 0.7, h, "occluder")
+        xy = target.centre_xy() + s * toward_cam + lat * side
+        o = rest(solid, 0, float(rng.uniform(0, 2 * np.pi)), xy)
+        ov = o.world_vertices() @ w2c[:3, :3].T + w2c[:3, 3]
+        if np.all(ov[:, 2] > 0.15):
+            occluder = o
+
+    # table: a slab around everything placed, its edges a random way off
+    t2w = np.eye(4)
+    t2w[:3, :3] = rot_z(float(rng.uniform(0, np.pi)))
+    t2w[:2, 3] = rng.uniform(-0.15, 0.15, 2)
+    half = np.array([rng.uniform(0.45, 0.9), rng.uniform(0.35, 0.6)])
+    for p in placed + ([occluder] if occluder else []):  # nothing may hang over the edge
+        local = t2w[:2, :2].T @ (p.centre_xy() - t2w[:2, 3])
+        half = np.maximum(half, np.abs(local) + footprint_radius(p) + 0.03)
+    wall_dist = float(rng.uniform(1.2, 2.5))
+    wall_normal = np.array([toward_cam[0], toward_cam[1], 0.0])
+    wall_point = np.array([*(-wall_dist * toward_cam), 0.0])
+    return Layout(target, tuple(clutter), occluder, w2c, float(np.degrees(el)), float(np.degrees(az)) % 360,
+                  float(dist), t2w, (float(half[0]), float(half[1])), wall_point, wall_normal)

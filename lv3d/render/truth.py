@@ -1,0 +1,104 @@
+"""Ground truth of a rendered scene in the meta.json layout of docs/dataset.md.
+
+A face is listed when it faces the camera and covers at least ``MIN_FACE_PIXELS`` pixels of the face
+mask. Its ``polygon`` is the whole 3D face projected to pixels (exact: a convex solid cannot hide its
+own front faces; only other objects and the image border can), ordered clockwise on screen, i.e. with
+a positive shoelace sum of (u, v); ``visible_fraction`` = mask pixels / polygon area.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..camera import Intrinsics
+from ..plane import Plane, dihedral_deg
+from .raycast import Body
+from .sampler import Layout
+
+MIN_FACE_PIXELS = 50
+
+
+def _r(x, nd: int = 6):
+    return np.round(np.asarray(x, np.float64), nd).tolist()
+
+
+def shoelace(poly: np.ndarray) -> float:
+    """Signed area sum of an (n, 2) pixel polygon: positive when clockwise on screen (v down)."""
+    u, v = poly[:, 0], poly[:, 1]
+    return 0.5 * float(np.sum(u * np.roll(v, -1) - np.roll(u, -1) * v))
+
+
+def plane_of(normal_cam: np.ndarray, point_cam: np.ndarray) -> Plane:
+    """Camera-frame plane through ``point_cam`` with normal ``normal_cam``, oriented towards the camera."""
+    return Plane.from_arrays(normal_cam, -float(np.dot(normal_cam, point_cam)))
+
+
+def object_truth(body: Body, k: Intrinsics, mask: np.ndarray | None) -> dict:
+    """Faces, adjacency and pose of one solid. With ``mask`` (H, W) uint8 face ids + 1, list visible faces
+    with pixel counts; without it, only class, size and pose (for clutter and occluders)."""
+    out = {"class": body.solid.cls, "size_m": {k_: round(float(v), 6) for k_, v in body.solid.size_m.items()},
+           "object_to_camera": _r(body.to_camera)}
+    if mask is None:
+        return out
+    verts = body.vertices()
+    normals = body.normals()
+    counts = np.bincount(mask.ravel(), minlength=len(body.solid.faces) + 1)
+    faces, visible = [], set()
+    for i, f in enumerate(body.solid.faces):
+        p = verts[list(f)]
+        front = float(np.dot(normals[i], p.mean(axis=0))) < 0  # outward normal points back at the camera
+        n_px = int(counts[i + 1])
+        if not front or n_px < MIN_FACE_PIXELS:
+            continue
+        poly = k.project(p)
+        if shoelace(poly) < 0:
+            poly = poly[::-1]
+        area = abs(shoelace(poly))
+        visible.add(i)
+        faces.append({"id": i, "sides": len(f), "visible": True, "pixels": n_px,
+                      "polygon": _r(poly, 3), "visible_fraction": round(min(1.0, n_px / max(area, 1e-9)), 4),
+                      "plane": plane_of(normals[i], p[0]).to_dict()})
+    adjacency = []
+    for (a, b), (fa, fb) in sorted(body.solid.edges().items(), key=lambda e: sorted(e[1])):
+        if fa in visible and fb in visible:
+            i, j = sorted((fa, fb))
+            adjacency.append({"faces": [i, j], "dihedral_deg": round(dihedral_deg(normals[i], normals[j]), 4)})
+    out.update(faces=faces, adjacency=adjacency)
+    return out
+
+
+def scene_truth(layout: Layout, target: Body, clutter: list[Body], occluder: Body | None,
+                k: Intrinsics, mask: np.ndarray) -> dict:
+    """The "truth" block of meta.json."""
+    t = object_truth(target, k, mask)
+    r = layout.world_to_camera[:3, :3]
+    up = r @ np.array([0, 0, 1.0])  # the table's normal, pointing up and so towards the camera
+    support = plane_of(up, layout.world_to_camera[:3, 3])  # the world origin lies on the table top
+    t.update(resting_face=layout.target.resting_face, target_pixels=int(np.count_nonzero(mask)),
+             support_plane=support.to_dict(),
+             camera={"elevation_deg": round(layout.elevation_deg, 3), "azimuth_deg": round(layout.azimuth_deg, 3),
+                     "distance_m": round(layout.distance_m, 4)},
+             clutter=[object_truth(c, k, None) for c in clutter],
+             occluder=object_truth(occluder, k, None) if occluder is not None else None)
+    return t
+
+
+def rasterise_polygon(poly: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """(H, W) bool: pixel centres inside the convex pixel polygon ``poly`` (n, 2), either orientation
+    (the same rule the ray caster follows, so it matches a face mask up to ties on edges)."""
+    poly = np.asarray(poly, np.float64)
+    if shoelace(poly) < 0:
+        poly = poly[::-1]
+    h, w = shape
+    u0, v0 = np.floor(poly.min(axis=0)).astype(int)
+    u1, v1 = np.ceil(poly.max(axis=0)).astype(int)
+    u0, v0, u1, v1 = max(u0, 0), max(v0, 0), min(u1, w - 1), min(v1, h - 1)
+    out = np.zeros(shape, bool)
+    if u0 > u1 or v0 > v1:
+        return out
+    u, v = np.meshgrid(np.arange(u0, u1 + 1), np.arange(v0, v1 + 1))
+    inside = np.ones(u.shape, bool)
+    for (a, b), (c, d) in zip(poly, np.roll(poly, -1, axis=0)):
+        inside &= (c - a) * (v - b) - (d - b) * (u - a) >= 0  # on the inner side of a clockwise loop
+    out[v0:v1 + 1, u0:u1 + 1] = inside
+    return out

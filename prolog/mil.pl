@@ -1,0 +1,325 @@
+/*  mil: a noise-tolerant meta-interpretive learner (Metagol-style).
+
+    A task is data:  task(BK, Targets, BodyPreds, Metarules, Pos, Neg)
+      BK         module holding the background knowledge (see body_kinds/3 for the three kinds)
+      Targets    [Name/Arity, ...] predicates to learn (several: learned together, may call each other)
+      BodyPreds  [Name/Arity, ...] background predicates a clause body may use
+      Metarules  [Name | metarule(Name, Subs, Head, Body), ...] names from metarule/4 or own ones
+      Pos, Neg   examples, ordinary atoms: cube(s1_o1), grandparent(ann, amy)
+    Settings are a list of options (see default/1).  Atoms inside the interpreter are lists
+    [Pred|Args] so that a predicate symbol can be a variable, as in Metagol.
+
+    A program is a list of items: sub(MetaruleName, Subs) while learning, cl(Head, Body) when fixed
+    (Head an atom list, Body a list of atom lists).  A proof's confidence combines the confidences
+    of the facts it used (option combine: product or min); an atom is proved only while that
+    confidence stays >= the threshold.
+*/
+:- module(mil, [ learn/3,            % +Task, +Settings, -Program   (Metagol: consistent with all examples)
+                 learn_noisy/4,      % +Task, +Settings, -Program, -Score  (samples, scored on all)
+                 prove_best/5,       % +Task, +Settings, +Clauses, +Atom, -best(Conf, Trace)
+                 program_clauses/3,  % +Task, +Program, -Clauses  (Prolog clauses H :- B)
+                 task_check/1,       % +Task: throws mil_error(...) for an unusable task
+                 default/1,          % ?Option
+                 metarule/4          % ?Name, ?Subs, ?Head, ?Body
+               ]).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(library(option)).
+:- use_module(library(random)).
+:- use_module(library(time)).
+:- use_module(library(solution_sequences)).
+
+%!  default(?Option) is nondet.  Settings as data; a task or caller overrides any of them.
+default(max_clauses(3)).        % iterative deepening bound on the number of clauses
+default(max_inventions(1)).     % invented predicate symbols allowed
+default(max_depth(10)).         % bound on nested clause applications in one proof (recursion)
+default(time_limit(10)).        % seconds for a whole search; exceeding it throws mil_error(time_limit(S))
+default(threshold(0.5)).        % an example is covered when its best proof's confidence >= this
+default(combine(product)).      % how a proof's confidence combines its facts' confidences
+default(samples(8)).            % noisy learning: random samples of the examples
+default(sample_pos(2)).         % positives per sample
+default(sample_neg(12)).        % negatives per sample
+default(solutions(200)).        % hypotheses kept per sample (smallest size found)
+default(clause_penalty(0.02)).  % score lost per clause (Occam), see docs/learner.md
+default(seed(0)).
+
+%!  metarule(?Name, ?Subs, ?Head, ?Body) is nondet.  The library of metarules; the first element
+%   of Subs is the head symbol, the rest are bound while the body is proved.
+metarule(ident,     [P,Q],     [P,A,B], [[Q,A,B]]).                       % P(A,B) :- Q(A,B)
+metarule(inverse,   [P,Q],     [P,A,B], [[Q,B,A]]).                       % P(A,B) :- Q(B,A)
+metarule(precon,    [P,Q,R],   [P,A,B], [[Q,A],[R,A,B]]).                 % P(A,B) :- Q(A), R(A,B)
+metarule(postcon,   [P,Q,R],   [P,A,B], [[Q,A,B],[R,B]]).                 % P(A,B) :- Q(A,B), R(B)
+metarule(chain,     [P,Q,R],   [P,A,B], [[Q,A,C],[R,C,B]]).               % P(A,B) :- Q(A,C), R(C,B)
+metarule(tailrec,   [P,Q],     [P,A,B], [[Q,A,C],[P,C,B]]).               % P(A,B) :- Q(A,C), P(C,B)
+metarule(base,      [P,Q],     [P,A],   [[Q,A]]).                         % P(A) :- Q(A)
+metarule(conj,      [P,Q,R],   [P,A],   [[Q,A],[R,A]]).                   % P(A) :- Q(A), R(A)
+metarule(part,      [P,Q,R],   [P,A],   [[Q,A,B],[R,B]]).                 % P(A) :- Q(A,B), R(B)  exists a part
+metarule(part2,     [P,Q,R,S], [P,A],   [[Q,A,B],[R,B],[S,B]]).           % P(A) :- Q(A,B), R(B), S(B)
+metarule(part_and,  [P,Q,R,S], [P,A],   [[Q,A,B],[R,B],[S,A]]).           % P(A) :- Q(A,B), R(B), S(A)
+metarule(part_pair, [P,Q,R,S,T], [P,A], [[Q,A,B],[R,B],[S,B,C],[T,C]]).   % P(A) :- Q(A,B), R(B), S(B,C), T(C)
+
+%!  learn(+Task, +Settings, -Program) is semidet.
+%   Metagol's search: the smallest programs first that prove every positive and no negative.
+learn(Task, Settings0, Prog) :-
+    settings(Task, Settings0, Settings),
+    option(time_limit(T), Settings),
+    timed(T, search(Task, Settings, Prog)).
+
+search(Task, Settings, Prog) :-
+    task_ctx(Task, Settings, Ctx0),
+    Task = task(_, _, _, _, Pos, Neg),
+    option(max_clauses(Max), Settings),
+    between(1, Max, N),
+    consistent(Ctx0, N, Pos, Neg, Prog).
+
+%!  learn_noisy(+Task, +Settings, -Program, -Score) is semidet.
+%   Hypotheses learned from seeded random samples of the examples, each scored on all of them
+%   (mil_score:score/5); the best is kept.  Fails when no sample gives any hypothesis.
+learn_noisy(Task, Settings0, Best, Score) :-
+    settings(Task, Settings0, Settings),
+    option(time_limit(T), Settings),
+    timed(T, learn_noisy_(Task, Settings, Best, Score)).
+
+learn_noisy_(Task, Settings, Best, Score) :-
+    task_ctx(Task, Settings, Ctx),
+    Task = task(_, _, _, _, Pos, Neg),
+    option(seed(Seed), Settings), set_random(seed(Seed)),
+    option(samples(K), Settings), option(sample_pos(SP), Settings), option(sample_neg(SN), Settings),
+    samples(K, SP, SN, Pos, Neg, Samples),
+    findall(Prog, (member(P1-N1, Samples), sample_hypothesis(Ctx, Settings, P1, N1, Prog)), Found),
+    list_to_set(Found, Unique),                     % in the order found: it breaks ties
+    option(clause_penalty(Lambda), Settings),
+    findall(Key-(Prog-S), (nth1(Order, Unique, Prog),
+                           score(Ctx, Lambda, Prog, Pos, Neg, S),
+                           S = score(J, Soft, _, _), literal_cost(Ctx, Prog, Cost),
+                           NCost is -Cost, NOrder is -Order,
+                           Key = k(J, Soft, NCost, NOrder)), Scored),
+    Scored \== [],
+    max_member(_-(Best-Score), Scored).
+
+%!  score(+Ctx, +Lambda, +Prog, +Pos, +Neg, -Score) is det.
+%   Score = score(J, Soft, TP/NPos, FP/NNeg): J = TP/NPos - FP/NNeg - Lambda * clauses
+%   (Youden's J, a balanced accuracy: why in docs/learner.md); Soft = mean best-proof confidence
+%   over positives minus that over negatives, which breaks ties between equal J.
+score(Ctx, Lambda, Prog, Pos, Neg, score(J, Soft, TP/NP, FP/NN)) :-
+    maplist(best_conf(Ctx, Prog), Pos, CP), maplist(best_conf(Ctx, Prog), Neg, CN),
+    include(<(0), CP, TPs), include(<(0), CN, FPs),
+    length(Pos, NP), length(Neg, NN), length(TPs, TP), length(FPs, FP), length(Prog, L),
+    rate(TP, NP, TPR), rate(FP, NN, FPR), mean(CP, MP), mean(CN, MN),
+    J is TPR - FPR - Lambda * L,
+    Soft is MP - MN.
+
+%   The last tie-break: each body literal costs its predicate's place in the body predicate list
+%   (0 for a target or invented predicate), so that the caller's order of preference decides
+%   between equally good programs.
+literal_cost(Ctx, Prog, Cost) :-
+    ctx(Ctx, bps, BPs),
+    findall(R, ( member(sub(_, [_|Syms]), Prog), member(Q, Syms),
+                 ( nth0(R, BPs, bp(Q, _, _)) -> true ; R = 0 ) ), Rs),
+    sum_list(Rs, Cost).
+
+best_conf(Ctx, Prog, E, C) :-
+    (   aggregate_all(max(C0), covers(Ctx, Prog, E, C0, _), C) -> true ; C = 0 ).
+
+rate(_, 0, 0.0) :- !.
+rate(K, N, R) :- R is K / N.
+mean([], 0.0) :- !.
+mean(Xs, M) :- sum_list(Xs, S), length(Xs, N), M is S / N.
+
+%   The smallest hypotheses consistent with one sample, at most `solutions` of them.
+sample_hypothesis(Ctx, Settings, Pos, Neg, Prog) :-
+    option(max_clauses(Max), Settings), option(solutions(J), Settings),
+    between(1, Max, N),
+    findall(P, limit(J, consistent(Ctx, N, Pos, Neg, P)), Progs),
+    Progs \== [], !,
+    member(Prog, Progs).
+
+%   K samples: the whole set when it is small, else random subsets (seeded by the caller).
+samples(_, SP, SN, Pos, Neg, [Pos-Neg]) :-
+    length(Pos, NP), NP =< SP, length(Neg, NN), NN =< SN, !.
+samples(K, SP, SN, Pos, Neg, Samples) :-
+    length(Samples, K),
+    maplist(sample(SP, SN, Pos, Neg), Samples).
+sample(SP, SN, Pos, Neg, P1-N1) :- pick(SP, Pos, P1), pick(SN, Neg, N1).
+pick(K, Xs, Ys) :- random_permutation(Xs, Zs), length(Xs, L), M is min(K, L), length(Ys, M), append(Ys, _, Zs).
+
+%   A program of exactly N clauses that proves every positive and no negative.
+consistent(Ctx0, N, Pos, Neg, Prog) :-
+    ctx_max(Ctx0, N, Ctx),
+    prove_examples(Pos, Ctx, [], Prog0),
+    length(Prog0, N),
+    sort(Prog0, Sorted), length(Sorted, N),             % no clause twice
+    \+ (member(E, Neg), covers(Ctx, Prog0, E, _, _)),
+    reverse(Prog0, Prog).
+
+prove_examples([], _, Prog, Prog).
+prove_examples([E|Es], Ctx, Prog1, Prog3) :-
+    E =.. Atom, ctx(Ctx, depth, D),
+    prove([Atom], Ctx, D, Prog1, Prog2, 1.0, _, _, []),
+    prove_examples(Es, Ctx, Prog2, Prog3).
+
+%!  covers(+Ctx, +Prog, +Example, -Conf, -Trace) is nondet.  A proof with the fixed program Prog.
+covers(Ctx0, Prog, E, C, Trace) :-
+    length(Prog, N), ctx_max(Ctx0, N, Ctx),             % no new clauses
+    E =.. Atom, ctx(Ctx, depth, D),
+    prove([Atom], Ctx, D, Prog, _, 1.0, C, Trace, []).
+
+%% ---- the meta-interpreter: prove(Atoms, Ctx, Depth, Prog1, Prog2, Conf1, Conf2, Trace1, Trace2)
+
+prove([], _, _, Prog, Prog, C, C, T, T).
+prove([Atom|Atoms], Ctx, D, Prog1, Prog3, C1, C3, T1, T3) :-
+    prove_aux(Atom, Ctx, D, Prog1, Prog2, C1, C2, T1, T2),
+    prove(Atoms, Ctx, D, Prog2, Prog3, C2, C3, T2, T3).
+
+% a background fact with a confidence: BK stores P(Args..., Conf)
+prove_aux([P|Args], Ctx, _, Prog, Prog, C1, C2, [fact(G, Cf)|T], T) :-
+    ctx(Ctx, bps, BPs), member(bp(P, A, fact), BPs), length(Args, A),
+    ctx(Ctx, bk, BK), append(Args, [Cf], Args1), G1 =.. [P|Args1],
+    call(BK:G1),
+    combine(Ctx, C1, Cf, C2),
+    G =.. [P|Args].
+% a derived background predicate: BK:bk_rule(Head, Body), its body proved by this interpreter
+prove_aux([P|Args], Ctx, D, Prog, Prog, C1, C2, [bk(G)|T1], T2) :-
+    ctx(Ctx, bps, BPs), member(bp(P, A, rule), BPs), length(Args, A),
+    G =.. [P|Args], ctx(Ctx, bk, BK),
+    call(BK:bk_rule(G, Body)),
+    maplist(term_list, Body, Atoms),
+    prove(Atoms, Ctx, D, Prog, _, C1, C2, T1, T2).
+% an ordinary Prolog background predicate: holds with confidence 1
+prove_aux([P|Args], Ctx, _, Prog, Prog, C, C, [call(G)|T], T) :-
+    ctx(Ctx, bps, BPs), member(bp(P, A, prolog), BPs), length(Args, A),
+    G =.. [P|Args], ctx(Ctx, bk, BK),
+    call(BK:G).
+% use a clause already in the program (a learned one or a meta-substitution being built)
+prove_aux(Atom, Ctx, D, Prog1, Prog2, C1, C2, [clause(I)|T1], T2) :-
+    D > 0, D1 is D - 1,
+    nth1(I, Prog1, Item),
+    item_instance(Item, Ctx, Atom, Body),
+    prove(Body, Ctx, D1, Prog1, Prog2, C1, C2, T1, T2).
+% add a clause: a metarule instance whose head symbol is a target or an invented predicate
+prove_aux(Atom, Ctx, D, Prog1, Prog2, C1, C2, [clause(new)|T1], T2) :-
+    D > 0, D1 is D - 1,
+    ctx(Ctx, max, Max), length(Prog1, L), L < Max,
+    Atom = [P|Args], length(Args, A),
+    head_symbol(Ctx, Prog1, P, A),
+    ctx(Ctx, metarules, MRs), member(MR, MRs),
+    copy_term(MR, metarule(Name, Subs, Atom, Body)),
+    Body = [[Q|_]|_], dif(Q, P),                      % no left recursion
+    prove(Body, Ctx, D1, [sub(Name, Subs)|Prog1], Prog2, C1, C2, T1, T2).
+
+%   The head and body of a program item, renamed apart, with the head unified with Atom.
+item_instance(sub(Name, Subs), Ctx, Atom, Body) :-
+    Atom = [P|_], Subs = [P|_],
+    ctx(Ctx, metarules, MRs), template(Name, MRs, MR),
+    copy_term(MR, metarule(Name, Subs, Atom, Body)).
+item_instance(cl(Head, Body0), _, Atom, Body) :-
+    Atom = [P|_], Head = [P|_],
+    copy_term(Head-Body0, Atom-Body).
+
+%   A new clause defines a target, an invented symbol already used, or the next fresh one.
+head_symbol(Ctx, _, P, A) :- ctx(Ctx, targets, Ts), member(P/A, Ts).
+head_symbol(Ctx, Prog, P, _) :-
+    invented(Ctx, Prog, Used),
+    (   member(P, Used)
+    ;   var(P), ctx(Ctx, inventions, MaxInv), length(Used, K), K < MaxInv,
+        ctx(Ctx, targets, [T/_|_]), K1 is K + 1, format(atom(P), '~w_~w', [T, K1])
+    ).
+
+invented(Ctx, Prog, Used) :-
+    ctx(Ctx, targets, Ts),
+    findall(P, (member(sub(_, [P|_]), Prog), atom(P), \+ memberchk(P/_, Ts)), Ps),
+    sort(Ps, Used).
+
+combine(Ctx, C1, Cf, C2) :-
+    ctx(Ctx, combine, How),
+    (   How == min -> C2 is min(C1, Cf) ; C2 is C1 * Cf ),
+    ctx(Ctx, threshold, Thr), C2 >= Thr.
+
+term_list(T, L) :- T =.. L.
+
+%% ---- context: the task and settings the interpreter reads, in one term
+
+task_ctx(task(BK, Targets, BodyPreds, MRs0, _, _), Settings, Ctx) :-
+    body_kinds(BK, BodyPreds, BPs),
+    maplist(metarule_term, MRs0, MRs),
+    option(max_depth(D), Settings), option(threshold(Thr), Settings),
+    option(combine(How), Settings), option(max_inventions(Inv), Settings),
+    option(max_clauses(Max), Settings),
+    Ctx = ctx(BK, Targets, BPs, MRs, D, Thr, How, Inv, Max).
+
+ctx(ctx(BK, _, _, _, _, _, _, _, _), bk, BK).
+ctx(ctx(_, Ts, _, _, _, _, _, _, _), targets, Ts).
+ctx(ctx(_, _, BPs, _, _, _, _, _, _), bps, BPs).
+ctx(ctx(_, _, _, MRs, _, _, _, _, _), metarules, MRs).
+ctx(ctx(_, _, _, _, D, _, _, _, _), depth, D).
+ctx(ctx(_, _, _, _, _, Thr, _, _, _), threshold, Thr).
+ctx(ctx(_, _, _, _, _, _, How, _, _), combine, How).
+ctx(ctx(_, _, _, _, _, _, _, Inv, _), inventions, Inv).
+ctx(ctx(_, _, _, _, _, _, _, _, Max), max, Max).
+ctx_max(ctx(A, B, C, E, F, G, H, I, _), Max, ctx(A, B, C, E, F, G, H, I, Max)).
+
+%   Each body predicate is a fact with a confidence (BK defines P/(A+1)), a derived rule
+%   (BK:bk_rule/2 has a head P/A) or plain Prolog (BK defines P/A, confidence 1).
+body_kinds(BK, BodyPreds, BPs) :- maplist(body_kind(BK), BodyPreds, BPs).
+body_kind(BK, P/A, bp(P, A, Kind)) :-
+    functor(H, P, A),
+    (   A1 is A + 1, current_predicate(BK:P/A1) -> Kind = fact
+    ;   catch(BK:bk_rule(H, _), error(existence_error(_, _), _), fail) -> Kind = rule
+    ;   current_predicate(BK:P/A) -> Kind = prolog
+    ;   throw(mil_error(unknown_body_pred(P/A)))
+    ).
+
+metarule_term(Name, MR) :- atom(Name), !,
+    (   metarule(Name, S, H, B) -> MR = metarule(Name, S, H, B)
+    ;   throw(mil_error(unknown_metarule(Name)))
+    ).
+metarule_term(metarule(N, S, H, B), metarule(N, S, H, B)).
+
+settings(task(_, _, _, _, _, _), Given, Settings) :-
+    findall(O, (default(O), functor(O, F, 1), functor(G, F, 1), \+ memberchk(G, Given)), Defaults),
+    append(Given, Defaults, Settings).
+
+task_check(Task) :- settings(Task, [], S), task_ctx(Task, S, _).
+
+%   The metarule called Name, without binding its variables (it is a template).
+template(Name, MRs, MR) :- member(MR, MRs), arg(1, MR, Name), !.
+
+%   Run Goal under a time limit; running out is an error term, never a hang.
+timed(T, Goal) :-
+    catch(call_with_time_limit(T, Goal), time_limit_exceeded,
+          throw(mil_error(time_limit(T)))).
+
+%% ---- fixed programs: best proof, clauses
+
+%!  prove_best(+Task, +Settings, +Clauses, +Atom, -Best) is semidet.
+%   Best = best(Conf, Trace): the most confident proof of Atom with the clauses (H :- B terms).
+prove_best(Task, Settings0, Clauses, Atom, best(C, Trace)) :-
+    settings(Task, Settings0, Settings),
+    task_ctx(Task, Settings, Ctx),
+    maplist(clause_item, Clauses, Prog),
+    aggregate_all(max(C0, T0), covers(Ctx, Prog, Atom, C0, T0), max(C, Trace)).
+
+clause_item((H :- B), cl(HL, BL)) :- !, H =.. HL, conj_list(B, Bs), maplist(term_list, Bs, BL).
+clause_item(H, cl(HL, [])) :- H =.. HL.
+
+conj_list((A, B), [A|Bs]) :- !, conj_list(B, Bs).
+conj_list(true, []) :- !.
+conj_list(A, [A]).
+
+%!  program_clauses(+Task, +Program, -Clauses) is det.  Program items as Prolog clauses,
+%   targets' clauses first.
+program_clauses(task(_, _, _, MRs0, _, _), Prog, Clauses) :-
+    maplist(metarule_term, MRs0, MRs),
+    maplist(item_clause(MRs), Prog, Clauses0),
+    findall(P, (member((H :- _), Clauses0), functor(H, P, _)), Ps0), list_to_set(Ps0, Ps),
+    findall(C, (member(P, Ps), member(C, Clauses0), C = (H :- _), functor(H, P, _)), Clauses).
+
+item_clause(MRs, sub(Name, Subs), (H :- B)) :-
+    template(Name, MRs, MR),
+    copy_term(MR, metarule(Name, Subs, HL, BL)),
+    H =.. HL, maplist(term_list, Bs, BL), list_conj(Bs, B).
+item_clause(_, cl(HL, BL), (H :- B)) :- H =.. HL, maplist(term_list, Bs, BL), list_conj(Bs, B).
+
+list_conj([], true).
+list_conj([A], A) :- !.
+list_conj([A|As], (A, B)) :- list_conj(As, B).

@@ -1,0 +1,26 @@
+/*  Background knowledge over the facts of docs/facts.md: a few derived predicates.
+
+    A derived predicate is data, bk_rule(Head, Body), whose body the learner's meta-interpreter
+    proves over the scene's facts; so a derived atom's confidence combines those of the facts it
+    rests on, exactly as a learned clause's does, and an explanation lists those facts.
+    A scene module imports this one (lv3d_bridge:load_scene/3) to see these rules.
+*/
+:- module(shape_bk, [derived/1]).
+
+%!  derived(?Name/Arity) is nondet.  The derived body predicates.
+derived(P/A) :- clause(bk_rule(H, _), true), functor(H, P, A).
+
+% two adjacent faces of the object meet at a right angle (cube, cuboid, prism caps)
+bk_rule(right_corner(O), [face_of(O, F), adjacent(F, G), perpendicular(F, G)]).
+% the face meets a neighbour at a right angle
+bk_rule(perpendicular_neighbour(F), [adjacent(F, G), perpendicular(F, G)]).
+% the face meets a neighbour at an acute interior angle (triangular prism sides, tetrahedron)
+bk_rule(acute_neighbour(F), [acute(F, _)]).
+% the face meets a neighbour at an obtuse interior angle (pentagonal/hexagonal prism sides, pyramids)
+bk_rule(obtuse_neighbour(F), [obtuse(F, _)]).
+% the face is a triangle and so is a neighbour (pyramids, tetrahedra: no triangle touches a triangle on a prism)
+bk_rule(triangle_neighbour(F), [adjacent(F, G), triangle(G)]).
+% the face has a quadrilateral neighbour (prisms, boxes)
+bk_rule(quadrilateral_neighbour(F), [adjacent(F, G), quadrilateral(G)]).
+% the face has a square neighbour (two adjacent squares: a cube)
+bk_rule(square_neighbour(F), [adjacent(F, G), square(G)]).

@@ -1,0 +1,74 @@
+"""Small scenes made by the test code itself: a box on a table, ray-cast analytically."""
+
+import numpy as np
+import pytest
+
+from lv3d.camera import Intrinsics
+from lv3d.rgbd import RGBD
+
+
+def _look_at(eye, target):
+    """World-to-camera rotation R and translation t (camera: x right, y down, z forward; world z up)."""
+    f = target - eye
+    f /= np.linalg.norm(f)
+    r = np.cross(f, [0, 0, 1.0])
+    r /= np.linalg.norm(r)
+    d = np.cross(f, r)
+    R = np.stack([r, d, f])
+    return R, -R @ eye
+
+
+def box_on_table(width=320, height=240, half=(0.05, 0.05), top=0.1, yaw_deg=30.0, noise_m=0.0, seed=0):
+    """A box of half extents ``half`` (metres) and height ``top`` standing on a table (world z = 0), seen from
+    0.6 m away and 40 deg above. Returns an RGBD frame (each box face its own colour) and the faces' outward
+    normals in the camera frame as {name: (3,)} for the visible ones (top, and the sides that face the camera)."""
+    k = Intrinsics(fx=300.0 * width / 320, fy=300.0 * width / 320, cx=(width - 1) / 2, cy=(height - 1) / 2,
+                   width=width, height=height)
+    eye = np.array([0.6 * np.cos(np.radians(40)), 0.0, 0.6 * np.sin(np.radians(40))]) + np.array([0, 0, 0.03])
+    R, t = _look_at(eye, np.array([0, 0, 0.04]))
+    u, v = np.meshgrid(np.arange(width), np.arange(height))
+    rays_c = np.stack([(u - k.cx) / k.fx, (v - k.cy) / k.fy, np.ones_like(u, float)], -1).reshape(-1, 3)
+    rays_w = rays_c @ R  # R^T applied to each ray
+    yaw = np.radians(yaw_deg)
+    Rb = np.array([[np.cos(yaw), -np.sin(yaw), 0], [np.sin(yaw), np.cos(yaw), 0], [0, 0, 1]])
+    o = Rb.T @ eye
+    d = rays_w @ Rb
+    lo = np.array([-half[0], -half[1], 0.0])
+    hi = np.array([half[0], half[1], top])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t1 = (lo - o) / d
+        t2 = (hi - o) / d
+    tmin = np.nanmax(np.minimum(t1, t2), axis=1)
+    tmax = np.nanmin(np.maximum(t1, t2), axis=1)
+    hit_box = (tmax >= tmin) & (tmin > 0)
+    axis = np.argmax(np.minimum(t1, t2), axis=1)
+    t_table = -eye[2] / rays_w[:, 2]
+    hit_table = (t_table > 0) & ~hit_box
+    tt = np.where(hit_box, tmin, np.where(hit_table, t_table, 0.0))
+    depth = (tt * rays_c[:, 2]).reshape(height, width)  # rays have z = 1 in the camera frame
+    rng = np.random.default_rng(seed)
+    if noise_m:
+        depth = np.where(depth > 0, depth + rng.normal(0, noise_m, depth.shape), 0)
+    pts_b = o + tmin[:, None] * d
+    sign = np.where(np.take_along_axis(pts_b, axis[:, None], 1)[:, 0] > (lo + hi)[axis] / 2, 1, 0)
+    face_code = axis * 2 + sign  # 0..5
+    palette = np.array([[200, 60, 60], [60, 200, 60], [60, 60, 200], [200, 200, 60], [150, 80, 30], [40, 180, 200]],
+                       np.uint8)
+    color = np.full((height * width, 3), 128, np.uint8)
+    color[hit_box] = palette[face_code[hit_box]]
+    color = color.reshape(height, width, 3)
+    normals = {}
+    names = {0: "-x", 1: "+x", 2: "-y", 3: "+y", 5: "top"}
+    for code, name in names.items():
+        n_b = np.zeros(3)
+        n_b[code // 2] = 1.0 if code % 2 else -1.0
+        n_c = R @ (Rb @ n_b)
+        if np.count_nonzero(hit_box & (face_code == code)) > 50:
+            normals[name] = n_c
+    frame = RGBD(color, depth.astype(np.float32), k, name="box")
+    return frame, normals
+
+
+@pytest.fixture(scope="session")
+def box_frame():
+    return box_on_table()

@@ -1,0 +1,45 @@
+import json
+
+import cv2
+import numpy as np
+
+from lv3d.cli import main
+
+
+def _write_frame(tmp_path, frame):
+    c = tmp_path / "box_rgb.png"
+    d = tmp_path / "box_depth.png"
+    cv2.imwrite(str(c), cv2.cvtColor(frame.color, cv2.COLOR_RGB2BGR))
+    cv2.imwrite(str(d), np.round(frame.depth * 1000).astype(np.uint16))
+    k = tmp_path / "k.json"
+    k.write_text(json.dumps(frame.intrinsics.to_dict()))
+    return c, d, k
+
+
+def test_extract_writes_scene_and_overlay(tmp_path, box_frame):
+    c, d, k = _write_frame(tmp_path, box_frame[0])
+    out = tmp_path / "out"
+    rc = main(["extract", str(c), "--depth", str(d), "--intrinsics", str(k), "--modality", "rgbd", "--out", str(out)])
+    assert rc == 0
+    scene = json.loads((out / "scene.json").read_text())
+    assert scene["modality"] == "rgbd" and scene["target"] == "s000000_o1"
+    assert len(scene["objects"][0]["faces"]) == 3
+    assert cv2.imread(str(out / "overlay.png")).shape == (240, 320, 3)
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".out")]  # no temporary folder left
+
+
+def test_extract_needs_depth_for_depth_modality(tmp_path, box_frame, capsys):
+    c, _, k = _write_frame(tmp_path, box_frame[0])
+    out = tmp_path / "out"
+    rc = main(["extract", str(c), "--intrinsics", str(k), "--modality", "depth", "--out", str(out)])
+    assert rc == 2
+    assert "--depth" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_extract_rejects_a_missing_image(tmp_path, box_frame, capsys):
+    _, d, k = _write_frame(tmp_path, box_frame[0])
+    rc = main(["extract", str(tmp_path / "nope.png"), "--depth", str(d), "--intrinsics", str(k),
+               "--out", str(tmp_path / "o")])
+    assert rc == 2
+    assert "nope.png" in capsys.readouterr().err

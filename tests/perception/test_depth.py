@@ -1,0 +1,66 @@
+import numpy as np
+
+from lv3d.perception.cloud import point_grid, remove_flying
+from lv3d.perception.depth import depth_scene
+from lv3d.perception.objects import segment_objects
+from lv3d.perception.planes import outward_normal
+from lv3d.perception.support import support_plane
+from lv3d.plane import dihedral_deg
+
+from .conftest import box_on_table
+
+
+def _angle(a, b):
+    return float(np.degrees(np.arccos(np.clip(abs(np.dot(a, b)), 0, 1))))
+
+
+def test_back_projection_and_normals_of_a_flat_wall():
+    from lv3d.camera import Intrinsics
+
+    k = Intrinsics(200, 200, 79.5, 59.5, 160, 120)
+    grid = point_grid(np.full((120, 160), 1.5, np.float32), k, stride=2)
+    assert grid.valid.sum() > 0.9 * grid.valid.size
+    assert np.allclose(grid.xyz[..., 2][grid.valid], 1.5)
+    n = grid.normals[grid.normals[..., 2] != 0]
+    assert np.allclose(n, [0, 0, -1], atol=1e-4)
+
+
+def test_flying_points_are_removed():
+    xyz = np.zeros((20, 20, 3), np.float32)
+    xyz[..., 2] = 1.0
+    xyz[10, 10, 2] = 1.5
+    valid = np.ones((20, 20), bool)
+    assert not remove_flying(xyz, valid)[10, 10]
+    assert remove_flying(xyz, valid)[5, 5]
+
+
+def test_support_plane_is_the_table(box_frame):
+    frame, _ = box_frame
+    grid = point_grid(frame.depth, frame.intrinsics)
+    sp = support_plane(grid.xyz[grid.valid].astype(float), seed=0)
+    table_normal = frame.intrinsics  # noqa: F841 (the table is world z = 0; its normal points up in the image)
+    assert sp is not None and -sp.normal[1] > 0.5
+    objs = segment_objects(grid, sp)
+    assert len(objs) == 1
+
+
+def test_box_planes_match_the_true_faces_and_meet_at_right_angles():
+    frame, normals = box_on_table(noise_m=0.001, seed=1)
+    res = depth_scene(frame, seed=0)
+    assert len(res.objects) == 1
+    obj = res.objects[0]
+    assert len(obj.planes) == len(normals) == 3
+    for p in obj.planes:
+        assert min(_angle(p.plane.n, n) for n in normals.values()) < 2.0
+    assert len(obj.adjacency) == 3
+    for i, j in obj.adjacency:
+        dih = dihedral_deg(outward_normal(obj.planes[i], obj.centroid_m), outward_normal(obj.planes[j], obj.centroid_m))
+        assert abs(dih - 90) < 3.0
+    assert all(p is not None and len(p) == 4 for p in obj.polygons)
+
+
+def test_depth_scene_is_deterministic(box_frame):
+    frame, _ = box_frame
+    a, b = depth_scene(frame, seed=5), depth_scene(frame, seed=5)
+    assert a.support == b.support
+    assert [p.plane for p in a.objects[0].planes] == [p.plane for p in b.objects[0].planes]

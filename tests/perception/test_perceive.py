@@ -1,0 +1,46 @@
+import json
+import re
+
+import numpy as np
+import pytest
+
+from lv3d.errors import InputError
+from lv3d.perception import perceive
+from lv3d.rgbd import RGBD
+
+
+def test_unknown_modality_is_an_input_error(box_frame):
+    with pytest.raises(InputError, match="modality"):
+        perceive(box_frame[0], "lidar")
+
+
+def test_depth_without_readings_is_an_input_error(box_frame):
+    frame = box_frame[0]
+    empty = RGBD(frame.color, np.zeros_like(frame.depth), frame.intrinsics)
+    with pytest.raises(InputError, match="no reading"):
+        perceive(empty, "depth")
+    assert perceive(empty, "rgb").objects  # colour alone still works
+
+
+@pytest.mark.parametrize("modality", ["rgb", "depth", "rgbd"])
+def test_each_modality_finds_the_three_faces_of_the_box(box_frame, modality):
+    scene = perceive(box_frame[0], modality, scene_id="s000042")
+    target = scene.target()
+    assert target is not None and target.id == "s000042_o1"
+    assert sorted(f.sides for f in target.faces) == [4, 4, 4]
+    assert len(target.adjacency) == 3
+    assert all(re.fullmatch(r"s000042_o1_f[1-3]", f.id) for f in target.faces)
+    assert len({f.id for f in target.faces}) == 3
+    assert all(v >= 0 for v in scene.timings_ms.values()) and scene.timings_ms
+    if modality == "rgbd":
+        assert all(f.provenance == "rgbd" and f.plane is not None for f in target.faces)
+    if modality == "rgb":
+        assert scene.support_plane is None and all(f.plane is None for f in target.faces)
+
+
+def test_perceive_is_deterministic(box_frame):
+    a = perceive(box_frame[0], "rgbd")
+    b = perceive(box_frame[0], "rgbd")
+    da, db = a.to_dict(), b.to_dict()
+    da.pop("timings_ms"), db.pop("timings_ms")
+    assert json.dumps(da, default=float) == json.dumps(db, default=float)

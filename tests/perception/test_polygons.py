@@ -1,0 +1,32 @@
+import numpy as np
+
+from lv3d.perception.polygons import area, clockwise, is_simple, rasterize, signed_area, simplify
+
+
+def test_simplify_keeps_only_true_corners():
+    square = np.array([[0, 0], [50, 0.4], [100, 0], [100, 60], [100, 100], [0, 100], [0, 40]], float)
+    out = simplify(square)
+    assert len(out) == 4
+    assert area(out) == np.float64(area(out)) and abs(area(out) - 10000) < 100
+
+
+def test_simplify_keeps_a_pentagon():
+    ang = np.radians(np.arange(5) * 72 - 90)
+    pent = np.stack([100 + 60 * np.cos(ang), 100 + 60 * np.sin(ang)], 1)
+    assert len(simplify(pent)) == 5
+
+
+def test_is_simple_rejects_a_bow_tie():
+    assert is_simple(np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float))
+    assert not is_simple(np.array([[0, 0], [10, 10], [10, 0], [0, 10]], float))
+
+
+def test_clockwise_in_the_image_has_positive_area():
+    p = np.array([[0, 0], [0, 10], [10, 10], [10, 0]], float)  # anticlockwise with v down
+    assert signed_area(p) < 0
+    assert signed_area(clockwise(p)) > 0
+
+
+def test_rasterize_counts_the_inside():
+    m = rasterize(np.array([[2, 2], [11, 2], [11, 11], [2, 11]], float), (20, 20))
+    assert m.sum() == 100

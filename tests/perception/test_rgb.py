@@ -1,0 +1,48 @@
+import cv2
+import numpy as np
+
+from lv3d.perception.rgb import rgb_faces
+
+
+def _canvas():
+    return np.full((240, 320, 3), (200, 200, 190), np.uint8)
+
+
+def test_filled_pentagon_gives_one_five_sided_face():
+    img = _canvas()
+    ang = np.radians(np.arange(5) * 72 - 90)
+    pts = np.stack([160 + 80 * np.cos(ang), 125 + 80 * np.sin(ang)], 1)
+    cv2.fillPoly(img, [np.round(pts).astype(np.int32)], (40, 90, 160))
+    res = rgb_faces(img)
+    assert len(res.faces) == 1
+    face = res.faces[0]
+    assert len(face.polygon) == 5
+    # every found corner is within 3 px of a true one
+    d = np.linalg.norm(face.polygon[:, None, :] - pts[None, :, :], axis=2)
+    assert d.min(axis=1).max() < 3.0
+    assert face.edge_support > 0.9
+
+
+def test_three_faces_of_a_drawn_cube_share_edges_and_form_one_object():
+    img = _canvas()
+    a, b, c, d, e, f, g = (160, 40), (230, 75), (160, 110), (90, 75), (90, 170), (160, 205), (230, 170)
+    cv2.fillPoly(img, [np.array([a, b, c, d])], (200, 60, 60))  # hue edge only: same grey level as others
+    cv2.fillPoly(img, [np.array([d, c, f, e])], (140, 40, 40))
+    cv2.fillPoly(img, [np.array([c, b, g, f])], (90, 20, 20))
+    res = rgb_faces(img)
+    assert sorted(len(f.polygon) for f in res.faces) == [4, 4, 4]
+    assert len(res.adjacency) == 3
+    assert res.groups == [[0, 1, 2]]
+
+
+def test_plain_image_has_no_face():
+    assert rgb_faces(_canvas()).faces == []
+
+
+def test_box_limits_the_search():
+    img = _canvas()
+    cv2.rectangle(img, (20, 20), (80, 80), (20, 20, 20), -1)
+    cv2.rectangle(img, (200, 120), (280, 200), (20, 20, 20), -1)
+    res = rgb_faces(img, box=(180, 100, 300, 220))
+    assert len(res.faces) == 1
+    assert res.faces[0].polygon[:, 0].min() > 180

@@ -1,0 +1,43 @@
+import numpy as np
+
+from lv3d.perception.faces import bounded_faces, build_graph
+from lv3d.perception.segments import merge_collinear
+
+
+def test_merge_collinear_joins_pieces_of_one_edge():
+    segs = np.array([[0, 0, 40, 0], [43, 0.5, 90, 0.5], [0, 10, 0, 60]], float)
+    out = merge_collinear(segs)
+    assert len(out) == 2
+    long = out[np.argmax(np.hypot(out[:, 2] - out[:, 0], out[:, 3] - out[:, 1]))]
+    assert abs(np.hypot(long[2] - long[0], long[3] - long[1]) - 90) < 1.5
+
+
+def test_merge_collinear_keeps_parallel_lines_apart():
+    segs = np.array([[0, 0, 50, 0], [0, 8, 50, 8]], float)
+    assert len(merge_collinear(segs)) == 2
+
+
+def test_square_with_gaps_at_the_corners_is_one_face():
+    # segments stop 3 px short of each corner, as a line detector does
+    segs = np.array([[13, 10, 97, 10], [100, 13, 100, 97], [97, 100, 13, 100], [10, 97, 10, 13]], float)
+    faces = bounded_faces(build_graph(segs))
+    assert len(faces) == 1
+    assert len(faces[0].cycle) == 4
+    assert np.allclose(sorted(faces[0].polygon[:, 0]), [10, 10, 100, 100], atol=1)
+
+
+def test_free_ended_segments_are_pruned_and_two_squares_share_an_edge():
+    segs = np.array([[10, 10, 100, 10], [10, 100, 100, 100], [10, 10, 10, 100], [100, 10, 100, 100],
+                     [100, 10, 190, 10], [100, 100, 190, 100], [190, 10, 190, 100],
+                     [150, 150, 220, 220]], float)  # the last is a stray line
+    g = build_graph(segs)
+    faces = bounded_faces(g)
+    assert len(faces) == 2
+    assert len(faces[0].edges & faces[1].edges) == 1
+
+
+def test_graph_is_deterministic():
+    rng = np.random.default_rng(3)
+    segs = rng.uniform(0, 200, (40, 4))
+    a, b = build_graph(segs), build_graph(segs.copy())
+    assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.edges, b.edges)
