@@ -66,15 +66,16 @@ def refine_polygon(polygon: np.ndarray, field: np.ndarray, *, intrinsics=(600.0,
     return np.asarray(g.vertices)[ids], np.asarray(g.vertex_cov)[ids], int(g.status)
 
 
-def fit_plane(points: np.ndarray, plane0: np.ndarray, *, settings: Settings = Settings()) -> tuple[np.ndarray, np.ndarray, int]:
+def fit_plane(points: np.ndarray, plane0: np.ndarray, *, settings: Settings = Settings(),
+              image_size: tuple[int, int] = (480, 640)) -> tuple[np.ndarray, np.ndarray, int]:
     """Robust, depth-noise-weighted plane through camera-frame points ((m, 3) metres) from a first guess
     ``plane0`` = (n, d); at most ``MAX_POINTS`` of them (an even random subset) are used. Returns the
     plane (4,), the standard deviations of its update (two normal tilts in radians, the offset in metres)
-    and the status."""
+    and the status. ``image_size`` (H, W) only picks which compiled program runs (the one of your frames)."""
     pts = np.asarray(points, np.float64)
     # a dummy triangle around the points' image position keeps the padded problem well formed
     tri = np.array([[0.0, 0.0], [10.0, 0.0], [0.0, 10.0]]) + 300.0
     prob, _ = pack_object([tri], intrinsics=(600.0, 600.0, 320.0, 240.0), planes=[plane0],
                           points=[pts], use_edges=[False])
-    g = ground_object(prob, jnp.zeros((16, 16), jnp.float32), True, settings)
+    g = ground_object(prob, jnp.zeros(image_size, jnp.float32), True, settings)
     return np.asarray(g.planes[0]), np.asarray(g.plane_std[0]), int(g.status)

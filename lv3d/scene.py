@@ -72,15 +72,20 @@ class Scene:
     timings_ms: dict[str, float] = field(default_factory=dict)
 
     def target(self) -> SceneObject | None:
-        """The object a label speaks of: the largest, preferring those near the image centre."""
+        """The object a label speaks of: the one nearest the image centre (the camera is aimed at it; clutter
+        and occluders may be larger but stand beside it), size breaking near ties. Objects with faces are
+        preferred over those without."""
         if not self.objects:
             return None
         k = self.intrinsics
-        diag = np.hypot(k.width, k.height)
+        # Gaussian in the centroid's distance from the image centre, sigma 2 % of the diagonal (16 px at
+        # 640x480): on rendered realsense/hard scenes this picks the target far more often than a size-led
+        # rule (0.96-1.00 vs 0.41-0.66 with depth), since larger clutter is what misled the size rule
+        sigma = 0.02 * float(np.hypot(k.width, k.height))
 
-        def score(o: SceneObject) -> float:
-            off = np.hypot(o.centroid_px[0] - k.width / 2, o.centroid_px[1] - k.height / 2) / diag
-            return o.pixel_count * (1.0 - off)
+        def score(o: SceneObject) -> tuple[bool, float, float]:
+            off = np.hypot(o.centroid_px[0] - k.width / 2, o.centroid_px[1] - k.height / 2)
+            return bool(o.faces), float(o.pixel_count * np.exp(-0.5 * (off / sigma) ** 2)), -off
 
         return max(self.objects, key=score)
 

@@ -2,11 +2,22 @@
     module per use, fit one target, classify with fixed programs, check program files.
     Everything handed back is atoms and numbers, which pyswip maps to str and float.
 */
-:- module(lv3d_bridge, [guard/4, load_scene/3, drop_scene/1, fit/8, classify/6, check_program/4]).
+:- module(lv3d_bridge, [guard/4, learn_task/3, load_scene/3, drop_scene/1, fit/8, classify/6, check_program/4]).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(mil).
 :- use_module(shape_bk).
+:- use_module(mil_task).
+
+%!  learn_task(+File, +Overrides, -Texts) is semidet.
+%   Learn the task file File (mil_task.pl format) with Metagol's search; Overrides (options)
+%   take precedence over the file's settings.  Texts: the program's clauses as atoms.
+learn_task(File, Overrides, Texts) :-
+    load_task(File, lv3d_task, Task, Settings0),
+    append(Overrides, Settings0, Settings),
+    learn(Task, Settings, Prog),
+    program_clauses(Task, Prog, Clauses),
+    maplist(clause_text, Clauses, Texts).
 
 %!  guard(:Goal, -Kind, -Where, -Message) is nondet.
 %   Kind = ok, or when Goal throws (atoms): Kind is time_limit, input (a bad task or program
@@ -95,6 +106,7 @@ trace_item(clause(I), [clause, I, 1.0]).
 check_program(File, Known, Target, Texts) :-
     catch(setup_call_cleanup(open(File, read, S), read_clauses(S, Clauses), close(S)), E,
           ( E = error(syntax_error(Msg), stream(_, L, _, _)) -> bad(File, 'syntax error at line ~w: ~w', [L, Msg])
+          ; E = error(syntax_error(Msg), file(_, L, _, _)) -> bad(File, 'syntax error at line ~w: ~w', [L, Msg])
           ; E = error(syntax_error(Msg), _) -> bad(File, 'syntax error: ~w', [Msg])
           ; E = error(existence_error(source_sink, _), _) -> bad(File, 'no such file', [])
           ; throw(E) )),

@@ -9,8 +9,9 @@
     Settings are a list of options (see default/1).  Atoms inside the interpreter are lists
     [Pred|Args] so that a predicate symbol can be a variable, as in Metagol.
 
-    A program is a list of items: sub(MetaruleName, Subs) while learning, cl(Head, Body) when fixed
-    (Head an atom list, Body a list of atom lists).  A proof's confidence combines the confidences
+    A program is a list of items: sub(MetaruleName, Subs, BodyLength) while learning, cl(Head, Body)
+    when fixed (Head an atom list, Body a list of atom lists).  Iterative deepening is on the total
+    number of body literals, and within it on the number of clauses (smallest programs first).  A proof's confidence combines the confidences
     of the facts it used (option combine: product or min); an atom is proved only while that
     confidence stays >= the threshold.
 */
@@ -31,6 +32,7 @@
 
 %!  default(?Option) is nondet.  Settings as data; a task or caller overrides any of them.
 default(max_clauses(3)).        % iterative deepening bound on the number of clauses
+default(max_literals(6)).       % and on the number of body literals of all clauses together
 default(max_inventions(1)).     % invented predicate symbols allowed
 default(max_depth(10)).         % bound on nested clause applications in one proof (recursion)
 default(time_limit(10)).        % seconds for a whole search; exceeding it throws mil_error(time_limit(S))
@@ -68,9 +70,15 @@ learn(Task, Settings0, Prog) :-
 search(Task, Settings, Prog) :-
     task_ctx(Task, Settings, Ctx0),
     Task = task(_, _, _, _, Pos, Neg),
-    option(max_clauses(Max), Settings),
-    between(1, Max, N),
-    consistent(Ctx0, N, Pos, Neg, Prog).
+    size(Settings, Ctx0, Ctx),
+    prove_examples(Pos, Ctx, [], Prog0),
+    consistent(Ctx, Neg, Prog0, Prog).
+
+%   Program sizes in iterative deepening order: literals, then clauses.
+size(Settings, Ctx0, Ctx) :-
+    option(max_literals(MaxL), Settings), option(max_clauses(MaxC), Settings),
+    between(1, MaxL, L), between(1, MaxC, N), N =< L,
+    ctx_size(Ctx0, N, L, Ctx).
 
 %!  learn_noisy(+Task, +Settings, -Program, -Score) is semidet.
 %   Hypotheses learned from seeded random samples of the examples, each scored on all of them
@@ -91,9 +99,9 @@ learn_noisy_(Task, Settings, Best, Score) :-
     option(clause_penalty(Lambda), Settings),
     findall(Key-(Prog-S), (nth1(Order, Unique, Prog),
                            score(Ctx, Lambda, Prog, Pos, Neg, S),
-                           S = score(J, Soft, _, _), literal_cost(Ctx, Prog, Cost),
-                           NCost is -Cost, NOrder is -Order,
-                           Key = k(J, Soft, NCost, NOrder)), Scored),
+                           S = score(J, Soft, _, _), support(Ctx, Prog, Pos, W),
+                           literal_cost(Ctx, Prog, Cost), NCost is -Cost, NOrder is -Order,
+                           Key = k(J, Soft, W, NCost, NOrder)), Scored),
     Scored \== [],
     max_member(_-(Best-Score), Scored).
 
@@ -109,13 +117,20 @@ score(Ctx, Lambda, Prog, Pos, Neg, score(J, Soft, TP/NP, FP/NN)) :-
     J is TPR - FPR - Lambda * L,
     Soft is MP - MN.
 
+%   Support: the mean number of proofs of a positive (at most 16 counted).  Between programs equal
+%   so far it prefers the one that holds for more parts of each positive, so that it still holds
+%   when another view hides some of them.
+support(Ctx, Prog, Pos, W) :-
+    findall(K, ( member(E, Pos), aggregate_all(count, limit(16, covers(Ctx, Prog, E, _, _)), K) ), Ks),
+    mean(Ks, W).
+
 %   The last tie-break: each body literal costs its predicate's place in the body predicate list
 %   (0 for a target or invented predicate), so that the caller's order of preference decides
 %   between equally good programs.
 literal_cost(Ctx, Prog, Cost) :-
     ctx(Ctx, bps, BPs),
-    findall(R, ( member(sub(_, [_|Syms]), Prog), member(Q, Syms),
-                 ( nth0(R, BPs, bp(Q, _, _)) -> true ; R = 0 ) ), Rs),
+    findall(R, ( member(sub(_, [_|Syms], _), Prog), member(Q, Syms),
+                 ( nth0(R, BPs, bp(Q, _, _, _)) -> true ; R = 0 ) ), Rs),
     sum_list(Rs, Cost).
 
 best_conf(Ctx, Prog, E, C) :-
@@ -126,11 +141,13 @@ rate(K, N, R) :- R is K / N.
 mean([], 0.0) :- !.
 mean(Xs, M) :- sum_list(Xs, S), length(Xs, N), M is S / N.
 
-%   The smallest hypotheses consistent with one sample, at most `solutions` of them.
-sample_hypothesis(Ctx, Settings, Pos, Neg, Prog) :-
-    option(max_clauses(Max), Settings), option(solutions(J), Settings),
-    between(1, Max, N),
-    findall(P, limit(J, consistent(Ctx, N, Pos, Neg, P)), Progs),
+%   The smallest hypotheses consistent with one sample, at most `solutions` of them: every program
+%   of the size that proves the positives, once each, then those that prove no negative.
+sample_hypothesis(Ctx0, Settings, Pos, Neg, Prog) :-
+    option(solutions(J), Settings),
+    size(Settings, Ctx0, Ctx),
+    findall(P, prove_examples(Pos, Ctx, [], P), Ps0), list_to_set(Ps0, Ps),
+    findall(P, limit(J, (member(P0, Ps), consistent(Ctx, Neg, P0, P))), Progs),
     Progs \== [], !,
     member(Prog, Progs).
 
@@ -143,14 +160,17 @@ samples(K, SP, SN, Pos, Neg, Samples) :-
 sample(SP, SN, Pos, Neg, P1-N1) :- pick(SP, Pos, P1), pick(SN, Neg, N1).
 pick(K, Xs, Ys) :- random_permutation(Xs, Zs), length(Xs, L), M is min(K, L), length(Ys, M), append(Ys, _, Zs).
 
-%   A program of exactly N clauses that proves every positive and no negative.
-consistent(Ctx0, N, Pos, Neg, Prog) :-
-    ctx_max(Ctx0, N, Ctx),
-    prove_examples(Pos, Ctx, [], Prog0),
-    length(Prog0, N),
-    sort(Prog0, Sorted), length(Sorted, N),             % no clause twice
+%   A program that proves every positive has exactly the size asked, no clause twice, and
+%   proves no negative.
+consistent(Ctx, Neg, Prog0, Prog) :-
+    ctx(Ctx, max, N), length(Prog0, N),
+    ctx(Ctx, lits, L), prog_lits(Prog0, L),
+    sort(Prog0, Sorted), length(Sorted, N),
     \+ (member(E, Neg), covers(Ctx, Prog0, E, _, _)),
     reverse(Prog0, Prog).
+
+prog_lits(Prog, L) :- foldl(add_lits, Prog, 0, L).
+add_lits(sub(_, _, K), L0, L) :- L is L0 + K.
 
 prove_examples([], _, Prog, Prog).
 prove_examples([E|Es], Ctx, Prog1, Prog3) :-
@@ -160,7 +180,7 @@ prove_examples([E|Es], Ctx, Prog1, Prog3) :-
 
 %!  covers(+Ctx, +Prog, +Example, -Conf, -Trace) is nondet.  A proof with the fixed program Prog.
 covers(Ctx0, Prog, E, C, Trace) :-
-    length(Prog, N), ctx_max(Ctx0, N, Ctx),             % no new clauses
+    length(Prog, N), ctx_size(Ctx0, N, 0, Ctx),         % no new clauses
     E =.. Atom, ctx(Ctx, depth, D),
     prove([Atom], Ctx, D, Prog, _, 1.0, C, Trace, []).
 
@@ -173,21 +193,21 @@ prove([Atom|Atoms], Ctx, D, Prog1, Prog3, C1, C3, T1, T3) :-
 
 % a background fact with a confidence: BK stores P(Args..., Conf)
 prove_aux([P|Args], Ctx, _, Prog, Prog, C1, C2, [fact(G, Cf)|T], T) :-
-    ctx(Ctx, bps, BPs), member(bp(P, A, fact), BPs), length(Args, A),
+    bp(Ctx, P, A, fact), length(Args, A),
     ctx(Ctx, bk, BK), append(Args, [Cf], Args1), G1 =.. [P|Args1],
     call(BK:G1),
     combine(Ctx, C1, Cf, C2),
     G =.. [P|Args].
 % a derived background predicate: BK:bk_rule(Head, Body), its body proved by this interpreter
 prove_aux([P|Args], Ctx, D, Prog, Prog, C1, C2, [bk(G)|T1], T2) :-
-    ctx(Ctx, bps, BPs), member(bp(P, A, rule), BPs), length(Args, A),
+    bp(Ctx, P, A, rule), length(Args, A),
     G =.. [P|Args], ctx(Ctx, bk, BK),
     call(BK:bk_rule(G, Body)),
     maplist(term_list, Body, Atoms),
     prove(Atoms, Ctx, D, Prog, _, C1, C2, T1, T2).
 % an ordinary Prolog background predicate: holds with confidence 1
 prove_aux([P|Args], Ctx, _, Prog, Prog, C, C, [call(G)|T], T) :-
-    ctx(Ctx, bps, BPs), member(bp(P, A, prolog), BPs), length(Args, A),
+    bp(Ctx, P, A, prolog), length(Args, A),
     G =.. [P|Args], ctx(Ctx, bk, BK),
     call(BK:G).
 % use a clause already in the program (a learned one or a meta-substitution being built)
@@ -199,16 +219,17 @@ prove_aux(Atom, Ctx, D, Prog1, Prog2, C1, C2, [clause(I)|T1], T2) :-
 % add a clause: a metarule instance whose head symbol is a target or an invented predicate
 prove_aux(Atom, Ctx, D, Prog1, Prog2, C1, C2, [clause(new)|T1], T2) :-
     D > 0, D1 is D - 1,
-    ctx(Ctx, max, Max), length(Prog1, L), L < Max,
+    ctx(Ctx, max, Max), length(Prog1, N), N < Max,
     Atom = [P|Args], length(Args, A),
     head_symbol(Ctx, Prog1, P, A),
     ctx(Ctx, metarules, MRs), member(MR, MRs),
     copy_term(MR, metarule(Name, Subs, Atom, Body)),
+    length(Body, K), prog_lits(Prog1, L0), ctx(Ctx, lits, L), L0 + K =< L,
     Body = [[Q|_]|_], dif(Q, P),                      % no left recursion
-    prove(Body, Ctx, D1, [sub(Name, Subs)|Prog1], Prog2, C1, C2, T1, T2).
+    prove(Body, Ctx, D1, [sub(Name, Subs, K)|Prog1], Prog2, C1, C2, T1, T2).
 
 %   The head and body of a program item, renamed apart, with the head unified with Atom.
-item_instance(sub(Name, Subs), Ctx, Atom, Body) :-
+item_instance(sub(Name, Subs, _), Ctx, Atom, Body) :-
     Atom = [P|_], Subs = [P|_],
     ctx(Ctx, metarules, MRs), template(Name, MRs, MR),
     copy_term(MR, metarule(Name, Subs, Atom, Body)).
@@ -227,7 +248,7 @@ head_symbol(Ctx, Prog, P, _) :-
 
 invented(Ctx, Prog, Used) :-
     ctx(Ctx, targets, Ts),
-    findall(P, (member(sub(_, [P|_]), Prog), atom(P), \+ memberchk(P/_, Ts)), Ps),
+    findall(P, (member(sub(_, [P|_], _), Prog), atom(P), \+ memberchk(P/_, Ts)), Ps),
     sort(Ps, Used).
 
 combine(Ctx, C1, Cf, C2) :-
@@ -244,24 +265,42 @@ task_ctx(task(BK, Targets, BodyPreds, MRs0, _, _), Settings, Ctx) :-
     maplist(metarule_term, MRs0, MRs),
     option(max_depth(D), Settings), option(threshold(Thr), Settings),
     option(combine(How), Settings), option(max_inventions(Inv), Settings),
-    option(max_clauses(Max), Settings),
-    Ctx = ctx(BK, Targets, BPs, MRs, D, Thr, How, Inv, Max).
+    option(max_clauses(Max), Settings), option(max_literals(Lits), Settings),
+    Ctx = ctx(BK, Targets, BPs, MRs, D, Thr, How, Inv, Max, Lits).
 
-ctx(ctx(BK, _, _, _, _, _, _, _, _), bk, BK).
-ctx(ctx(_, Ts, _, _, _, _, _, _, _), targets, Ts).
-ctx(ctx(_, _, BPs, _, _, _, _, _, _), bps, BPs).
-ctx(ctx(_, _, _, MRs, _, _, _, _, _), metarules, MRs).
-ctx(ctx(_, _, _, _, D, _, _, _, _), depth, D).
-ctx(ctx(_, _, _, _, _, Thr, _, _, _), threshold, Thr).
-ctx(ctx(_, _, _, _, _, _, How, _, _), combine, How).
-ctx(ctx(_, _, _, _, _, _, _, Inv, _), inventions, Inv).
-ctx(ctx(_, _, _, _, _, _, _, _, Max), max, Max).
-ctx_max(ctx(A, B, C, E, F, G, H, I, _), Max, ctx(A, B, C, E, F, G, H, I, Max)).
+ctx(ctx(BK, _, _, _, _, _, _, _, _, _), bk, BK).
+ctx(ctx(_, Ts, _, _, _, _, _, _, _, _), targets, Ts).
+ctx(ctx(_, _, BPs, _, _, _, _, _, _, _), bps, BPs).
+ctx(ctx(_, _, _, MRs, _, _, _, _, _, _), metarules, MRs).
+ctx(ctx(_, _, _, _, D, _, _, _, _, _), depth, D).
+ctx(ctx(_, _, _, _, _, Thr, _, _, _, _), threshold, Thr).
+ctx(ctx(_, _, _, _, _, _, How, _, _, _), combine, How).
+ctx(ctx(_, _, _, _, _, _, _, Inv, _, _), inventions, Inv).
+ctx(ctx(_, _, _, _, _, _, _, _, Max, _), max, Max).
+ctx(ctx(_, _, _, _, _, _, _, _, _, L), lits, L).
+ctx_size(ctx(A, B, C, E, F, G, H, I, _, _), Max, L, ctx(A, B, C, E, F, G, H, I, Max, L)).
+
+%   The kind of a body predicate; a bound name is looked up without leaving a choice point,
+%   an unbound one ranges over the visible body predicates.
+bp(Ctx, P, A, Kind) :-
+    ctx(Ctx, bps, BPs),
+    (   atom(P) -> memberchk(bp(P, A0, K0, _), BPs), A = A0, Kind = K0
+    ;   member(bp(P, A, Kind, visible), BPs)
+    ).
 
 %   Each body predicate is a fact with a confidence (BK defines P/(A+1)), a derived rule
-%   (BK:bk_rule/2 has a head P/A) or plain Prolog (BK defines P/A, confidence 1).
-body_kinds(BK, BodyPreds, BPs) :- maplist(body_kind(BK), BodyPreds, BPs).
-body_kind(BK, P/A, bp(P, A, Kind)) :-
+%   (BK:bk_rule/2 has a head P/A) or plain Prolog (BK defines P/A, confidence 1).  The predicates
+%   that derived rules use follow, hidden: proved when a rule calls them, never put in a clause.
+body_kinds(BK, BodyPreds, BPs) :-
+    maplist(body_kind(BK, visible), BodyPreds, Visible),
+    findall(Q/B, ( member(bp(P, A, rule, _), Visible), functor(H, P, A),
+                   catch(BK:bk_rule(H, Body), _, fail), member(G, Body), functor(G, Q, B),
+                   \+ memberchk(Q/B, BodyPreds) ), Hidden0),
+    sort(Hidden0, Hidden),
+    maplist(body_kind(BK, hidden), Hidden, HiddenBPs),
+    append(Visible, HiddenBPs, BPs).
+
+body_kind(BK, Vis, P/A, bp(P, A, Kind, Vis)) :-
     functor(H, P, A),
     (   A1 is A + 1, current_predicate(BK:P/A1) -> Kind = fact
     ;   catch(BK:bk_rule(H, _), error(existence_error(_, _), _), fail) -> Kind = rule
@@ -314,7 +353,7 @@ program_clauses(task(_, _, _, MRs0, _, _), Prog, Clauses) :-
     findall(P, (member((H :- _), Clauses0), functor(H, P, _)), Ps0), list_to_set(Ps0, Ps),
     findall(C, (member(P, Ps), member(C, Clauses0), C = (H :- _), functor(H, P, _)), Clauses).
 
-item_clause(MRs, sub(Name, Subs), (H :- B)) :-
+item_clause(MRs, sub(Name, Subs, _), (H :- B)) :-
     template(Name, MRs, MR),
     copy_term(MR, metarule(Name, Subs, HL, BL)),
     H =.. HL, maplist(term_list, Bs, BL), list_conj(Bs, B).

@@ -28,8 +28,12 @@ load_task(File, M, task(M, Targets, BodyPreds, MRs, Pos, Neg), Settings) :-
     findall(P/A, (member(E, Pos), functor(E, P, A)), Ts0), sort(Ts0, Targets),
     forall(member(E, Neg), ( functor(E, P, A), memberchk(P/A, Targets) -> true
                            ; problem(File, format('negative example ~q is not about a target', [E])) )),
-    catch(mil:task_check(task(M, Targets, BodyPreds, MRs, Pos, Neg)), mil_error(Why),
-          problem(File, format('~q', [Why]))).
+    catch(task_check(task(M, Targets, BodyPreds, MRs, Pos, Neg)), mil_error(Why), unusable(File, Why)).
+
+unusable(File, unknown_body_pred(P/A)) :- !,
+    problem(File, format('body predicate ~w/~w is not defined in the file', [P, A])).
+unusable(File, unknown_metarule(N)) :- !, problem(File, format('unknown metarule ~q', [N])).
+unusable(File, Why) :- problem(File, format('~q', [Why])).
 
 read_terms(File, Terms) :-
     catch(setup_call_cleanup(open(File, read, S), read_all(S, Terms), close(S)), E,
@@ -44,6 +48,7 @@ read_all(S, Terms) :-
     (   T == end_of_file -> Terms = [] ; Terms = [T|Ts], read_all(S, Ts) ).
 
 syntax_where(stream(_, Line, Col, _), W) :- !, format(atom(W), 'at line ~w column ~w', [Line, Col]).
+syntax_where(file(_, Line, Col, _), W) :- !, format(atom(W), 'at line ~w column ~w', [Line, Col]).
 syntax_where(_, '').
 
 task_term(File, _, (:- D), _, _) :- !,

@@ -151,7 +151,9 @@ def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int,
     best = next((n for n in ("lv3d-rgbd", "lv3d-depth", "lv3d-rgb") if n in fitted), None)
     if best:
         fit, preds = fitted[best]
-        it, (label, conf) = test[0], preds[0]
+        # the first test scene in which perception found an object (else there is nothing to explain)
+        j = next((j for j, it in enumerate(test) if fit.facts[it.id].target is not None), 0)
+        it, (label, conf) = test[j], preds[j]
         click.echo(f"\nWhy {best} says {it.id} (truly a {it.cls}) is a {label} (confidence {conf:.2f}):")
         click.echo(str(fit.explain(it.id)))
 

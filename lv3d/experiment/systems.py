@@ -46,8 +46,12 @@ class LogicSystem:
         from ..learn import Model
 
         keep = [(self.facts[i], y) for i, y in zip(ids, labels) if self.facts[i].target is not None]
+        present = {y for _, y in keep}
+        classes = [c for c in ([positive] if positive else sorted(present)) if c in present]
+        if not classes:  # perception found no object in any positive: nothing to learn from
+            return FittedLogic(Model({}, self.settings), self.facts)
         model = Model.fit([f for f, _ in keep], [y for _, y in keep], settings=self.settings or None, seed=seed,
-                          classes=[positive] if positive else None)
+                          classes=classes)
         return FittedLogic(model, self.facts)
 
 

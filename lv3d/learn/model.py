@@ -21,18 +21,24 @@ FIT_MODULE, SCENE_MODULE = "lv3d_fit", "lv3d_scene"
 
 
 # Search order of the body predicates, which decides among equally good hypotheses (the first
-# found wins): what a face is (sides, metric shape), then how faces meet, then the 2D outline, and
-# last the face's orientation to the table, which depends on how the solid happens to rest.
+# found wins): what a face is (sides, metric shape), what faces it meets, at which angles, then
+# the 2D outline, and last the face's orientation to the table, which depends on how the solid
+# happens to rest and so generalises worst from one view.
 BODY_ORDER = ("face_of", "triangle", "quadrilateral", "pentagon", "hexagon", "square", "rectangle", "regular",
-              "perpendicular_neighbour", "acute_neighbour", "obtuse_neighbour", "triangle_neighbour",
-              "quadrilateral_neighbour", "square_neighbour", "right_corner",
+              "triangle_neighbour", "quadrilateral_neighbour", "square_neighbour",
+              "perpendicular_neighbour", "acute_neighbour", "obtuse_neighbour", "right_corner",
               "adjacent", "perpendicular", "acute", "obtuse", "parallel", "parallelogram", "horizontal", "vertical")
+
+
+# object/1 holds for every target; horizontal/vertical say how a solid rests, not what it is, and
+# a concept learned from one view with them fails on the next pose.
+EXCLUDED = ("object", "horizontal", "vertical")
 
 
 def body_preds(modality: str) -> list[tuple[str, int]]:
     """The body predicates a system seeing ``modality`` learns with, in search order: the contract's
     (but object/1, true of every target) and the derived ones of prolog/shape_bk.pl."""
-    own = [(p, a) for p, (a, mods) in PREDICATES.items() if modality in mods and p != "object"]
+    own = [(p, a) for p, (a, mods) in PREDICATES.items() if modality in mods and p not in EXCLUDED]
     preds = own + list(engine.derived_preds())
     rank = {p: i for i, p in enumerate(BODY_ORDER)}
     return sorted(preds, key=lambda pa: rank.get(pa[0], len(rank)))

@@ -8,7 +8,7 @@ from ..camera import Intrinsics
 from ..errors import InputError
 from ..rgbd import RGBD
 from .noise import NoiseConfig, as_config, noisy_color, noisy_depth
-from .raycast import Body, raycast
+from .raycast import Body, ray_lengths, raycast
 from .sampler import FLOOR_Z_M, TABLE_THICKNESS_M, Layout, sample_layout
 from .shading import environment_colour, object_albedo, shade
 from .solids import CLASSES, Solid, box
@@ -89,9 +89,10 @@ def render_scene(cls: str, seed: int, noise: str | NoiseConfig = "clean", width:
 
     color = shade(hits, layout, roles, albedo, light_cam, cfg, look_rng)
     # on a face's plane n . X + offset = 0 with X = z * ray, so |n . ray| / |ray| = |offset| / (z |ray|)
-    ray_len = np.linalg.norm(hits.rays, axis=-1)
-    offset = np.append(hits.face_offset, 1.0)[hits.gface]
-    cos_inc = np.where(hits.depth > 0, np.abs(offset) / np.maximum(hits.depth * ray_len, 1e-9), 0.0)
+    cos_inc = None
+    if cfg.grazing_deg < 90:
+        offset = np.take(np.append(hits.face_offset, 1.0).astype(np.float32), hits.gface)
+        cos_inc = np.abs(offset) / np.maximum(hits.depth * ray_lengths(k), np.float32(1e-9))
     depth = noisy_depth(hits.depth, cos_inc, cfg, noise_rng)
     color8 = noisy_color(color, cfg, noise_rng)
     mask = np.where(hits.body == target_index, hits.face + 1, 0).astype(np.uint8)

@@ -65,6 +65,26 @@ def pixel_rays(k: Intrinsics) -> np.ndarray:
     return d
 
 
+_RAY_PLANES: dict = {}
+
+
+def ray_planes(shape: tuple[int, int], rays: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The x and y components of ``rays`` (H, W, 3) as contiguous (H, W) arrays (cached per image size)."""
+    key = (shape, rays[0, 0, 0].item(), rays[-1, -1, 1].item())
+    if key not in _RAY_PLANES:
+        _RAY_PLANES.clear()
+        _RAY_PLANES[key] = (np.ascontiguousarray(rays[..., 0]), np.ascontiguousarray(rays[..., 1]))
+    return _RAY_PLANES[key]
+
+
+@lru_cache(maxsize=8)
+def ray_lengths(k: Intrinsics) -> np.ndarray:
+    """(H, W) float32 lengths of the pixel rays of :func:`pixel_rays`."""
+    n = np.linalg.norm(pixel_rays(k), axis=-1)
+    n.setflags(write=False)
+    return n
+
+
 @lru_cache(maxsize=8)
 def rays_from_origin(k: Intrinsics) -> np.ndarray:
     """(H, W, 6) float32 rays (origin 0, direction with z = 1) for open3d."""

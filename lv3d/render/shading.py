@@ -9,7 +9,7 @@ import colorsys
 import numpy as np
 
 from .noise import NoiseConfig
-from .raycast import Hits
+from .raycast import Hits, ray_planes
 from .sampler import Layout
 
 
@@ -57,7 +57,7 @@ def _coords(hits: Hits, idx: np.ndarray, cam_to_frame: np.ndarray) -> tuple[np.n
     """Coordinates (x, y, z), each (m,) float32 metres, in some frame of the hit points at flat pixel
     indices ``idx``; ``cam_to_frame`` (4, 4) maps camera-frame points into that frame."""
     z = hits.depth.ravel()[idx]
-    rx, ry = hits.rays[..., 0].ravel()[idx], hits.rays[..., 1].ravel()[idx]
+    rx, ry = (c.ravel()[idx] for c in ray_planes(hits.depth.shape, hits.rays))
     a = cam_to_frame.astype(np.float32)
     return tuple(z * (a[i, 0] * rx + a[i, 1] * ry + a[i, 2]) + a[i, 3] for i in range(3))
 
@@ -68,31 +68,34 @@ def shade(hits: Hits, layout: Layout, roles: list[str], albedo: list[np.ndarray]
     role; ``albedo``: per body (faces, 3) albedo in 0..1. Albedo and Lambert term are per face (flat
     faces, directional light), looked up through ``hits.gface``; textures scale them per pixel."""
     f32 = np.float32
-    alb_lut = np.concatenate(albedo + [np.full((1, 3), 0.16)]).astype(np.float32)  # last row: nothing hit
-    lambert_lut = np.append(np.clip(hits.face_normal @ light_cam, 0.0, None), 0.0)
+    alb_lut = np.concatenate(albedo + [np.full((1, 3), 0.16)])  # last row: nothing hit
+    lambert = np.append(np.clip(hits.face_normal @ light_cam, 0.0, None), 0.0)
     ambient = rng.uniform(0.28, 0.42)
-    diffuse_lut = (255 * (1.0 - ambient) * 1.1 * lambert_lut).astype(np.float32)
+    diffuse = 255 * (1.0 - ambient) * 1.1 * lambert
+    # colour = albedo * (ambient + diffuse * (1 - shadow)) * texture = (lit - shade * shadow) * texture,
+    # with per-face tables lit and shade
+    lit_lut = (alb_lut * (255 * ambient + diffuse)[:, None]).astype(np.float32)
+    lit_lut[-1] = 0.16 * 255
     gface = np.where(hits.gface >= 0, hits.gface, len(alb_lut) - 1)
-    diffuse = diffuse_lut[gface]
-    if hits.shadow.any():
-        diffuse *= f32(1.0) - hits.shadow
-    light = f32(255 * ambient) + diffuse
-    light[hits.gface < 0] = 255.0
+    colour = np.take(lit_lut, gface, axis=0)
+    if np.any(hits.shadow):
+        shade_lut = (alb_lut * diffuse[:, None]).astype(np.float32)
+        colour -= np.take(shade_lut, gface, axis=0) * hits.shadow[..., None]
     mod = np.ones(hits.depth.shape, np.float32).ravel()
     body = hits.body.ravel()
     w2c = layout.world_to_camera
     c2w = np.linalg.inv(w2c)
-    textured = np.zeros(body.shape, bool)
     for i, role in enumerate(roles):
-        if role in ("floor", "wall"):
-            idx = np.flatnonzero(body == i)
+        if role not in ("floor", "wall", "table"):
+            continue
+        idx = np.flatnonzero(body == i)
+        if role == "floor":
             x, y, z = _coords(hits, idx, c2w)
-            if role == "floor":
-                mod[idx] = f32(0.9) + f32(0.1) * ((np.floor(x / f32(0.3)) + np.floor(y / f32(0.3))) % 2)
-            else:
-                mod[idx] = f32(0.95) + f32(0.05) * _wavy(x + y, z, rng, 2, (0.5, 2.0))
-        elif role == "table":
-            idx = np.flatnonzero(body == i)
+            mod[idx] = f32(0.9) + f32(0.1) * ((np.floor(x / f32(0.3)) + np.floor(y / f32(0.3))) % 2)
+        elif role == "wall":
+            x, y, z = _coords(hits, idx, c2w)
+            mod[idx] = f32(0.95) + f32(0.05) * _wavy(x + y, z, rng, 2, (0.5, 2.0))
+        else:
             xt, yt, _ = _coords(hits, idx, np.linalg.inv(w2c @ layout.table_to_world))
             m = f32(1.0) - f32(cfg.table_grain) * wood_grain(xt, yt, rng)
             for _ in range(cfg.distractor_lines):
@@ -101,13 +104,11 @@ def shade(hits: Hits, layout: Layout, roles: list[str], albedo: list[np.ndarray]
                 paint = f32(rng.choice([0.15, 1.9]))  # dark or light paint, relative to the wood
                 m = np.where(dist < f32(rng.uniform(0.002, 0.006)), paint, m)
             mod[idx] = m
-            textured[idx] = True
-        else:
-            textured |= body == i
-    if cfg.texture > 0:
-        idx = np.flatnonzero(textured)
+    if cfg.texture > 0:  # on the table and the solids (roles after the background)
+        first_solid = next(i for i, r in enumerate(roles) if r not in ("table", "floor", "wall"))
+        idx = np.flatnonzero((body >= first_solid) | (body == roles.index("table")))
         x, y, z = _coords(hits, idx, c2w)
         blotch = 0.5 + 0.5 * np.tanh(f32(1.5) * _wavy(x + f32(0.7) * z, y - f32(0.5) * z, rng, 4, (0.02, 0.08)))
         mod[idx] *= f32(1.0) - f32(cfg.texture) * blotch
-    img = alb_lut[gface] * (light * mod.reshape(light.shape))[..., None]
+    img = colour * mod.reshape(hits.depth.shape)[..., None]
     return np.clip(img, 0, 255, out=img)

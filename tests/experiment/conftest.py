@@ -127,3 +127,18 @@ def tiny_config(tmp_path):
     p = tmp_path / "tiny.yaml"
     p.write_text(TINY)
     return p
+
+
+@pytest.fixture
+def synthetic_facts(monkeypatch):
+    """The synthetic data set and facts of ``fake_world``, but the real learner."""
+    from lv3d.experiment import data as data_mod
+
+    def ensure_dataset(cfg, out):
+        target = data_mod.dataset_dir(cfg, out)
+        if not (target / "manifest.json").is_file():
+            write_dataset(target, cfg["data"]["classes"], cfg["data"]["per_class"], cfg["seed"])
+        return target
+
+    monkeypatch.setattr(data_mod, "ensure_dataset", ensure_dataset)
+    monkeypatch.setattr("lv3d.pipeline.scene_facts", fake_scene_facts)

@@ -4,7 +4,7 @@ import numpy as np
 
 import grounding
 
-from .conftest import plane_through, sample_face, wedge
+from grounding_synth import plane_through, sample_face, wedge
 
 
 def _angle_deg(a, b):

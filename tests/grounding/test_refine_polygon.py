@@ -4,7 +4,7 @@ import numpy as np
 
 import grounding
 
-from .conftest import render_polygons
+from grounding_synth import render_polygons
 
 
 def test_vertices_move_onto_the_true_corners():

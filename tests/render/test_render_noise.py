@@ -66,3 +66,19 @@ def test_colour_knobs_change_colour_only():
     assert np.array_equal(clean.depth, noisy.depth)
     diff = np.abs(clean.color.astype(int) - noisy.color.astype(int))
     assert 2 < diff.mean() < 40
+
+
+def test_gaussian_samples_every_channel_and_is_seeded():
+    from lv3d.render.noise import gaussian
+    g = gaussian((200, 200, 3), np.random.default_rng(1))
+    assert np.allclose(g.reshape(-1, 3).std(axis=0), 1.0, atol=0.02) and abs(g.mean()) < 0.01
+    assert np.array_equal(g, gaussian((200, 200, 3), np.random.default_rng(1)))
+
+
+def test_grazing_angle_knob_drops_oblique_surfaces_only():
+    clean, _ = render_scene("cube", 4, "clean", 160, 120)
+    graze, _ = render_scene("cube", 4, noise_config("clean", grazing_deg=60.0), 160, 120)
+    dropped = (clean.depth > 0) & (graze.depth == 0)
+    assert dropped.any() and (graze.depth > 0).any()
+    kept = graze.depth > 0
+    assert np.array_equal(graze.depth[kept], clean.depth[kept])
