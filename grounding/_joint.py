@@ -44,7 +44,7 @@ def zero_params(prob: ObjectProblem) -> Params:
 
 def geometry(params: Params, prob: ObjectProblem) -> tuple[Float[Array, "U 2"], Float[Array, "F 4"]]:
     """Vertices (pixels) and planes (camera frame) after the update ``params``."""
-    planes = jax.vmap(moved_plane)(prob.planes, params.dplanes)
+    planes = jax.vmap(moved_plane)(prob.planes, params.dplanes, prob.pivots)
     return prob.vertices + params.dverts, planes
 
 

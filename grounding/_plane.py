@@ -1,10 +1,11 @@
 """Planes in the camera frame and the depth residuals that fit them.
 
 A plane is ``(n, d)``, ``n . X + d = 0``, ``n`` a unit normal towards the camera, metres. Refinement
-moves a plane by a local update ``delta = (a, b, c)``: ``n = normalise(n0 + 0.01 (a t1 + b t2))`` with
-``t1, t2`` spanning the plane's tangent space (so a, b are in units of about 0.01 rad) and
-``d = d0 + 0.001 c`` (c in millimetres): units in which a solver's step tolerance means the same for
-vertices (pixels) and planes.
+moves a plane by a local update ``delta = (a, b, c)`` about a pivot ``p`` on it (the centre of the face's
+points): ``n = normalise(n0 + 0.01 (a t1 + b t2))`` with ``t1, t2`` spanning the plane's tangent space (a, b
+in units of about 0.01 rad), and the plane shifted by ``0.001 c`` metres along ``n`` at the pivot. Tilting
+about the face rather than the camera centre keeps tilt and shift nearly independent, and the units make
+a solver's step tolerance mean the same for vertices (pixels) and planes.
 """
 
 from __future__ import annotations
@@ -26,13 +27,15 @@ def tangent_basis(n: Float[Array, " 3"]) -> tuple[Float[Array, " 3"], Float[Arra
     return t1, jnp.cross(n, t1)
 
 
-def moved_plane(plane0: Float[Array, " 4"], delta: Float[Array, " 3"]) -> Float[Array, " 4"]:
-    """The plane ``plane0`` after the local update ``delta = (a, b, c)`` (see the module docstring)."""
+def moved_plane(plane0: Float[Array, " 4"], delta: Float[Array, " 3"], pivot: Float[Array, " 3"]) -> Float[Array, " 4"]:
+    """The plane ``plane0`` after the local update ``delta = (a, b, c)`` about ``pivot`` (camera frame,
+    metres; see the module docstring)."""
     n0 = plane0[:3]
     t1, t2 = tangent_basis(n0)
+    on_plane = pivot - (pivot @ n0 + plane0[3]) * n0
     n = n0 + TILT_UNIT * (delta[0] * t1 + delta[1] * t2)
     n = n / safe_norm(n)
-    return jnp.concatenate([n, plane0[3:] + OFFSET_UNIT_M * delta[2]])
+    return jnp.concatenate([n, (-(n @ on_plane) - OFFSET_UNIT_M * delta[2])[None]])
 
 
 def depth_sigma(z: Float[Array, "..."], a: float, b: float) -> Float[Array, "..."]:

@@ -49,6 +49,7 @@ class ObjectProblem(eqx.Module):
     edge_support_prior: Float[Array, " F"]  # edge support from perception, used where use_edges is False
     has_plane: Bool[Array, " F"]
     planes: Float[Array, "F 4"]            # first-guess planes (n, d), camera frame, metres
+    pivots: Float[Array, "F 3"]            # centre of each face's points: planes tilt about it, camera frame, metres
     points: Float[Array, "F P 3"]          # the face's depth points, camera frame, metres
     point_weight: Float[Array, "F P"]      # 1 for a real point, 0 for padding
     links: Int[Array, "L 3"]               # (vertex, face a, face b): the vertex on plane a must lie on plane b
@@ -124,6 +125,7 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
     pts = np.zeros((MAX_FACES, MAX_POINTS, 3))
     pts[..., 2] = 1.0  # padding sits in front of the camera so that no division meets zero
     pw = np.zeros((MAX_FACES, MAX_POINTS))
+    pivots = np.zeros((MAX_FACES, 3))
     for f in range(nf):
         if planes[f] is not None and points[f] is not None and len(points[f]) >= 3:
             plane_arr[f] = np.asarray(planes[f], np.float64)
@@ -131,6 +133,7 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
             p = _take(np.asarray(points[f], np.float64), MAX_POINTS, seed + f)
             pts[f, : len(p)] = p
             pw[f, : len(p)] = 1.0
+            pivots[f] = p.mean(0)
     adj = np.zeros((MAX_FACES, MAX_FACES), bool)
     links = np.zeros((MAX_LINKS, 3), np.int32)
     lmask = np.zeros(MAX_LINKS, bool)
@@ -157,7 +160,7 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
         vertices=np.asarray(vertices, np.float32), vertex_mask=np.asarray(vmask), vertex_sigma_px=np.asarray(vsig, np.float32),
         face_index=np.asarray(face_index), face_vmask=np.asarray(face_vmask), face_mask=np.asarray(fmask),
         use_edges=np.asarray(ue), edge_support_prior=np.asarray(es, np.float32), has_plane=np.asarray(has_plane),
-        planes=np.asarray(plane_arr, np.float32), points=np.asarray(pts, np.float32), point_weight=np.asarray(pw, np.float32),
+        planes=np.asarray(plane_arr, np.float32), pivots=np.asarray(pivots, np.float32), points=np.asarray(pts, np.float32), point_weight=np.asarray(pw, np.float32),
         links=np.asarray(links), link_mask=np.asarray(lmask), adjacency=np.asarray(adj),
         support_plane=np.asarray(sp, np.float32), has_support=np.asarray(support_plane is not None),
         intrinsics=np.asarray(intrinsics, np.float32))

@@ -114,9 +114,10 @@ check_program(File, Known, Target, Texts) :-
     maplist(clause_head(File), Clauses, Heads0), sort(Heads0, Defined),
     ( memberchk(Target/1, Defined) -> true ; bad(File, 'does not define ~w/1', [Target]) ),
     forall(( member(C, Clauses), C = (_ :- B), body_goal(B, G) ),
-           ( functor(G, P, A),
-             ( memberchk(P/A, Known) ; memberchk(P/A, Defined) ) -> true
-           ; bad(File, 'unknown predicate ~w/~w in a clause body', [P, A]) )),
+           ( callable(G) -> functor(G, P, A),
+             (   ( memberchk(P/A, Known) ; memberchk(P/A, Defined) ) -> true
+             ;   bad(File, 'unknown predicate ~w/~w in a clause body', [P, A]) )
+           ; bad(File, 'clause body goal ~q is not an atom', [G]) )),
     maplist(clause_text, Clauses, Texts).
 
 read_clauses(S, Cs) :-

@@ -14,6 +14,8 @@ from .boundary import mask_polygon
 from .cloud import PointGrid, point_grid
 from .objects import DepthObject, segment_objects
 from .planes import DepthPlane, object_planes, plane_adjacency
+from .snap import snap_polygons
+from .support import noise_threshold
 
 
 @dataclass(frozen=True)
@@ -55,6 +57,11 @@ def depth_scene(frame: RGBD, stride: int = 2, seed: int = 0, max_objects: int = 
         adj = plane_adjacency(planes)
         tb = time.perf_counter()
         polys = [mask_polygon(p.mask, stride, (h, w)) for p in planes]
+        if planes:
+            # sides along a neighbour or the support plane go onto the planes' intersection line
+            z = float(np.median(planes[0].points[:, 2]))
+            polys = snap_polygons(polys, [p.plane for p in planes], adj, support, frame.intrinsics,
+                                  2.5 * noise_threshold(z))
         t_boundary += time.perf_counter() - tb
         t_planes += tb - ta
         ij = np.argwhere(o.mask)

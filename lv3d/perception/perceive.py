@@ -117,7 +117,7 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
                 continue  # a patch of print or shadow on a plane that depth already has: not a face
             if a in match:
                 p = o.planes[match[a]]
-                face = Face("", f.polygon, "rgbd", plane=p.plane, points=p.points, edge_support=f.edge_support,
+                face = Face("", _pick_polygon(f.polygon, o.polygons[match[a]]), "rgbd", plane=p.plane, points=p.points, edge_support=f.edge_support,
                             plane_rms_m=p.rms_m)
                 plane_face[match[a]] = len(faces)
             else:
@@ -150,3 +150,13 @@ def _dilate(mask: np.ndarray) -> np.ndarray:
     import cv2
 
     return cv2.dilate(mask.astype(np.uint8), np.ones((3, 3), np.uint8), iterations=2).astype(bool)
+
+
+def _pick_polygon(colour: np.ndarray, depth: np.ndarray | None) -> np.ndarray:
+    import os
+    mode = os.environ.get("LV3D_PICK", "colour")
+    if depth is None or mode == "colour":
+        return colour
+    if mode == "depth":
+        return depth
+    return colour if len(colour) == len(depth) else depth

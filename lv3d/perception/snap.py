@@ -1,0 +1,151 @@
+"""Depth face polygons snapped to plane intersections.
+
+A polygon traced from a plane's grid mask sits a cell or two inside the true face, its bottom side is cut off
+with the noise band above the support plane, and its corners are rounded off into short extra sides. The
+sides a face shares with a neighbouring plane (or with the support plane) lie on the image of the two planes'
+3D intersection line, which the plane fits know far better than the mask does. So each side that runs along
+such a line is moved onto it, sides too short to be real are dropped, and the corners are recomputed as the
+crossings of consecutive side lines. A result that is not a convex polygon near the original is discarded.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..camera import Intrinsics
+from ..plane import Plane
+from .polygons import area, clockwise, is_simple
+
+_Line = tuple[np.ndarray, np.ndarray]  # (point, unit direction) in pixels
+
+
+def _meet(a: _Line, b: _Line) -> np.ndarray | None:
+    """Crossing of two image lines, None when they are nearly parallel."""
+    (p, u), (q, v) = a, b
+    cross = u[0] * v[1] - u[1] * v[0]
+    if abs(cross) < np.sin(np.radians(8.0)):
+        return None
+    d = q - p
+    s = (d[0] * v[1] - d[1] * v[0]) / cross
+    return p + s * u
+
+
+def _intersection_line(pi: Plane, pj: Plane, near: np.ndarray, k: Intrinsics) -> _Line | None:
+    """Image of the 3D line where planes ``pi`` and ``pj`` meet, around the camera-frame point ``near`` (m)."""
+    d = np.cross(pi.n, pj.n)
+    nd = np.linalg.norm(d)
+    if nd < np.sin(np.radians(10.0)):
+        return None
+    d /= nd
+    # the point of the line nearest ``near``: solve n_i.x = -o_i, n_j.x = -o_j, d.x = d.near
+    a = np.stack([pi.n, pj.n, d])
+    x0 = np.linalg.solve(a, np.array([-pi.offset, -pj.offset, float(d @ near)]))
+    ends = np.stack([x0 - 0.03 * d, x0 + 0.03 * d])
+    if np.any(ends[:, 2] <= 0.05):
+        return None
+    uv = k.project(ends)
+    u = uv[1] - uv[0]
+    n = np.linalg.norm(u)
+    if n < 1e-6:
+        return None
+    return uv[0], u / n
+
+
+def _convex(poly: np.ndarray) -> bool:
+    d = np.roll(poly, -1, axis=0) - poly
+    e = np.roll(d, -1, axis=0)
+    cross = d[:, 0] * e[:, 1] - d[:, 1] * e[:, 0]
+    return bool(np.all(cross > 0) or np.all(cross < 0))
+
+
+def snap_polygon(poly: np.ndarray, plane: Plane, others: list[Plane], k: Intrinsics, near_m: float,
+                 max_move_px: float = 14.0, short_frac: float = 0.2) -> np.ndarray:
+    """``poly`` (n, 2) pixels, the traced outline of the face on ``plane``, with its sides that run within
+    ``near_m`` metres (both ends, in 3D on ``plane``) of one of ``others`` (neighbour and support planes) moved
+    onto that intersection line, sides shorter than ``short_frac`` of the mean side dropped, and corners
+    recomputed. Returns the input when the result is not convex or moves a corner more than ``max_move_px`` plus a
+    tenth of the face's size (square root of its area, px)."""
+    n = len(poly)
+    if n < 3:
+        return poly
+    ends3d = plane.intersect_rays(k.rays(poly))  # (n, 3) metres
+    if np.any(~np.isfinite(ends3d)) or np.any(ends3d[:, 2] <= 0):
+        return poly
+    lines: list[_Line] = []
+    snapped = np.zeros(n, bool)
+    # each other plane claims at most one side (a convex face meets a plane along one edge): the longest of
+    # those whose ends lie within ``near_m`` of it on average (one end of a traced side often strays further)
+    length = np.linalg.norm(np.roll(poly, -1, axis=0) - poly, axis=1)
+    claims: dict[int, tuple[float, int]] = {}
+    for j, q in enumerate(others):
+        dist = np.abs(q.distance(ends3d))
+        side = 0.5 * (dist + np.roll(dist, -1))  # side s runs from vertex s to s+1
+        cand = np.nonzero(side <= near_m)[0]
+        if len(cand) == 0:
+            continue
+        s = int(cand[np.argmax(length[cand])])
+        if s not in claims or side[s] < claims[s][0]:
+            claims[s] = (float(side[s]), j)
+    for s in range(n):
+        a, b = poly[s], poly[(s + 1) % n]
+        line = None
+        if s in claims:
+            mid = 0.5 * (ends3d[s] + ends3d[(s + 1) % n])
+            line = _intersection_line(plane, others[claims[s][1]], mid, k)
+            if line is not None:
+                # the snapped line must run roughly along the traced side
+                u = (b - a) / max(np.linalg.norm(b - a), 1e-9)
+                if abs(u @ line[1]) < np.cos(np.radians(20.0)):
+                    line = None
+        if line is None:
+            u = b - a
+            line = (a, u / max(np.linalg.norm(u), 1e-9))
+        else:
+            snapped[s] = True
+        lines.append(line)
+    # drop unsnapped sides much shorter than the rest: rounded-off corners, not edges of the face
+    keep = [s for s in range(n) if snapped[s] or length[s] >= short_frac * length.mean()]
+    out = _corners(poly, [lines[s] for s in keep], max_move_px)
+    if out is None:
+        # a corner cut off further (a sharp apex whose tip went to the neighbour's mask): try without the
+        # short unsnapped sides next to a snapped one
+        keep = [s for s in keep if snapped[s] or length[s] >= 0.35 * length.mean()
+                or not (snapped[s - 1] or snapped[(s + 1) % n])]
+        out = _corners(poly, [lines[s] for s in keep], max_move_px)
+    return poly if out is None else clockwise(out)
+
+
+def _corners(poly: np.ndarray, lines: list[_Line], max_move_px: float) -> np.ndarray | None:
+    """The polygon whose sides lie on ``lines`` (in order), or None when it is no convex polygon whose corners
+    stay near those of ``poly``."""
+    if len(lines) < 3:
+        return None
+    out = []
+    for i in range(len(lines)):
+        p = _meet(lines[i - 1], lines[i])
+        if p is None:
+            return None
+        out.append(p)
+    out = np.array(out)
+    # each new corner is the crossing of two traced sides: it must stay near the traced outline's corners
+    d = np.linalg.norm(out[:, None, :] - poly[None, :, :], axis=2).min(axis=1)
+    if np.any(d > max_move_px + 0.1 * np.sqrt(area(poly))) or not _convex(out) or not is_simple(out) \
+            or area(out) < 0.5 * area(poly):
+        return None
+    return out
+
+
+def snap_polygons(polys: list[np.ndarray | None], planes: list[Plane], adjacency: list[tuple[int, int]],
+                  support: Plane | None, k: Intrinsics, near_m: float) -> list[np.ndarray | None]:
+    """:func:`snap_polygon` for each face of one object: its neighbours are the planes adjacent to it, and the
+    support plane."""
+    out = []
+    for i, poly in enumerate(polys):
+        if poly is None:
+            out.append(None)
+            continue
+        others = [planes[b if a == i else a] for a, b in adjacency if i in (a, b)]
+        if support is not None:
+            others.append(support)
+        out.append(snap_polygon(poly, planes[i], others, k, near_m))
+    return out

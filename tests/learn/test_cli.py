@@ -1,0 +1,42 @@
+"""The ``lv3d mil`` and ``lv3d learn`` commands."""
+
+import pytest
+
+import prolog
+from lv3d.cli import main
+
+
+def test_mil_prints_program(capsys):
+    assert main(["mil", str(prolog.source("tasks/ancestor.pl"))]) == 0
+    out = capsys.readouterr().out
+    assert "ancestor(A, B) :-\n    parent(A, C),\n    ancestor(C, B)." in out
+
+
+def test_mil_bad_file_is_one_line_and_exit_2(tmp_path, capsys):
+    f = tmp_path / "t.pl"
+    f.write_text("pos(p(a)\n")
+    assert main(["mil", str(f)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"lv3d: error: {f}: syntax error") and "\n" not in err
+
+
+def test_mil_time_limit_is_one_line_and_exit_2(tmp_path, capsys):
+    f = tmp_path / "t.pl"
+    f.write_text("body_pred(e/2).\nmetarules([ident, inverse, chain, precon, postcon]).\n"
+                 "setting(max_clauses(8)).\nsetting(max_literals(16)).\nsetting(max_inventions(4)).\n"
+                 + "".join(f"e(n{i}, n{(i * 5 + 2) % 11}).\n" for i in range(11))
+                 + "pos(t(n1, n2)).\npos(t(n3, n4)).\nneg(t(n2, n1)).\n")
+    assert main(["mil", str(f), "--time-limit", "0.3"]) == 2
+    assert "time limit of 0.3 s" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_learn_fit_then_predict_on_a_rendered_data_set(tmp_path, capsys):
+    from lv3d.render.dataset import make_dataset
+
+    data = make_dataset(tmp_path / "data", ["cube", "square_pyramid", "pentagonal_prism"], 2, "clean", 7,
+                        workers=1, width=320, height=240, progress=False)
+    assert main(["learn", "fit", "--data", str(data), "--out", str(tmp_path / "m")]) == 0
+    assert (tmp_path / "m" / "cube.pl").is_file()
+    assert main(["learn", "predict", "--data", str(data), "--model", str(tmp_path / "m")]) == 0
+    assert "accuracy 6/6" in capsys.readouterr().out

@@ -1,0 +1,60 @@
+"""Facts from hand-made ground truth (docs/dataset.md layout)."""
+
+import numpy as np
+import pytest
+
+from lv3d.errors import InputError
+from lv3d.truth_facts import truth_facts
+
+K = {"fx": 500.0, "fy": 500.0, "cx": 160.0, "cy": 120.0, "width": 320, "height": 240}
+
+
+def project(points):
+    p = np.asarray(points, float)
+    return (np.stack([K["fx"] * p[:, 0] / p[:, 2] + K["cx"], K["fy"] * p[:, 1] / p[:, 2] + K["cy"]], 1)).tolist()
+
+
+def cube_meta():
+    """A 0.1 m cube 1 m in front of the camera, seen from above-front: top and front faces."""
+    top = [[-0.05, -0.05, 0.95], [0.05, -0.05, 0.95], [0.05, -0.05, 1.05], [-0.05, -0.05, 1.05]]
+    front = [[-0.05, -0.05, 0.95], [0.05, -0.05, 0.95], [0.05, 0.05, 0.95], [-0.05, 0.05, 0.95]]
+    return {"intrinsics": K, "truth": {
+        "class": "cube", "support_plane": {"normal": [0, -1, 0], "offset": 0.05},
+        "faces": [{"id": 1, "sides": 4, "visible": True, "polygon": project(top),
+                   "plane": {"normal": [0, -1, 0], "offset": -0.05}},
+                  {"id": 2, "sides": 4, "visible": True, "polygon": project(front),
+                   "plane": {"normal": [0, 0, -1], "offset": 0.95}}],
+        "adjacency": [{"faces": [1, 2], "dihedral_deg": 90.0}]}}
+
+
+def atoms(sf):
+    return {f.atom() for f in sf.facts}
+
+
+def test_cube_faces_are_squares_meeting_at_right_angles():
+    a = atoms(truth_facts(cube_meta(), "s1", "rgbd"))
+    assert {"object(s1_o1)", "face_of(s1_o1,s1_o1_f1)", "square(s1_o1_f1)", "square(s1_o1_f2)",
+            "horizontal(s1_o1_f1)", "vertical(s1_o1_f2)", "adjacent(s1_o1_f1,s1_o1_f2)",
+            "perpendicular(s1_o1_f2,s1_o1_f1)", "quadrilateral(s1_o1_f2)"} <= a
+    assert not any(x.startswith(("acute", "obtuse", "triangle")) for x in a)
+
+
+def test_modality_keeps_only_its_predicates():
+    rgb = atoms(truth_facts(cube_meta(), "s1", "rgb"))
+    assert "quadrilateral(s1_o1_f1)" in rgb and "adjacent(s1_o1_f1,s1_o1_f2)" in rgb
+    assert not any(x.startswith(("square", "perpendicular", "horizontal")) for x in rgb)
+
+
+def test_perturb_is_seeded_and_spoils_confidences():
+    a = truth_facts(cube_meta(), "s1", "rgbd", perturb=0.6, seed=3)
+    b = truth_facts(cube_meta(), "s1", "rgbd", perturb=0.6, seed=3)
+    assert [f.to_prolog() for f in a.facts] == [f.to_prolog() for f in b.facts]
+    assert any(f.conf < 1 for f in a.facts) and all(0 < f.conf <= 1 for f in a.facts)
+    assert "object(s1_o1)" in atoms(a)
+
+
+def test_malformed_truth_is_an_input_error():
+    meta = cube_meta()
+    del meta["truth"]["faces"][0]["plane"]
+    with pytest.raises(InputError, match="ground truth is malformed"):
+        truth_facts(meta, "s1", "rgbd")
