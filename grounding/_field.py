@@ -1,4 +1,4 @@
-"""Edge fields: smooth images whose value is the distance (pixels) to the nearest image edge.
+"""Edge fields: images whose value is the signed distance (pixels) to the nearest image edge, zero on it.
 Computed with OpenCV outside jit and handed to the refinement as a plain array."""
 
 from __future__ import annotations
@@ -7,30 +7,53 @@ import cv2
 import numpy as np
 
 
-def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 60.0, blur_px: float = 0.0,
-                        cap_px: float = 30.0) -> np.ndarray:
-    """Distance (float32 pixels, (H, W)) from each pixel to the nearest Canny edge of ``image``.
+def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 60.0, cap_px: float = 30.0) -> np.ndarray:
+    """Signed distance (float32 pixels, (H, W)) from each pixel to the tangent line of its nearest image edge.
 
-    ``image``: (H, W) or (H, W, C) uint8; edges of every channel count, so faces that differ only in hue
-    are separated. The distance is capped at ``cap_px`` (nothing beyond is a plausible edge for a side)
-    and blurred with a Gaussian of ``blur_px`` so that its gradient is smooth at the edge itself.
+    Edges are Canny edges of every channel of ``image`` ((H, W) or (H, W, C) uint8), so faces that differ
+    only in hue are separated. Each edge pixel is moved to the sub-pixel peak of the gradient magnitude
+    along its gradient direction, and every pixel gets its distance to the line through that point
+    across the gradient. The sign says which side of the edge a pixel is on (towards the brighter side
+    of the edge's strongest channel is positive); an edge's zero crossing is sub-pixel accurate and the
+    field is linear across it, so bilinear sampling keeps both. Values are clipped to ``+-cap_px``.
     """
     img = np.asarray(image)
     if img.ndim == 2:
         img = img[..., None]
     if img.dtype != np.uint8:
         img = cv2.normalize(img, None, 0, 255, cv2.NORM_MINMAX).astype(np.uint8)
-    edges = np.zeros(img.shape[:2], np.uint8)
-    for c in range(img.shape[2]):
+    h, w, nc = img.shape
+    edges = np.zeros((h, w), np.uint8)
+    gx = np.zeros((h, w), np.float32)
+    gy = np.zeros((h, w), np.float32)
+    mag = np.zeros((h, w), np.float32)
+    for c in range(nc):
         ch = cv2.GaussianBlur(np.ascontiguousarray(img[..., c]), (5, 5), 1.0)
         edges |= cv2.Canny(ch, low, high, L2gradient=True)
+        cx = cv2.Sobel(ch, cv2.CV_32F, 1, 0, ksize=3)
+        cy = cv2.Sobel(ch, cv2.CV_32F, 0, 1, ksize=3)
+        cm = cx * cx + cy * cy
+        take = cm > mag
+        gx[take], gy[take], mag[take] = cx[take], cy[take], cm[take]
     if not edges.any():
-        return np.full(img.shape[:2], cap_px, np.float32)
-    dist = cv2.distanceTransform(np.where(edges > 0, 0, 255).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
-    dist = np.minimum(dist, cap_px)
-    if blur_px > 0:
-        dist = cv2.GaussianBlur(dist, (0, 0), blur_px)
-    return dist.astype(np.float32)
+        return np.full((h, w), cap_px, np.float32)
+    _, labels = cv2.distanceTransformWithLabels(np.where(edges > 0, 0, 255).astype(np.uint8), cv2.DIST_L2, 5,
+                                                labelType=cv2.DIST_LABEL_PIXEL)
+    ev, eu = np.nonzero(edges)  # raster order: label k is the k-th edge pixel
+    g = np.stack([gx[ev, eu], gy[ev, eu]], 1)
+    n = g / np.maximum(np.linalg.norm(g, axis=1, keepdims=True), 1e-6)
+    # sub-pixel peak of the gradient magnitude along the normal (parabola through three samples)
+    m = np.sqrt(mag)
+    pts = np.stack([eu, ev], 1).astype(np.float32)
+    samples = [cv2.remap(m, (pts[:, :1] + k * n[:, :1]).astype(np.float32), (pts[:, 1:] + k * n[:, 1:]).astype(np.float32),
+                         cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)[:, 0] for k in (-1.0, 0.0, 1.0)]
+    curv = samples[0] - 2 * samples[1] + samples[2]
+    offset = np.where(curv < -1e-6, 0.5 * (samples[0] - samples[2]) / np.where(curv < -1e-6, curv, -1.0), 0.0)
+    sub = pts + np.clip(offset, -0.5, 0.5)[:, None] * n
+    k = labels.ravel() - 1
+    vv, uu = np.divmod(np.arange(h * w), w)
+    signed = (uu - sub[k, 0]) * n[k, 0] + (vv - sub[k, 1]) * n[k, 1]
+    return np.clip(signed, -cap_px, cap_px).reshape(h, w).astype(np.float32)
 
 
 def normal_edge_field(depth: np.ndarray, intrinsics: tuple[float, float, float, float], *, smooth_px: float = 2.0,

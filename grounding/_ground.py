@@ -44,7 +44,7 @@ def ground_object(prob: ObjectProblem, field: Float[Array, "H W"], refine: Bool[
     verts, planes = geometry(params, prob)
     dist = edge_distances(verts, prob, field)
     m = edge_mask(prob)
-    near = jnp.sum((dist < settings.support_px) * m, axis=(1, 2)) / jnp.maximum(jnp.sum(m, axis=(1, 2)) * dist.shape[2], 1)
+    near = jnp.sum((jnp.abs(dist) < settings.support_px) * m, axis=(1, 2)) / jnp.maximum(jnp.sum(m, axis=(1, 2)) * dist.shape[2], 1)
     support = jnp.where(prob.use_edges, near, prob.edge_support_prior)
     conf = confidences(q, std, jq, cov, prob.face_vmask, prob.face_mask, prob.has_plane, prob.has_support,
                        prob.adjacency, support, floors)
@@ -70,7 +70,8 @@ def fit_plane(points: np.ndarray, plane0: np.ndarray, *, settings: Settings = Se
               image_size: tuple[int, int] = (480, 640)) -> tuple[np.ndarray, np.ndarray, int]:
     """Robust, depth-noise-weighted plane through camera-frame points ((m, 3) metres) from a first guess
     ``plane0`` = (n, d); at most ``MAX_POINTS`` of them (an even random subset) are used. Returns the
-    plane (4,), the standard deviations of its update (two normal tilts in radians, the offset in metres)
+    plane (4,), the standard deviations of its update (two normal tilts in radians, the shift along the
+    normal at the points' centre in metres)
     and the status. ``image_size`` (H, W) only picks which compiled program runs (the one of your frames)."""
     pts = np.asarray(points, np.float64)
     # a dummy triangle around the points' image position keeps the padded problem well formed

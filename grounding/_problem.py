@@ -72,7 +72,7 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
                 planes: list[np.ndarray | None] | None = None, points: list[np.ndarray | None] | None = None,
                 use_edges: list[bool] | None = None, edge_support: list[float | None] | None = None,
                 adjacency: list[tuple[int, int]] = (), support_plane: np.ndarray | None = None,
-                merge_px: float = 4.0, boundary_sigma_px: float = 2.0, free_sigma_px: float = 20.0,
+                merge_px: float = 6.0, boundary_sigma_px: float = 2.0, free_sigma_px: float = 20.0,
                 seed: int = 0) -> tuple[ObjectProblem, np.ndarray]:
     """Pad one object's faces into an :class:`ObjectProblem` (numpy, outside jit).
 

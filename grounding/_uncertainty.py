@@ -125,4 +125,4 @@ def propagate(params: Params, prob: ObjectProblem, cov: Float[Array, "K K"]):
     q_flat, unravel_q = ravel_pytree(q)
     jq = jax.jacfwd(lambda x: ravel_pytree(quantities(unravel(x), prob))[0])(flat)
     var = jnp.einsum("qk,kl,ql->q", jq, cov, jq)
-    return q, jq, unravel_q(jnp.sqrt(jnp.maximum(var, 0.0)))
+    return q, jq, unravel_q(jnp.sqrt(jnp.maximum(var, 1e-12)))  # finite gradient where a quantity is certain

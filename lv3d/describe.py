@@ -37,6 +37,8 @@ class ObjectResult:
     faces: list[FaceResult]
     dihedral_deg: dict[tuple[str, str], float]  # measured interior dihedral of each pair with planes
     status: int
+    # per padded problem: (face ids in slot order, grounding result as nested dicts of numpy arrays)
+    raw: list[tuple[list[str], dict]]
 
 
 def _simplify(poly: np.ndarray, max_sides: int) -> np.ndarray:
@@ -86,6 +88,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         face_conf: dict[str, float] = {}
         face_results: list[FaceResult] = []
         dihedrals: dict[tuple[str, str], float] = {}
+        raw: list[tuple[list[str], dict]] = []
         status = 0
         for chunk in _chunks(usable, grounding.MAX_FACES):
             if not chunk:
@@ -102,6 +105,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 support_plane=support)
             g = grounding.ground_object(prob, field_j, refine)
             g = _to_numpy(g)
+            raw.append((ids, g))
             status = max(status, int(g["status"]))
             c = g["conf"]
             for i, f in enumerate(chunk):
@@ -144,7 +148,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 cands.append(("adjacent", (a, b), p, None))
                 cands.append(("adjacent", (b, a), p, None))
         cands.append(("object", (obj.id,), max(face_conf.values(), default=0.0), None))
-        results.append(ObjectResult(obj, face_results, dihedrals, status))
+        results.append(ObjectResult(obj, face_results, dihedrals, status, raw))
     return cands, results
 
 

@@ -83,18 +83,20 @@ size(Settings, Ctx0, Ctx) :-
 %!  learn_noisy(+Task, +Settings, -Program, -Score) is semidet.
 %   Hypotheses learned from seeded random samples of the examples, each scored on all of them
 %   (mil_score:score/5); the best is kept.  Fails when no sample gives any hypothesis.
+%   Each sample's search has an equal share of the time limit; a sample that runs out gives no
+%   hypothesis (a mislabelled example can make a sample's search exhaustive), and only when every
+%   sample runs out is it an error.
 learn_noisy(Task, Settings0, Best, Score) :-
     settings(Task, Settings0, Settings),
-    option(time_limit(T), Settings),
-    timed(T, learn_noisy_(Task, Settings, Best, Score)).
-
-learn_noisy_(Task, Settings, Best, Score) :-
     task_ctx(Task, Settings, Ctx),
     Task = task(_, _, _, _, Pos, Neg),
     option(seed(Seed), Settings), set_random(seed(Seed)),
     option(samples(K), Settings), option(sample_pos(SP), Settings), option(sample_neg(SN), Settings),
     samples(K, SP, SN, Pos, Neg, Samples),
-    findall(Prog, (member(P1-N1, Samples), sample_hypothesis(Ctx, Settings, P1, N1, Prog)), Found),
+    option(time_limit(T), Settings), length(Samples, NS), TS is T / NS,
+    foldl(sample_hypotheses(Ctx, Settings, TS), Samples, r([], 0), r(Found0, TimedOut)),
+    (   TimedOut =:= NS -> throw(mil_error(time_limit(T))) ; true ),
+    append(Found0, Found),
     list_to_set(Found, Unique),                     % in the order found: it breaks ties
     option(clause_penalty(Lambda), Settings),
     findall(Key-(Prog-S), (nth1(Order, Unique, Prog),
@@ -141,6 +143,13 @@ rate(K, N, R) :- R is K / N.
 mean([], 0.0) :- !.
 mean(Xs, M) :- sum_list(Xs, S), length(Xs, N), M is S / N.
 
+sample_hypotheses(Ctx, Settings, TS, P1-N1, r(Found0, Out0), r(Found, Out)) :-
+    catch(call_with_time_limit(TS, findall(P, sample_hypothesis(Ctx, Settings, P1, N1, P), Ps)),
+          time_limit_exceeded, Ps = timeout),
+    (   Ps == timeout -> Found = Found0, Out is Out0 + 1
+    ;   append(Found0, [Ps], Found), Out = Out0
+    ).
+
 %   The smallest hypotheses consistent with one sample, at most `solutions` of them: every program
 %   of the size that proves the positives, once each, then those that prove no negative.
 sample_hypothesis(Ctx0, Settings, Pos, Neg, Prog) :-
@@ -172,10 +181,12 @@ consistent(Ctx, Neg, Prog0, Prog) :-
 prog_lits(Prog, L) :- foldl(add_lits, Prog, 0, L).
 add_lits(sub(_, _, K), L0, L) :- L is L0 + K.
 
+%   Each example's proof may extend the program; other proofs that give the same program are
+%   pruned (distinct/2), else every proof of every later example would repeat a hypothesis.
 prove_examples([], _, Prog, Prog).
 prove_examples([E|Es], Ctx, Prog1, Prog3) :-
     E =.. Atom, ctx(Ctx, depth, D),
-    prove([Atom], Ctx, D, Prog1, Prog2, 1.0, _, _, []),
+    distinct(Prog2, prove([Atom], Ctx, D, Prog1, Prog2, 1.0, _, _, [])),
     prove_examples(Es, Ctx, Prog2, Prog3).
 
 %!  covers(+Ctx, +Prog, +Example, -Conf, -Trace) is nondet.  A proof with the fixed program Prog.
@@ -188,36 +199,45 @@ covers(Ctx0, Prog, E, C, Trace) :-
 
 prove([], _, _, Prog, Prog, C, C, T, T).
 prove([Atom|Atoms], Ctx, D, Prog1, Prog3, C1, C3, T1, T3) :-
-    prove_aux(Atom, Ctx, D, Prog1, Prog2, C1, C2, T1, T2),
+    kind(Ctx, Atom, Kind),
+    prove_aux(Kind, Atom, Ctx, D, Prog1, Prog2, C1, C2, T1, T2),
     prove(Atoms, Ctx, D, Prog2, Prog3, C2, C3, T2, T3).
 
+%   What proves an atom: a body predicate's kind (fact, rule, prolog), else the program.  A bound
+%   name is looked up once; an unbound one ranges over the visible body predicates, then the program.
+kind(Ctx, [P|Args], Kind) :-
+    ctx(Ctx, bps, BPs),
+    (   atom(P)
+    ->  (   memberchk(bp(P, A, K, _), BPs) -> length(Args, A), Kind = K ; Kind = program )
+    ;   (   member(bp(P, A, Kind, visible), BPs), length(Args, A)
+        ;   Kind = program
+        )
+    ).
+
 % a background fact with a confidence: BK stores P(Args..., Conf)
-prove_aux([P|Args], Ctx, _, Prog, Prog, C1, C2, [fact(G, Cf)|T], T) :-
-    bp(Ctx, P, A, fact), length(Args, A),
+prove_aux(fact, [P|Args], Ctx, _, Prog, Prog, C1, C2, [fact(G, Cf)|T], T) :-
     ctx(Ctx, bk, BK), append(Args, [Cf], Args1), G1 =.. [P|Args1],
     call(BK:G1),
     combine(Ctx, C1, Cf, C2),
     G =.. [P|Args].
 % a derived background predicate: BK:bk_rule(Head, Body), its body proved by this interpreter
-prove_aux([P|Args], Ctx, D, Prog, Prog, C1, C2, [bk(G)|T1], T2) :-
-    bp(Ctx, P, A, rule), length(Args, A),
+prove_aux(rule, [P|Args], Ctx, D, Prog, Prog, C1, C2, [bk(G)|T1], T2) :-
     G =.. [P|Args], ctx(Ctx, bk, BK),
     call(BK:bk_rule(G, Body)),
     maplist(term_list, Body, Atoms),
     prove(Atoms, Ctx, D, Prog, _, C1, C2, T1, T2).
 % an ordinary Prolog background predicate: holds with confidence 1
-prove_aux([P|Args], Ctx, _, Prog, Prog, C, C, [call(G)|T], T) :-
-    bp(Ctx, P, A, prolog), length(Args, A),
+prove_aux(prolog, [P|Args], Ctx, _, Prog, Prog, C, C, [call(G)|T], T) :-
     G =.. [P|Args], ctx(Ctx, bk, BK),
     call(BK:G).
 % use a clause already in the program (a learned one or a meta-substitution being built)
-prove_aux(Atom, Ctx, D, Prog1, Prog2, C1, C2, [clause(I)|T1], T2) :-
+prove_aux(program, Atom, Ctx, D, Prog1, Prog2, C1, C2, [clause(I)|T1], T2) :-
     D > 0, D1 is D - 1,
     nth1(I, Prog1, Item),
     item_instance(Item, Ctx, Atom, Body),
     prove(Body, Ctx, D1, Prog1, Prog2, C1, C2, T1, T2).
 % add a clause: a metarule instance whose head symbol is a target or an invented predicate
-prove_aux(Atom, Ctx, D, Prog1, Prog2, C1, C2, [clause(new)|T1], T2) :-
+prove_aux(program, Atom, Ctx, D, Prog1, Prog2, C1, C2, [clause(new)|T1], T2) :-
     D > 0, D1 is D - 1,
     ctx(Ctx, max, Max), length(Prog1, N), N < Max,
     Atom = [P|Args], length(Args, A),
@@ -279,14 +299,6 @@ ctx(ctx(_, _, _, _, _, _, _, Inv, _, _), inventions, Inv).
 ctx(ctx(_, _, _, _, _, _, _, _, Max, _), max, Max).
 ctx(ctx(_, _, _, _, _, _, _, _, _, L), lits, L).
 ctx_size(ctx(A, B, C, E, F, G, H, I, _, _), Max, L, ctx(A, B, C, E, F, G, H, I, Max, L)).
-
-%   The kind of a body predicate; a bound name is looked up without leaving a choice point,
-%   an unbound one ranges over the visible body predicates.
-bp(Ctx, P, A, Kind) :-
-    ctx(Ctx, bps, BPs),
-    (   atom(P) -> memberchk(bp(P, A0, K0, _), BPs), A = A0, Kind = K0
-    ;   member(bp(P, A, Kind, visible), BPs)
-    ).
 
 %   Each body predicate is a fact with a confidence (BK defines P/(A+1)), a derived rule
 %   (BK:bk_rule/2 has a head P/A) or plain Prolog (BK defines P/A, confidence 1).  The predicates

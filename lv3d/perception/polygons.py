@@ -11,7 +11,8 @@ def signed_area(poly: np.ndarray) -> float:
     """Shoelace area in pixels^2; positive when the vertices run clockwise in the image (v down)."""
     p = np.asarray(poly, dtype=np.float64)
     x, y = p[:, 0], p[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+    # shoelace with the closing term written out: np.roll is slow on these tiny arrays
+    return 0.5 * float(np.dot(x[:-1], y[1:]) - np.dot(x[1:], y[:-1]) + x[-1] * y[0] - x[0] * y[-1])
 
 
 def area(poly: np.ndarray) -> float:
@@ -104,3 +105,30 @@ def sample_boundary(poly: np.ndarray, step: float = 1.0) -> np.ndarray:
         t = np.arange(k)[:, None] / k
         out.append(a + t * (b - a))
     return np.concatenate(out, axis=0)
+
+
+def drop_short_sides(poly: np.ndarray, rel_len: float = 0.15, reach: float = 1.5) -> np.ndarray:
+    """Remove sides shorter than ``rel_len`` of the mean side by extending their neighbours to where they
+    cross, if that point lies within ``reach`` times the side's length (+2 px) of it: a junction of three
+    edges is often traced as two corners a few pixels apart, and no face of the solids has such a side."""
+    p = np.asarray(poly, dtype=np.float64)
+    while len(p) > 3:
+        d = np.roll(p, -1, axis=0) - p
+        length = np.hypot(d[:, 0], d[:, 1])
+        s = int(np.argmin(length))
+        if length[s] >= rel_len * length.mean():
+            break
+        n = len(p)
+        a0, a1 = p[s - 1], p[s]                 # side before: (s-1) -> s
+        b0, b1 = p[(s + 1) % n], p[(s + 2) % n]  # side after: (s+1) -> (s+2)
+        u, v = a1 - a0, b1 - b0
+        cross = u[0] * v[1] - u[1] * v[0]
+        if abs(cross) < 1e-9 * max(1.0, np.hypot(*u) * np.hypot(*v)):
+            break
+        w = b0 - a0
+        x = a0 + (w[0] * v[1] - w[1] * v[0]) / cross * u
+        if np.hypot(*(x - 0.5 * (p[s] + p[(s + 1) % n]))) > reach * length[s] + 2.0:
+            break
+        p = np.delete(p, (s + 1) % n, axis=0)
+        p[s if (s + 1) % n != 0 or s == 0 else s - 1] = x
+    return p

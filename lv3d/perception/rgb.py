@@ -10,8 +10,9 @@ import numpy as np
 
 from .edges import channels, edge_distance, edge_map, edge_support
 from .faces import bounded_faces, build_graph
-from .polygons import area, clockwise, is_simple, simplify
+from .polygons import area, clockwise, drop_short_sides, is_simple, simplify
 from .segments import detect_color_segments, union_find_labels
+from .split import gradient_magnitude, split_by_diagonal, split_concave
 
 
 @dataclass(frozen=True)
@@ -62,6 +63,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     chans = channels(crop)
     edges = np.maximum.reduce([edge_map(c) for c in chans])
     dist = edge_distance(edges)
+    grad = gradient_magnitude(chans)
     t1 = time.perf_counter()
     segs = detect_color_segments(chans)
     t2 = time.perf_counter()
@@ -73,7 +75,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         a = area(f.polygon)
         if a < min_area_px or a > max_area_frac * w * h:
             continue
-        poly = clockwise(simplify(f.polygon))
+        poly = clockwise(drop_short_sides(simplify(f.polygon)))
         if len(poly) < 3 or not is_simple(poly) or area(poly) < min_area_px:
             continue
         if _touches_frame(poly, frame) > 0.5:
@@ -81,7 +83,20 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         sup = edge_support(poly, dist)
         if sup < min_support:
             continue
-        cands.append((poly, f.edges, sup, area(poly)))
+        pieces = split_concave(poly, grad, min_area_px)
+        if len(pieces) == 1:
+            pieces = split_by_diagonal(poly, grad, min_area_px)
+        if len(pieces) == 1:
+            cands.append((poly, f.edges, sup, area(poly)))
+            continue
+        # the cut is an edge the graph lacks: a shared made-up edge key makes the parts neighbours
+        cut = (-1 - len(cands), -1 - len(cands))
+        for q in pieces:
+            q = clockwise(drop_short_sides(simplify(q)))
+            qc = q.astype(np.float32).reshape(-1, 1, 2)
+            own = frozenset(e for e in f.edges if cv2.pointPolygonTest(
+                qc, tuple(float(x) for x in 0.5 * (g.vertices[e[0]] + g.vertices[e[1]])), True) >= -2.0)
+            cands.append((q, own | {cut}, edge_support(q, dist), area(q)))
     # a face that contains another kept face is a region around it (table, wall), not an object face
     keep = [not any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
                     for j in range(len(cands))) for i in range(len(cands))]

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..camera import Intrinsics
 from ..plane import Plane
-from .polygons import area, clockwise, is_simple
+from .polygons import area, clockwise
 
 _Line = tuple[np.ndarray, np.ndarray]  # (point, unit direction) in pixels
 
@@ -31,31 +31,39 @@ def _meet(a: _Line, b: _Line) -> np.ndarray | None:
 
 
 def _intersection_line(pi: Plane, pj: Plane, near: np.ndarray, k: Intrinsics) -> _Line | None:
-    """Image of the 3D line where planes ``pi`` and ``pj`` meet, around the camera-frame point ``near`` (m)."""
-    d = np.cross(pi.n, pj.n)
-    nd = np.linalg.norm(d)
+    """Image of the 3D line where planes ``pi`` and ``pj`` meet, around the camera-frame point ``near`` (m).
+    Written with 3-vectors in plain numpy (no solve/project calls): it runs for every side of every face."""
+    ni, nj = pi.n, pj.n
+    d = np.cross(ni, nj)
+    nd = float(np.sqrt(d @ d))
     if nd < np.sin(np.radians(10.0)):
         return None
-    d /= nd
-    # the point of the line nearest ``near``: solve n_i.x = -o_i, n_j.x = -o_j, d.x = d.near
-    a = np.stack([pi.n, pj.n, d])
-    x0 = np.linalg.solve(a, np.array([-pi.offset, -pj.offset, float(d @ near)]))
-    ends = np.stack([x0 - 0.03 * d, x0 + 0.03 * d])
-    if np.any(ends[:, 2] <= 0.05):
+    d = d / nd
+    # the point of the line nearest ``near``: n_i.x = -o_i, n_j.x = -o_j, d.x = d.near, by Cramer's rule
+    # with rows (n_i, n_j, d), whose determinant is d . (n_i x n_j) = nd
+    rhs = (-pi.offset, -pj.offset, float(d @ near))
+    x0 = (rhs[0] * np.cross(nj, d) + rhs[1] * np.cross(d, ni) + rhs[2] * np.cross(ni, nj)) / nd
+    a, b = x0 - 0.03 * d, x0 + 0.03 * d
+    if a[2] <= 0.05 or b[2] <= 0.05:
         return None
-    uv = k.project(ends)
-    u = uv[1] - uv[0]
-    n = np.linalg.norm(u)
+    ua = np.array([k.fx * a[0] / a[2] + k.cx, k.fy * a[1] / a[2] + k.cy])
+    ub = np.array([k.fx * b[0] / b[2] + k.cx, k.fy * b[1] / b[2] + k.cy])
+    u = ub - ua
+    n = float(np.hypot(u[0], u[1]))
     if n < 1e-6:
         return None
-    return uv[0], u / n
+    return ua, u / n
 
 
 def _convex(poly: np.ndarray) -> bool:
-    d = np.roll(poly, -1, axis=0) - poly
-    e = np.roll(d, -1, axis=0)
+    """Every turn the same way and one full turn in all: convex and simple."""
+    d = np.diff(np.vstack([poly, poly[:1]]), axis=0)
+    e = np.vstack([d[1:], d[:1]])
     cross = d[:, 0] * e[:, 1] - d[:, 1] * e[:, 0]
-    return bool(np.all(cross > 0) or np.all(cross < 0))
+    if not (np.all(cross > 0) or np.all(cross < 0)):
+        return False
+    turn = np.arctan2(cross, (d * e).sum(axis=1))
+    return bool(abs(abs(turn.sum()) - 2 * np.pi) < 1e-3)
 
 
 def snap_polygon(poly: np.ndarray, plane: Plane, others: list[Plane], k: Intrinsics, near_m: float,
@@ -75,11 +83,11 @@ def snap_polygon(poly: np.ndarray, plane: Plane, others: list[Plane], k: Intrins
     snapped = np.zeros(n, bool)
     # each other plane claims at most one side (a convex face meets a plane along one edge): the longest of
     # those whose ends lie within ``near_m`` of it on average (one end of a traced side often strays further)
-    length = np.linalg.norm(np.roll(poly, -1, axis=0) - poly, axis=1)
+    length = np.linalg.norm(np.vstack([poly[1:], poly[:1]]) - poly, axis=1)
     claims: dict[int, tuple[float, int]] = {}
     for j, q in enumerate(others):
         dist = np.abs(q.distance(ends3d))
-        side = 0.5 * (dist + np.roll(dist, -1))  # side s runs from vertex s to s+1
+        side = 0.5 * (dist + np.append(dist[1:], dist[0]))  # side s runs from vertex s to s+1
         cand = np.nonzero(side <= near_m)[0]
         if len(cand) == 0:
             continue
@@ -129,8 +137,7 @@ def _corners(poly: np.ndarray, lines: list[_Line], max_move_px: float) -> np.nda
     out = np.array(out)
     # each new corner is the crossing of two traced sides: it must stay near the traced outline's corners
     d = np.linalg.norm(out[:, None, :] - poly[None, :, :], axis=2).min(axis=1)
-    if np.any(d > max_move_px + 0.1 * np.sqrt(area(poly))) or not _convex(out) or not is_simple(out) \
-            or area(out) < 0.5 * area(poly):
+    if np.any(d > max_move_px + 0.1 * np.sqrt(area(poly))) or not _convex(out) or area(out) < 0.5 * area(poly):
         return None
     return out
 

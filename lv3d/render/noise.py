@@ -78,12 +78,13 @@ def as_config(noise: str | NoiseConfig) -> NoiseConfig:
     raise InputError("noise", f"expected a preset name or NoiseConfig, got {type(noise).__name__}")
 
 
-def gaussian(shape: tuple[int, ...], rng: np.random.Generator) -> np.ndarray:
-    """Standard normal float32 samples of ``shape``, seeded from ``rng``. OpenCV's generator (per thread,
-    reseeded here on every call, so still reproducible) is several times faster than numpy's."""
+def gaussian(shape: tuple[int, ...], rng: np.random.Generator, sigma: float = 1.0) -> np.ndarray:
+    """Normal float32 samples of ``shape`` with mean 0 and standard deviation ``sigma``, seeded from
+    ``rng``. OpenCV's generator (per thread, reseeded here on every call, so still reproducible) is
+    several times faster than numpy's."""
     cv2.setRNGSeed(int(rng.integers(1, 2**31 - 1)))
     out = np.empty((int(np.prod(shape)), 1), np.float32)  # one channel: a scalar std applies to channel 0 only
-    cv2.randn(out, 0.0, 1.0)
+    cv2.randn(out, 0.0, float(sigma))
     return out.reshape(shape)
 
 
@@ -94,18 +95,23 @@ def noisy_depth(depth: np.ndarray, cos_incidence: np.ndarray | None, cfg: NoiseC
     (needed only when ``cfg.grazing_deg`` < 90)."""
     h, w = depth.shape
     f32 = np.float32  # float32 throughout: half the memory traffic of float64, and metres need no more
-    z = depth.astype(np.float32)
+    z = depth.astype(np.float32)  # a copy: changed in place below
     valid = z > 0
     if cfg.flying_pixels > 0:
         # pixels on depth discontinuities take a mix of fore- and background, as stereo matching does
-        zf = np.where(valid, z, f32(0))
-        hi = cv2.dilate(zf, np.ones((3, 3), np.uint8))
-        lo = cv2.erode(np.where(valid, zf, np.float32(1e3)), np.ones((3, 3), np.uint8))
-        edge = valid & (hi - lo > 0.03) & (lo < 1e3) & (rng.random((h, w), dtype=np.float32) < cfg.flying_pixels)
-        mix = rng.random((h, w), dtype=np.float32)
-        z = np.where(edge, lo + mix * (hi - lo), z)
+        hi = cv2.dilate(z, np.ones((3, 3), np.uint8))  # z is 0 where invalid
+        lo = cv2.erode(np.where(valid, z, f32(1e3)), np.ones((3, 3), np.uint8))
+        cand = np.flatnonzero(valid & (hi - lo > 0.03) & (lo < 1e3))
+        # random numbers only for the few edge pixels, not the whole frame
+        cand = cand[rng.random(len(cand), dtype=np.float32) < cfg.flying_pixels]
+        lo_c, hi_c = lo.ravel()[cand], hi.ravel()[cand]
+        z.ravel()[cand] = lo_c + rng.random(len(cand), dtype=np.float32) * (hi_c - lo_c)
     if cfg.depth_sigma_base_m > 0 or cfg.depth_sigma_k > 0:
-        z = z + gaussian((h, w), rng) * (f32(cfg.depth_sigma_base_m) + f32(cfg.depth_sigma_k) * z * z)
+        sigma = z * z
+        sigma *= f32(cfg.depth_sigma_k)
+        sigma += f32(cfg.depth_sigma_base_m)
+        sigma *= gaussian((h, w), rng)
+        z += sigma
     if cfg.grazing_deg < 90.0 and cos_incidence is not None:
         valid &= cos_incidence > np.cos(np.radians(cfg.grazing_deg))
     if cfg.hole_blobs > 0:
@@ -116,23 +122,29 @@ def noisy_depth(depth: np.ndarray, cos_incidence: np.ndarray | None, cfg: NoiseC
             ax = tuple(max(1, int(cfg.hole_radius_px * scale * rng.uniform(0.4, 1.8))) for _ in range(2))
             cv2.ellipse(holes, c, ax, float(rng.uniform(0, 180)), 0, 360, 1, -1)
         valid &= holes == 0
-    z = np.where(valid & (z > 0), np.round(z * f32(1000)) / f32(1000), f32(0))
-    return np.clip(z, f32(0), f32(65.535))
+    valid &= z > 0
+    z *= f32(1000)
+    np.round(z, out=z)
+    z /= f32(1000)
+    z[~valid] = 0
+    return np.clip(z, f32(0), f32(65.535), out=z)
 
 
 def noisy_color(color: np.ndarray, cfg: NoiseConfig, rng: np.random.Generator) -> np.ndarray:
     """Apply colour nuisances (exposure, blur, sensor noise, JPEG) to an (H, W, 3) float image in 0..255;
     returns uint8 RGB."""
-    img = color.astype(np.float32)
+    img = color.astype(np.float32, copy=False)
     if cfg.exposure > 0:
         img = img * np.float32(np.exp(rng.normal(0.0, cfg.exposure)))
     if cfg.blur_px > 0:
         s = cfg.blur_px * img.shape[1] / 640.0
-        img = cv2.GaussianBlur(img, (0, 0), s)
-    if cfg.color_sigma > 0:
-        img = img + gaussian(img.shape, rng) * np.float32(cfg.color_sigma)
-    out = np.clip(np.round(img), 0, 255).astype(np.uint8)
+        r = max(1, int(np.ceil(2.5 * s)))  # OpenCV's default kernel reaches 4 sigma: weights there are < 1e-3
+        img = cv2.GaussianBlur(img, (2 * r + 1, 2 * r + 1), s)
+    # one pass: add the noise, round to nearest (ties to even, as np.round) and saturate to 0..255
+    noise = gaussian(img.shape, rng, cfg.color_sigma) if cfg.color_sigma > 0 else np.zeros_like(img)
+    out = cv2.add(img, noise, dtype=cv2.CV_8U)
     if cfg.jpeg_quality > 0:
-        ok, buf = cv2.imencode(".jpg", out[:, :, ::-1], [cv2.IMWRITE_JPEG_QUALITY, int(cfg.jpeg_quality)])
-        out = cv2.imdecode(buf, cv2.IMREAD_COLOR)[:, :, ::-1].copy()
+        ok, buf = cv2.imencode(".jpg", cv2.cvtColor(out, cv2.COLOR_RGB2BGR),
+                               [cv2.IMWRITE_JPEG_QUALITY, int(cfg.jpeg_quality)])
+        out = cv2.cvtColor(cv2.imdecode(buf, cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)
     return out

@@ -7,7 +7,7 @@ Rays leave the camera centre with direction ((u - cx)/fx, (v - cy)/fy, 1), so th
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import cv2
 import numpy as np
@@ -25,12 +25,24 @@ class Body:
     to_camera: np.ndarray
 
     def vertices(self) -> np.ndarray:
-        """Camera-frame vertices (n, 3), metres."""
-        return self.solid.vertices @ self.to_camera[:3, :3].T + self.to_camera[:3, 3]
+        """Camera-frame vertices (n, 3), metres (read-only, computed once)."""
+        return self._vertices
 
     def normals(self) -> np.ndarray:
-        """Camera-frame outward face normals (f, 3)."""
-        return self.solid.normals() @ self.to_camera[:3, :3].T
+        """Camera-frame outward face normals (f, 3) (read-only, computed once)."""
+        return self._normals
+
+    @cached_property
+    def _vertices(self) -> np.ndarray:
+        v = self.solid.vertices @ self.to_camera[:3, :3].T + self.to_camera[:3, 3]
+        v.setflags(write=False)
+        return v
+
+    @cached_property
+    def _normals(self) -> np.ndarray:
+        n = self.solid.normals() @ self.to_camera[:3, :3].T
+        n.setflags(write=False)
+        return n
 
 
 @dataclass(frozen=True)
@@ -115,7 +127,7 @@ def build_scene(bodies: list[Body]) -> tuple[o3d.t.geometry.RaycastingScene, np.
 def raycast(bodies: list[Body], k: Intrinsics, light_cam: np.ndarray | None = None, nthreads: int = 1,
             background: int = 0) -> Hits:
     """What each pixel sees of ``bodies`` (camera frame); with ``light_cam`` (unit vector towards a
-    directional light, camera frame) also which points lie in shadow.
+    directional light, camera frame) also which points lie in shadow (:mod:`lv3d.render.shadows`).
 
     The solids are ray cast with Embree (open3d), over the image window they can cover. The first
     ``background`` bodies are big flat surfaces (table slab, floor, wall) that would cost most of the
@@ -123,8 +135,10 @@ def raycast(bodies: list[Body], k: Intrinsics, light_cam: np.ndarray | None = No
     OpenCV and z-buffered with the exact depth of its plane at every pixel centre.
     """
     face_base = np.cumsum([0] + [len(b.solid.faces) for b in bodies])
-    face_body = np.repeat(np.arange(len(bodies)), np.diff(face_base))
-    face_id = np.concatenate([np.arange(len(b.solid.faces)) for b in bodies])
+    # per flat face: its body and its id within the body; a last entry -1 answers gface = -1 (nothing hit)
+    face_body = np.append(np.repeat(np.arange(len(bodies), dtype=np.int32), np.diff(face_base)), np.int32(-1))
+    face_id = np.append(np.concatenate([np.arange(len(b.solid.faces), dtype=np.int32) for b in bodies]),
+                        np.int32(-1))
     normals = np.concatenate([b.normals() for b in bodies])
     offsets_f = np.concatenate([-np.einsum("fc,fc->f", b.normals(), b.vertices()[[f[0] for f in b.solid.faces]])
                                 for b in bodies])
@@ -133,39 +147,50 @@ def raycast(bodies: list[Body], k: Intrinsics, light_cam: np.ndarray | None = No
     solids = bodies[background:]
     if solids:
         scene, offsets, tri_body, tri_face = build_scene(solids)
-        (v0, v1), (u0, u1) = _window(solids, k)
-        if v1 > v0 and u1 > u0:
-            out = scene.cast_rays(o3d.core.Tensor(np.ascontiguousarray(rays_from_origin(k)[v0:v1, u0:u1])),
-                                  nthreads=nthreads)
+        idx = _silhouette_pixels(solids, k)
+        if len(idx):
+            out = scene.cast_rays(o3d.core.Tensor(rays_from_origin(k).reshape(-1, 6)[idx]), nthreads=nthreads)
             t = out["t_hit"].numpy()
-            hit = t < depth[v0:v1, u0:u1]  # inf where nothing was hit: never nearer
-            tri = offsets[np.where(hit, out["geometry_ids"].numpy(), 0)] + np.where(hit, out["primitive_ids"].numpy(), 0)
-            g = face_base[background + tri_body[tri]] + tri_face[tri]
-            depth[v0:v1, u0:u1] = np.where(hit, t, depth[v0:v1, u0:u1])
-            gface[v0:v1, u0:u1] = np.where(hit, g, gface[v0:v1, u0:u1])
-    hit = gface >= 0
-    depth = np.where(hit, depth, np.float32(0))
-    body = np.where(hit, face_body[gface], -1)
-    face = np.where(hit, face_id[gface], -1)
-    shadow = np.zeros(depth.shape, np.float32)
+            hit = t < depth.ravel()[idx]  # inf where nothing was hit: never nearer
+            idx, t = idx[hit], t[hit]
+            tri = offsets[out["geometry_ids"].numpy()[hit]] + out["primitive_ids"].numpy()[hit]
+            depth.ravel()[idx] = t
+            gface.ravel()[idx] = face_base[background + tri_body[tri]] + tri_face[tri]
+    depth[gface < 0] = 0  # inf where nothing was hit
+    body = np.take(face_body, gface)
+    face = np.take(face_id, gface)
     if light_cam is not None:
-        shadow = _shadow_fraction(build_scene(bodies)[0], k, depth, light_cam, nthreads)
+        from .shadows import soft_shadow  # builds on this module's Body
+
+        shadow = soft_shadow(bodies, gface, normals, offsets_f, face_body[:-1], k, np.asarray(light_cam, float))
+    else:
+        shadow = np.zeros(depth.shape, np.float32)
     return Hits(depth, body, face, gface, normals, offsets_f, shadow, pixel_rays(k))
 
 
-def _window(bodies: list[Body], k: Intrinsics) -> tuple[tuple[int, int], tuple[int, int]]:
-    """Rows and columns (half-open) of the image that the bodies' projections can cover."""
-    v = np.concatenate([b.vertices() for b in bodies])
-    if np.any(v[:, 2] < 1e-3):  # something reaches behind the camera: cast everywhere
-        return (0, k.height), (0, k.width)
-    uv = k.project(v)
-    u0, v0 = np.floor(uv.min(axis=0)).astype(int) - 1
-    u1, v1 = np.ceil(uv.max(axis=0)).astype(int) + 2
-    return (max(v0, 0), min(v1, k.height)), (max(u0, 0), min(u1, k.width))
+def _silhouette_pixels(bodies: list[Body], k: Intrinsics) -> np.ndarray:
+    """Flat indices (int64, ascending) of the pixels whose rays can meet ``bodies``: the silhouette of a
+    convex solid in front of the camera is the convex hull of its projected vertices, filled here and
+    grown by a pixel or so (rays are cast only there: a fraction of the image)."""
+    mask = np.zeros((k.height, k.width), np.uint8)
+    for b in bodies:
+        v = b.vertices()
+        if np.any(v[:, 2] < 1e-3):  # it reaches behind the camera: cast everywhere
+            mask[:] = 1
+            break
+        uv = k.project(v)
+        if np.all(uv.max(axis=0) < -2) or np.all(uv.min(axis=0) > [k.width + 1, k.height + 1]):
+            continue
+        hull = cv2.convexHull(np.round(np.clip(uv, -1e5, 1e5) * 16).astype(np.int32))
+        cv2.fillConvexPoly(mask, hull, 1, cv2.LINE_8, shift=4)
+        cv2.polylines(mask, [hull], True, 1, 3, cv2.LINE_8, shift=4)  # pixel centres right on the outline
+    return np.flatnonzero(mask)
 
 
 def clip_near(poly: np.ndarray, z_near: float) -> np.ndarray:
     """The part of the planar polygon (n, 3) with z >= ``z_near`` (Sutherland-Hodgman against one plane)."""
+    if poly[:, 2].min() >= z_near:  # the usual case: all in front
+        return poly
     out = []
     for a, b in zip(poly, np.roll(poly, -1, axis=0)):
         ina, inb = a[2] >= z_near, b[2] >= z_near
@@ -179,9 +204,9 @@ def clip_near(poly: np.ndarray, z_near: float) -> np.ndarray:
 def _fill_background(bodies: list[Body], normals: np.ndarray, offsets_f: np.ndarray,
                      k: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
     """Z-buffer of the flat faces of ``bodies`` (the first bodies of the flat face tables): depth (H, W)
-    float32 (inf where none) and flat face index (H, W) int64 (-1 where none)."""
+    float32 (inf where none) and flat face index (H, W) int32 (-1 where none)."""
     depth = np.full((k.height, k.width), np.inf, np.float32)
-    gface = np.full((k.height, k.width), -1, np.int64)
+    gface = np.full((k.height, k.width), -1, np.int32)
     rays = pixel_rays(k)
     rx, ry = rays[0, :, 0], rays[:, 0, 1]
     g = 0
@@ -204,26 +229,14 @@ def _fill_background(bodies: list[Body], normals: np.ndarray, offsets_f: np.ndar
             pts = np.round((np.clip(uv, -1e6, 1e6) - lo) * 16).astype(np.int32)
             cv2.fillPoly(mask, [pts], 1, cv2.LINE_8, shift=4)
             # depth of the plane n . X + d = 0 along the ray (rx, ry, 1): z = -d / (n . ray)
-            ndr = (np.float32(n[0]) * rx[lo[0]:hi[0]])[None, :] + (np.float32(n[1]) * ry[lo[1]:hi[1]])[:, None] \
-                + np.float32(n[2])
-            z = np.float32(-d) / np.minimum(ndr, np.float32(-1e-9))
+            # (in place: these windows are often the whole image)
+            z = (np.float32(n[0]) * rx[lo[0]:hi[0]] + np.float32(n[2]))[None, :] \
+                + (np.float32(n[1]) * ry[lo[1]:hi[1]])[:, None]
+            np.minimum(z, np.float32(-1e-9), out=z)
+            np.divide(np.float32(-d), z, out=z)
             win = (slice(lo[1], hi[1]), slice(lo[0], hi[0]))
-            closer = (mask > 0) & (z < depth[win])
-            depth[win][closer] = z[closer]
-            gface[win][closer] = g - 1
+            closer = np.less(z, depth[win])
+            closer &= mask.view(bool)
+            np.copyto(depth[win], z, where=closer)
+            np.copyto(gface[win], np.int32(g - 1), where=closer)
     return depth, gface
-
-
-def _shadow_fraction(scene, k: Intrinsics, depth: np.ndarray, light_cam: np.ndarray, nthreads: int) -> np.ndarray:
-    """(H, W) float32 in 0..1: how much of the directional light each hit point misses. Shadow rays go
-    from every second pixel in each direction and are upsampled bilinearly: a quarter of the rays,
-    and soft shadow edges like a real penumbra. Rays start on the surface and skip the first
-    millimetre (``tnear``), so a convex face never shadows itself."""
-    sub = (slice(None, None, 2), slice(None, None, 2))
-    d = depth[sub]
-    rays = np.empty(d.shape + (6,), np.float32)
-    np.multiply(pixel_rays(k)[sub], d[..., None], out=rays[..., :3])
-    rays[..., 3:] = light_cam.astype(np.float32)
-    occ = scene.test_occlusions(o3d.core.Tensor(rays), tnear=1e-3, tfar=20.0, nthreads=nthreads).numpy()
-    occ = np.where(d > 0, occ, 0).astype(np.float32)
-    return cv2.resize(occ, (k.width, k.height), interpolation=cv2.INTER_LINEAR)

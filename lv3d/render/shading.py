@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import colorsys
 
+import cv2
 import numpy as np
 
 from .noise import NoiseConfig
@@ -44,22 +45,69 @@ def _wavy(x: np.ndarray, y: np.ndarray, rng: np.random.Generator, n: int, wavele
     return out * np.float32(1 / np.sqrt(n))
 
 
-def wood_grain(xt: np.ndarray, yt: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Wood grain in 0..1 at table coordinates (metres): stripes along x, warped along y."""
+def wood_warp(xt: np.ndarray, yt: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """The slow wobble (metres) of the wood grain's stripes at table coordinates (metres)."""
     f32 = np.float32
-    warp = f32(0.012) * _wavy(xt * f32(0.2), yt, rng, 3, (0.1, 0.4)) + f32(0.004) * _wavy(xt, yt, rng, 2, (0.03, 0.08))
+    return f32(0.012) * _wavy(xt * f32(0.2), yt, rng, 3, (0.1, 0.4)) + f32(0.004) * _wavy(xt, yt, rng, 2, (0.03, 0.08))
+
+
+def wood_grain(yt: np.ndarray, warp: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Wood grain in 0..1: stripes along the table's x at table coordinate ``yt`` (metres), shifted by
+    ``warp`` (metres, from :func:`wood_warp`)."""
+    f32 = np.float32
     period = rng.uniform(0.008, 0.025)
-    g = f32(0.5) + f32(0.5) * np.sin(f32(2 * np.pi / period) * (yt + warp))
-    return g ** 3 * f32(0.7) + f32(0.15) + f32(0.15) * np.sin(f32(2 * np.pi / (period * 0.37)) * (yt + f32(0.7) * warp))
+    g = np.sin(f32(2 * np.pi / period) * (yt + warp))
+    g = f32(0.5) + f32(0.5) * g
+    out = g * g
+    out *= g
+    out *= f32(0.7)
+    out += f32(0.15) + f32(0.15) * np.sin(f32(2 * np.pi / (period * 0.37)) * (yt + f32(0.7) * warp))
+    return out
 
 
-def _coords(hits: Hits, idx: np.ndarray, cam_to_frame: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Coordinates (x, y, z), each (m,) float32 metres, in some frame of the hit points at flat pixel
-    indices ``idx``; ``cam_to_frame`` (4, 4) maps camera-frame points into that frame."""
+def _coords(hits: Hits, idx: np.ndarray, cam_to_frame: np.ndarray, n: int = 3) -> tuple[np.ndarray, ...]:
+    """The first ``n`` coordinates (x, y, z), each (m,) float32 metres, in some frame of the hit points at
+    flat pixel indices ``idx``; ``cam_to_frame`` (4, 4) maps camera-frame points into that frame."""
     z = hits.depth.ravel()[idx]
     rx, ry = (c.ravel()[idx] for c in ray_planes(hits.depth.shape, hits.rays))
     a = cam_to_frame.astype(np.float32)
-    return tuple(z * (a[i, 0] * rx + a[i, 1] * ry + a[i, 2]) + a[i, 3] for i in range(3))
+    return tuple(z * (a[i, 0] * rx + a[i, 1] * ry + a[i, 2]) + a[i, 3] for i in range(n))
+
+
+class _HalfRes:
+    """Hit points on every second pixel in each direction, for the slowly varying textures: they are
+    computed on a quarter of the pixels and upsampled bilinearly (their wavelengths span many pixels)."""
+
+    def __init__(self, hits: Hits):
+        self.shape = hits.depth.shape
+        self.z = hits.depth[::2, ::2]
+        self.rx, self.ry = (np.ascontiguousarray(c[::2, ::2]) for c in ray_planes(self.shape, hits.rays))
+
+    def coords(self, cam_to_frame: np.ndarray) -> tuple[np.ndarray, ...]:
+        """(x, y, z), each (H/2, W/2) float32 metres, in the frame ``cam_to_frame`` (4, 4) maps into."""
+        a = cam_to_frame.astype(np.float32)
+        return tuple(self.z * (a[i, 0] * self.rx + a[i, 1] * self.ry + a[i, 2]) + a[i, 3] for i in range(3))
+
+    def up(self, field: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        """The half-resolution ``field`` upsampled to full resolution, at flat pixel indices ``idx``."""
+        h, w = self.shape
+        return cv2.resize(field, (w, h), interpolation=cv2.INTER_LINEAR).ravel()[idx]
+
+
+def _table(hits: Hits, half: _HalfRes, idx: np.ndarray, cam_to_table: np.ndarray, cfg: NoiseConfig,
+           rng: np.random.Generator) -> np.ndarray:
+    """Texture factor (m,) of the table at flat pixel indices ``idx``: wood grain and painted lines."""
+    f32 = np.float32
+    xh, yh, _ = half.coords(cam_to_table)
+    warp = half.up(wood_warp(xh, yh, rng), idx)
+    xt, yt = _coords(hits, idx, cam_to_table, 2)
+    m = f32(1.0) - f32(cfg.table_grain) * wood_grain(yt, warp, rng)
+    for _ in range(cfg.distractor_lines):
+        ang = rng.uniform(0, np.pi)
+        dist = np.abs(f32(np.cos(ang)) * xt + f32(np.sin(ang)) * yt - f32(rng.uniform(-0.25, 0.25)))
+        paint = f32(rng.choice([0.15, 1.9]))  # dark or light paint, relative to the wood
+        m = np.where(dist < f32(rng.uniform(0.002, 0.006)), paint, m)
+    return m
 
 
 def shade(hits: Hits, layout: Layout, roles: list[str], albedo: list[np.ndarray], light_cam: np.ndarray,
@@ -68,47 +116,43 @@ def shade(hits: Hits, layout: Layout, roles: list[str], albedo: list[np.ndarray]
     role; ``albedo``: per body (faces, 3) albedo in 0..1. Albedo and Lambert term are per face (flat
     faces, directional light), looked up through ``hits.gface``; textures scale them per pixel."""
     f32 = np.float32
-    alb_lut = np.concatenate(albedo + [np.full((1, 3), 0.16)])  # last row: nothing hit
-    lambert = np.append(np.clip(hits.face_normal @ light_cam, 0.0, None), 0.0)
     ambient = rng.uniform(0.28, 0.42)
-    diffuse = 255 * (1.0 - ambient) * 1.1 * lambert
-    # colour = albedo * (ambient + diffuse * (1 - shadow)) * texture = (lit - shade * shadow) * texture,
-    # with per-face tables lit and shade
-    lit_lut = (alb_lut * (255 * ambient + diffuse)[:, None]).astype(np.float32)
-    lit_lut[-1] = 0.16 * 255
-    gface = np.where(hits.gface >= 0, hits.gface, len(alb_lut) - 1)
-    colour = np.take(lit_lut, gface, axis=0)
+    # colour = albedo (per face, RGB) * intensity (per pixel, grey), with intensity =
+    # (255 ambient + diffuse * (1 - shadow)) * texture; one (H, W, 3) lookup and one product
+    alb_lut = np.concatenate(albedo + [np.full((1, 3), 0.16 / ambient)]).astype(np.float32)  # last: nothing hit
+    lambert = np.append(np.clip(hits.face_normal @ light_cam, 0.0, None), 0.0)
+    diffuse = (255 * (1.0 - ambient) * 1.1 * lambert).astype(np.float32)
+    gface = hits.gface  # -1 (nothing hit) picks the last rows
+    intensity = np.take(diffuse, gface)
     if np.any(hits.shadow):
-        shade_lut = (alb_lut * diffuse[:, None]).astype(np.float32)
-        colour -= np.take(shade_lut, gface, axis=0) * hits.shadow[..., None]
+        intensity *= f32(1.0) - hits.shadow
+    intensity += f32(255 * ambient)
     mod = np.ones(hits.depth.shape, np.float32).ravel()
     body = hits.body.ravel()
     w2c = layout.world_to_camera
     c2w = np.linalg.inv(w2c)
+    half = _HalfRes(hits)
+    half_world = half.coords(c2w)
     for i, role in enumerate(roles):
         if role not in ("floor", "wall", "table"):
             continue
         idx = np.flatnonzero(body == i)
         if role == "floor":
-            x, y, z = _coords(hits, idx, c2w)
+            x, y = _coords(hits, idx, c2w, 2)
             mod[idx] = f32(0.9) + f32(0.1) * ((np.floor(x / f32(0.3)) + np.floor(y / f32(0.3))) % 2)
         elif role == "wall":
-            x, y, z = _coords(hits, idx, c2w)
-            mod[idx] = f32(0.95) + f32(0.05) * _wavy(x + y, z, rng, 2, (0.5, 2.0))
+            x, y, z = half_world
+            mod[idx] = f32(0.95) + f32(0.05) * half.up(_wavy(x + y, z, rng, 2, (0.5, 2.0)), idx)
         else:
-            xt, yt, _ = _coords(hits, idx, np.linalg.inv(w2c @ layout.table_to_world))
-            m = f32(1.0) - f32(cfg.table_grain) * wood_grain(xt, yt, rng)
-            for _ in range(cfg.distractor_lines):
-                ang = rng.uniform(0, np.pi)
-                dist = np.abs(f32(np.cos(ang)) * xt + f32(np.sin(ang)) * yt - f32(rng.uniform(-0.25, 0.25)))
-                paint = f32(rng.choice([0.15, 1.9]))  # dark or light paint, relative to the wood
-                m = np.where(dist < f32(rng.uniform(0.002, 0.006)), paint, m)
-            mod[idx] = m
+            mod[idx] = _table(hits, half, idx, np.linalg.inv(w2c @ layout.table_to_world), cfg, rng)
     if cfg.texture > 0:  # on the table and the solids (roles after the background)
         first_solid = next(i for i, r in enumerate(roles) if r not in ("table", "floor", "wall"))
         idx = np.flatnonzero((body >= first_solid) | (body == roles.index("table")))
-        x, y, z = _coords(hits, idx, c2w)
-        blotch = 0.5 + 0.5 * np.tanh(f32(1.5) * _wavy(x + f32(0.7) * z, y - f32(0.5) * z, rng, 4, (0.02, 0.08)))
-        mod[idx] *= f32(1.0) - f32(cfg.texture) * blotch
-    img = colour * mod.reshape(hits.depth.shape)[..., None]
+        x, y, z = half_world
+        blotch = f32(0.5) + f32(0.5) * np.tanh(f32(1.5) * _wavy(x + f32(0.7) * z, y - f32(0.5) * z, rng, 4,
+                                                                 (0.02, 0.08)))
+        mod[idx] *= f32(1.0) - f32(cfg.texture) * half.up(blotch, idx)
+    intensity *= mod.reshape(hits.depth.shape)
+    img = np.take(alb_lut, gface, axis=0)
+    img *= intensity[..., None]
     return np.clip(img, 0, 255, out=img)

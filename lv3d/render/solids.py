@@ -9,6 +9,7 @@ class (prisms: 0 = bottom base, 1 = top base, 2.. = lateral faces; pyramids: 0 =
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -33,7 +34,12 @@ class Solid:
     size_m: dict = field(default_factory=dict)
 
     def normals(self) -> np.ndarray:
-        """Outward unit normals (f, 3) of the faces, object frame (Newell's method, robust for any loop)."""
+        """Outward unit normals (f, 3) of the faces, object frame (read-only, computed once per solid)."""
+        return self._normals
+
+    @cached_property
+    def _normals(self) -> np.ndarray:
+        # Newell's method: robust for any planar loop
         out = np.zeros((len(self.faces), 3))
         for i, f in enumerate(self.faces):
             p = self.vertices[list(f)]
@@ -42,6 +48,7 @@ class Solid:
                           ((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])).sum(),
                           ((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1])).sum()])
             out[i] = n / np.linalg.norm(n)
+        out.setflags(write=False)
         return out
 
     def triangles(self) -> tuple[np.ndarray, np.ndarray]:

@@ -31,7 +31,7 @@ def _problem(theta, rng, noise_px=1.5, plane_noise=0.03):
 
 def test_joint_refinement_recovers_a_right_angled_wedge():
     rng = np.random.default_rng(3)
-    prob, index, field, polys, planes = _problem(90.0, rng)
+    prob, index, field, polys, planes = _problem(90.0, rng, noise_px=1.0)
     g = grounding.ground_object(prob, field, True)
     assert int(g.status) == 0
     verts = np.asarray(g.vertices)

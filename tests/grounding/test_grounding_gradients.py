@@ -18,7 +18,7 @@ def _setup():
     rng = np.random.default_rng(0)
     prob, _ = grounding.pack_object(
         polys, intrinsics=INTR, planes=[plane_through(*f[:3]) for f in faces3d],
-        points=[sample_face(f, 100, rng), None], adjacency=adj, support_plane=np.array([0.0, -0.8, -0.6, 0.5]))
+        points=[sample_face(faces3d[0], 100, rng), None], adjacency=adj, support_plane=np.array([0.0, -0.8, -0.6, 0.5]))
     return prob, field
 
 
@@ -39,14 +39,21 @@ def test_residual_and_quantity_gradients_are_finite():
 
 def test_confidence_gradients_are_finite():
     prob, field = _setup()
+    params = _joint.zero_params(prob)
+    cov, _ = jax.jit(_uncertainty.param_covariance)(params, prob, field, grounding.Settings())
+    q, jq, std = jax.jit(_uncertainty.propagate)(params, prob, cov)
 
-    def total(verts):
-        p = grounding.ground_object(prob.__class__(**{**prob.__dict__, "vertices": verts}), field, False)
-        c = p.conf
-        return jnp.sum(c.p_sides) + jnp.sum(c.p_parallelogram) + jnp.sum(p.quantities.corner_deg)
+    def total(corners, tilt):
+        qq = q.__class__(**{**q.__dict__, "corner_deg": corners, "tilt_deg": tilt})
+        c = _confidence.confidences(qq, std, jq, cov, prob.face_vmask, prob.face_mask, prob.has_plane,
+                                    prob.has_support, prob.adjacency, jnp.ones(prob.face_mask.shape),
+                                    grounding.Floors())
+        return jnp.sum(c.p_sides) + jnp.sum(c.p_horizontal) + jnp.sum(c.p_vertical)
 
-    g = jax.grad(total)(jnp.asarray(prob.vertices))
-    assert np.all(np.isfinite(np.asarray(g)))
+    # corners that turn by about the corner threshold: side-count confidences are far from saturated
+    g = jax.jit(jax.grad(total, argnums=(0, 1)))(jnp.full_like(q.corner_deg, 166.0), q.tilt_deg)
+    assert all(np.all(np.isfinite(np.asarray(x))) for x in g)
+    assert np.any(np.asarray(g[0]) != 0.0)
 
 
 def test_interval_probability():

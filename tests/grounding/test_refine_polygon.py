@@ -29,12 +29,13 @@ def test_a_polygon_already_on_its_edges_stays_put():
     assert np.abs(refined - truth).max() < 0.6
 
 
-def test_edge_field_is_the_distance_to_the_nearest_edge():
+def test_edge_field_is_a_signed_sub_pixel_distance():
     img = np.zeros((480, 640, 3), np.uint8)
-    img[:, 320:] = 200  # one vertical edge between columns 319 and 320
+    img[:, 320:] = 200  # a vertical step whose true position is u = 319.5
     field = grounding.edge_distance_field(img)
     assert field.shape == (480, 640) and field.dtype == np.float32
     row = field[240]
-    assert row[319:321].min() < 0.5
-    assert abs(row[300] - min(abs(300 - 319), abs(300 - 320))) <= 1.0
-    assert row[0] == row.max()  # capped far away from any edge
+    assert row[300] < 0 < row[340]  # the bright side is positive
+    assert abs(row[319] + 0.5) < 0.15 and abs(row[320] - 0.5) < 0.15
+    assert abs(row[300] + 19.5) < 0.2
+    assert row[0] == -30.0  # clipped far from any edge

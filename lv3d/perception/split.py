@@ -1,0 +1,121 @@
+"""Splitting a non-convex colour face into the convex faces it merged.
+
+Every face of the solids is convex, so a traced face with a reflex corner is two faces whose shared edge the
+line detector missed (two faces of one colour under nearly the same shading). That edge runs from the reflex
+corner to another corner of the outline; of the cuts that leave two convex parts, the one with the strongest
+image gradient along it is taken.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from .polygons import area, signed_area
+
+
+def gradient_magnitude(channels: list[np.ndarray]) -> np.ndarray:
+    """Largest Sobel gradient magnitude (H, W) float32 over the given grey channels (H, W) uint8."""
+    out = None
+    for c in channels:
+        m = cv2.magnitude(cv2.Sobel(c, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(c, cv2.CV_32F, 0, 1, ksize=3))
+        out = m if out is None else np.maximum(out, m)
+    return out
+
+
+def reflex_corners(poly: np.ndarray, tol_deg: float = 4.0) -> list[int]:
+    """Indices of the corners of ``poly`` (n, 2) where it turns against its orientation by more than
+    ``tol_deg`` degrees."""
+    p = np.asarray(poly, np.float64)
+    d_in = p - np.roll(p, 1, axis=0)
+    d_out = np.roll(p, -1, axis=0) - p
+    cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
+    sin = cross / np.maximum(np.linalg.norm(d_in, axis=1) * np.linalg.norm(d_out, axis=1), 1e-9)
+    sign = 1.0 if signed_area(p) > 0 else -1.0
+    return [int(i) for i in np.nonzero(sign * sin < -np.sin(np.radians(tol_deg)))[0]]
+
+
+def _line_strength(a: np.ndarray, b: np.ndarray, grad: np.ndarray, trim_px: float = 3.0) -> float:
+    """Mean gradient magnitude along segment ab, leaving out ``trim_px`` at each end (corners are strong)."""
+    length = float(np.hypot(*(b - a)))
+    if length <= 2 * trim_px + 2:
+        return 0.0
+    t = np.linspace(trim_px / length, 1 - trim_px / length, max(4, int(length)))
+    pts = a + t[:, None] * (b - a)
+    h, w = grad.shape
+    u = np.clip(np.round(pts[:, 0]).astype(int), 0, w - 1)
+    v = np.clip(np.round(pts[:, 1]).astype(int), 0, h - 1)
+    return float(grad[v, u].mean())
+
+
+def split_concave(poly: np.ndarray, grad: np.ndarray, min_area_px: float, depth: int = 2) -> list[np.ndarray]:
+    """Convex pieces of ``poly`` (n, 2) pixels: ``[poly]`` when it is convex (or cannot be cut into convex
+    parts), else the parts of the best cut from a reflex corner to another corner, each split again up to
+    ``depth`` times. ``grad``: gradient magnitude (H, W) in the polygon's pixel frame. Parts smaller than
+    ``min_area_px`` make a cut invalid."""
+    p = np.asarray(poly, np.float64)
+    n = len(p)
+    reflex = reflex_corners(p)
+    if not reflex or depth == 0 or n < 4:
+        return [p]
+    best, best_score = None, -1.0
+    for r in reflex:
+        for k in range(n):
+            if k in (r, (r + 1) % n, (r - 1) % n):
+                continue
+            i, j = min(r, k), max(r, k)
+            a, b = p[i:j + 1], np.concatenate([p[j:], p[:i + 1]])
+            if len(a) < 3 or len(b) < 3 or min(area(a), area(b)) < min_area_px:
+                continue
+            # a cut must remove the reflex corner from both parts' sight: at least one part convex, and it
+            # must not leave the face (the segment's midpoint inside it)
+            mid = 0.5 * (p[i] + p[j])
+            if cv2.pointPolygonTest(p.astype(np.float32).reshape(-1, 1, 2), (float(mid[0]), float(mid[1])),
+                                    False) < 0:
+                continue
+            fewer = len(reflex_corners(a)) + len(reflex_corners(b))
+            score = _line_strength(p[i], p[j], grad) - 1000.0 * fewer
+            if score > best_score:
+                best, best_score = (a, b), score
+    if best is None:
+        return [p]
+    return [q for part in best for q in split_concave(part, grad, min_area_px, depth - 1)]
+
+
+def split_by_diagonal(poly: np.ndarray, grad: np.ndarray, min_area_px: float, rel_interior: float = 3.0,
+                      min_strength: float = 20.0, rel_boundary: float = 0.1) -> list[np.ndarray]:
+    """``poly`` cut along its strongest diagonal (corner to corner) when the image has an edge there that the
+    line detector missed: a thin face merged with its neighbour makes a convex outline, so only the gradient
+    can tell. The diagonal's mean gradient must exceed ``rel_interior`` times the 90th percentile of the
+    gradient inside the face (texture, noise), ``min_strength``, and ``rel_boundary`` times the outline's.
+    Returns ``[poly]`` when no diagonal qualifies."""
+    p = np.asarray(poly, np.float64)
+    n = len(p)
+    if n < 4:
+        return [p]
+    diags = [(_line_strength(p[i], p[j], grad), i, j) for i in range(n) for j in range(i + 2, n)
+             if not (i == 0 and j == n - 1)]
+    strength, i, j = max(diags)
+    if strength < min_strength:
+        return [p]
+    a, b = p[i:j + 1], np.concatenate([p[j:], p[:i + 1]])
+    if min(area(a), area(b)) < min_area_px:
+        return [p]
+    boundary = np.mean([_line_strength(p[k], p[(k + 1) % n], grad) for k in range(n)])
+    if strength < rel_boundary * boundary:
+        return [p]
+    # the interior: the polygon shrunk by a few pixels, in a box around it
+    u0, v0 = np.floor(p.min(axis=0)).astype(int)
+    u1, v1 = np.ceil(p.max(axis=0)).astype(int) + 1
+    h, w = grad.shape
+    u0, v0, u1, v1 = max(0, u0), max(0, v0), min(w, u1), min(h, v1)
+    m = np.zeros((v1 - v0, u1 - u0), np.uint8)
+    cv2.fillPoly(m, [np.round(p - [u0, v0]).astype(np.int32)], 1)
+    m = cv2.erode(m, np.ones((7, 7), np.uint8))
+    # leave out a band along the diagonal itself, or the edge being tested counts as interior texture
+    cv2.line(m, tuple(int(x) for x in np.round(p[i] - [u0, v0])), tuple(int(x) for x in np.round(p[j] - [u0, v0])),
+             0, 7)
+    inner = grad[v0:v1, u0:u1][m.astype(bool)]
+    if inner.size and strength < rel_interior * float(np.percentile(inner, 90)):
+        return [p]
+    return [a, b]

@@ -1,0 +1,43 @@
+import cv2
+import numpy as np
+
+from lv3d.perception.polygons import area, drop_short_sides
+from lv3d.perception.split import gradient_magnitude, reflex_corners, split_by_diagonal, split_concave
+
+
+def _image(polys_colours, shape=(200, 200), background=90):
+    img = np.full((*shape, 3), background, np.uint8)
+    for poly, colour in polys_colours:
+        cv2.fillPoly(img, [np.round(poly).astype(np.int32)], colour)
+    return [np.ascontiguousarray(img[:, :, c]) for c in range(3)]
+
+
+def test_a_non_convex_outline_splits_at_its_reflex_corner_along_the_faint_edge():
+    # a cube's top and left faces in nearly one colour: their shared edge (80, 110)-(188, 135) is faint
+    top = np.array([[80.0, 110.0], [155.0, 78.0], [260.0, 100.0], [188.0, 135.0]])
+    left = np.array([[80.0, 110.0], [188.0, 135.0], [188.0, 262.0], [82.0, 228.0]])
+    grad = gradient_magnitude(_image([(top, (200, 60, 60)), (left, (190, 60, 60))], shape=(300, 300)))
+    outline = np.array([[80.0, 110.0], [155.0, 78.0], [260.0, 100.0], [188.0, 135.0], [188.0, 262.0],
+                        [82.0, 228.0]])
+    assert reflex_corners(outline) == [3]
+    parts = split_concave(outline, grad, min_area_px=100.0)
+    assert len(parts) == 2 and not any(reflex_corners(p) for p in parts)
+    assert sorted(round(area(p)) for p in parts) == sorted([round(area(top)), round(area(left))])
+
+
+def test_a_convex_outline_splits_only_where_the_image_has_an_edge():
+    quad = np.array([[40.0, 40.0], [160.0, 40.0], [160.0, 160.0], [40.0, 160.0]])
+    tri = np.array([[40.0, 40.0], [160.0, 160.0], [40.0, 160.0]])
+    faint = gradient_magnitude(_image([(quad, (200, 60, 60)), (tri, (185, 60, 60))]))
+    assert len(split_by_diagonal(quad, faint, min_area_px=100.0)) == 2
+    flat = gradient_magnitude(_image([(quad, (200, 60, 60))]))
+    assert len(split_by_diagonal(quad, flat, min_area_px=100.0)) == 1
+
+
+def test_a_corner_traced_as_two_goes_back_to_one():
+    square = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [4.0, 100.0], [0.0, 96.0]])
+    out = drop_short_sides(square)
+    assert len(out) == 4
+    assert np.abs(out - np.array([0.0, 100.0])).sum(axis=1).min() < 1e-9
+    pentagon = np.array([[50.0, 0.0], [100.0, 36.0], [81.0, 95.0], [19.0, 95.0], [0.0, 36.0]])
+    assert len(drop_short_sides(pentagon)) == 5  # real sides stay

@@ -1,0 +1,127 @@
+"""describe(): a hand-built Scene and frame -> facts with confidences, per modality."""
+
+import cv2
+import numpy as np
+import pytest
+
+from lv3d.camera import Intrinsics
+from lv3d.describe import describe
+from lv3d.facts import PREDICATES
+from lv3d.plane import Plane
+from lv3d.rgbd import RGBD
+from lv3d.scene import Face, Scene, SceneObject
+
+K = Intrinsics(fx=600.0, fy=600.0, cx=319.5, cy=239.5, width=640, height=480)
+
+
+def _wedge():
+    """Two faces of a box meeting at 90 degrees, both facing the camera: 3D corners (4, 3) each, metres."""
+    e0, e1 = np.array([-0.06, 0, 0]), np.array([0.06, 0, 0])
+    up, back = np.array([0, -0.1, 0]), np.array([0, 0, 0.1])
+    top = np.array([e0, e1, e1 + back, e0 + back])      # horizontal, on top
+    front = np.array([e1, e0, e0 - up, e1 - up])  # vertical, in front, hanging down
+    a = np.radians(40)
+    rot = np.array([[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]])
+    shift = np.array([0.0, -0.02, 0.7])
+    return [f @ rot.T + shift for f in (top, front)], rot
+
+
+def _project(x):
+    return np.stack([K.fx * x[:, 0] / x[:, 2] + K.cx, K.fy * x[:, 1] / x[:, 2] + K.cy], 1)
+
+
+def _mask(poly, ss=8):
+    """Pixels whose centre lies inside the polygon (supersampled, so the outline is where the polygon is)."""
+    big = np.zeros((480 * ss, 640 * ss), np.uint8)
+    p = (np.asarray(poly) + 0.5) * ss - 0.5
+    cv2.fillPoly(big, [np.round(p * 16).astype(np.int32)], 255, shift=4)
+    return cv2.resize(big, (640, 480), interpolation=cv2.INTER_AREA) > 127
+
+
+def _frame_and_faces(rng):
+    faces3d, rot = _wedge()
+    polys = [_project(f) for f in faces3d]
+    color = np.full((480, 640, 3), 40, np.uint8)
+    depth = np.zeros((480, 640), np.float32)
+    v, u = np.mgrid[0:480, 0:640]
+    rays = np.stack([(u - K.cx) / K.fx, (v - K.cy) / K.fy, np.ones_like(u, float)], -1)
+    out = []
+    for poly, f3, col in zip(polys, faces3d, [(210, 160, 90), (70, 150, 220)]):
+        mask = _mask(poly)
+        color[mask] = col
+        plane = Plane.from_arrays(np.cross(f3[1] - f3[0], f3[2] - f3[0]), 0.0)
+        plane = Plane.from_arrays(plane.n, -plane.n @ f3[0])
+        t = -plane.offset / (rays @ plane.n)
+        z = (t * (1 + rng.normal(0, 0.002, t.shape))).astype(np.float32)
+        depth[mask] = z[mask]
+        pts = rays[mask] * z[mask][:, None]
+        out.append((poly + rng.normal(0, 1.0, poly.shape), plane, pts))
+    support = Plane.from_arrays(rot @ np.array([0, -1.0, 0]), 0.0)
+    support = Plane.from_arrays(support.n, -support.n @ (faces3d[1][2]))
+    return RGBD(color, depth, K, "synthetic"), out, support
+
+
+def _scene(modality, rng, with_extra_rgb_face=False):
+    frame, faces, support = _frame_and_faces(rng)
+    # shared corners: the second face's first two vertices are the first face's second and first
+    faces[1] = (np.vstack([faces[0][0][1], faces[0][0][0], faces[1][0][2:]]), faces[1][1], faces[1][2])
+    objs = []
+    fl = []
+    for j, (poly, plane, pts) in enumerate(faces, start=1):
+        if modality == "rgb":
+            fl.append(Face(f"s1_o1_f{j}", poly, "rgb"))
+        else:
+            fl.append(Face(f"s1_o1_f{j}", poly, modality, plane=plane, points=pts))
+    if with_extra_rgb_face:
+        tri = np.array([[100.0, 100], [160, 100], [130, 150]])
+        frame.color[_mask(tri)] = (230, 230, 230)
+        fl.append(Face("s1_o1_f3", tri, "rgb"))
+    objs.append(SceneObject("s1_o1", fl, [("s1_o1_f1", "s1_o1_f2")], pixel_count=5000, centroid_px=(320, 240)))
+    return Scene("s1", modality, K, objs, support_plane=None if modality == "rgb" else support), frame
+
+
+def _by_atom(sf):
+    return {f.atom(): f for f in sf.facts}
+
+
+def test_rgbd_scene_gets_shape_orientation_and_relation_facts():
+    scene, frame = _scene("rgbd", np.random.default_rng(0), with_extra_rgb_face=True)
+    sf = describe(scene, frame)
+    facts = _by_atom(sf)
+    assert sf.target == "s1_o1" and sf.modality == "rgbd"
+    for atom in ("object(s1_o1)", "quadrilateral(s1_o1_f1)", "quadrilateral(s1_o1_f2)",
+                 "perpendicular(s1_o1_f1,s1_o1_f2)", "perpendicular(s1_o1_f2,s1_o1_f1)",
+                 "adjacent(s1_o1_f1,s1_o1_f2)", "adjacent(s1_o1_f2,s1_o1_f1)",
+                 "horizontal(s1_o1_f1)", "vertical(s1_o1_f2)", "rectangle(s1_o1_f1)"):
+        assert atom in facts and facts[atom].conf > 0.8, (atom, facts.get(atom))
+    assert abs(facts["perpendicular(s1_o1_f1,s1_o1_f2)"].value - 90.0) < 3.0
+    assert "acute(s1_o1_f1,s1_o1_f2)" not in facts and "parallel(s1_o1_f1,s1_o1_f2)" not in facts
+    # the rgb-only face gets 2D facts but nothing that needs a plane
+    assert "triangle(s1_o1_f3)" in facts
+    assert not any(a.endswith("(s1_o1_f3)") and a.split("(")[0] in ("horizontal", "vertical", "regular")
+                   for a in facts)
+    assert all(0.05 <= f.conf <= 1.0 for f in sf.facts)
+
+
+def test_rgb_scene_has_no_plane_facts():
+    scene, frame = _scene("rgb", np.random.default_rng(1))
+    sf = describe(scene, frame)
+    preds = {f.pred for f in sf.facts}
+    assert preds <= {p for p, (_, mods) in PREDICATES.items() if "rgb" in mods}
+    assert {"quadrilateral", "adjacent", "object", "face_of"} <= preds
+
+
+def test_depth_scene_uses_depth_edges_and_unrefined_facts_keep_confidences():
+    scene, frame = _scene("depth", np.random.default_rng(2))
+    for refine in (True, False):
+        facts = _by_atom(describe(scene, frame, refine=refine))
+        assert "parallelogram(s1_o1_f1)" not in facts  # an image-shape fact, not for depth
+        assert facts["perpendicular(s1_o1_f1,s1_o1_f2)"].conf > 0.8
+        assert 0.05 < facts["quadrilateral(s1_o1_f1)"].conf <= 1.0
+
+
+@pytest.mark.parametrize("modality", ["rgb", "depth", "rgbd"])
+def test_every_emitted_predicate_is_allowed_for_the_modality(modality):
+    scene, frame = _scene(modality, np.random.default_rng(3))
+    sf = describe(scene, frame)
+    assert sf.facts and all(modality in PREDICATES[f.pred][1] for f in sf.facts)
