@@ -7,6 +7,18 @@ import cv2
 import numpy as np
 
 
+def _bilinear(img: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Bilinear samples of a (H, W) image at (n, 2) pixel positions, clamped to the image."""
+    h, w = img.shape
+    u = np.clip(uv[:, 0], 0, w - 1.001)
+    v = np.clip(uv[:, 1], 0, h - 1.001)
+    u0, v0 = u.astype(int), v.astype(int)
+    fu, fv = u - u0, v - v0
+    top = img[v0, u0] * (1 - fu) + img[v0, u0 + 1] * fu
+    bottom = img[v0 + 1, u0] * (1 - fu) + img[v0 + 1, u0 + 1] * fu
+    return top * (1 - fv) + bottom * fv
+
+
 def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 60.0, cap_px: float = 30.0) -> np.ndarray:
     """Signed distance (float32 pixels, (H, W)) from each pixel to the tangent line of its nearest image edge.
 
@@ -45,8 +57,7 @@ def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 6
     # sub-pixel peak of the gradient magnitude along the normal (parabola through three samples)
     m = np.sqrt(mag)
     pts = np.stack([eu, ev], 1).astype(np.float32)
-    samples = [cv2.remap(m, (pts[:, :1] + k * n[:, :1]).astype(np.float32), (pts[:, 1:] + k * n[:, 1:]).astype(np.float32),
-                         cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)[:, 0] for k in (-1.0, 0.0, 1.0)]
+    samples = [_bilinear(m, pts + k * n) for k in (-1.0, 0.0, 1.0)]
     curv = samples[0] - 2 * samples[1] + samples[2]
     offset = np.where(curv < -1e-6, 0.5 * (samples[0] - samples[2]) / np.where(curv < -1e-6, curv, -1.0), 0.0)
     sub = pts + np.clip(offset, -0.5, 0.5)[:, None] * n

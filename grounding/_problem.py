@@ -51,7 +51,7 @@ class ObjectProblem(eqx.Module):
     planes: Float[Array, "F 4"]            # first-guess planes (n, d), camera frame, metres
     pivots: Float[Array, "F 3"]            # centre of each face's points: planes tilt about it, camera frame, metres
     points: Float[Array, "F P 3"]          # the face's depth points, camera frame, metres
-    point_weight: Float[Array, "F P"]      # 1 for a real point, 0 for padding
+    point_weight: Float[Array, "F P"]      # how many readings a point stands for (0 for padding)
     links: Int[Array, "L 3"]               # (vertex, face a, face b): the vertex on plane a must lie on plane b
     link_mask: Bool[Array, " L"]
     adjacency: Bool[Array, "F F"]          # faces sharing an edge (symmetric)
@@ -60,25 +60,40 @@ class ObjectProblem(eqx.Module):
     intrinsics: Float[Array, " 4"]         # fx, fy, cx, cy in pixels
 
 
-def _take(points: np.ndarray, n: int, seed: int) -> np.ndarray:
-    """At most ``n`` rows of ``points``, an even random subset chosen with ``seed``."""
+def _compress(points: np.ndarray, n: int, intrinsics) -> tuple[np.ndarray, np.ndarray]:
+    """At most ``n`` points that stand for ``points`` ((m, 3) metres): the means of the points in the
+    cells of an image-space grid, each weighted by its count (a cell mean's noise is sigma / sqrt(count)),
+    so a fit to them is the fit to all points at a fraction of the cost."""
     if len(points) <= n:
-        return points
-    idx = np.random.default_rng(seed).choice(len(points), n, replace=False)
-    return points[np.sort(idx)]
+        return points, np.ones(len(points))
+    fx, fy, cx, cy = intrinsics
+    z = np.where(np.abs(points[:, 2]) < 1e-9, 1e-9, points[:, 2])
+    uv = np.stack([fx * points[:, 0] / z + cx, fy * points[:, 1] / z + cy], 1)
+    lo, hi = uv.min(0), uv.max(0) + 1e-6
+    side = np.sqrt(np.prod(hi - lo) / n)  # cell side for about n cells over the bounding box
+    while True:
+        cells = np.floor((uv - lo) / side).astype(np.int64)
+        key = cells[:, 0] * 100003 + cells[:, 1]
+        uniq, inv, counts = np.unique(key, return_inverse=True, return_counts=True)
+        if len(uniq) <= n:
+            break
+        side *= 1.15
+    sums = np.zeros((len(uniq), 3))
+    np.add.at(sums, inv, points)
+    return sums / counts[:, None], counts.astype(np.float64)
 
 
 def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, float, float],
                 planes: list[np.ndarray | None] | None = None, points: list[np.ndarray | None] | None = None,
                 use_edges: list[bool] | None = None, edge_support: list[float | None] | None = None,
                 adjacency: list[tuple[int, int]] = (), support_plane: np.ndarray | None = None,
-                merge_px: float = 6.0, boundary_sigma_px: float = 2.0, free_sigma_px: float = 20.0,
-                seed: int = 0) -> tuple[ObjectProblem, np.ndarray]:
+                merge_px: float = 6.0, boundary_sigma_px: float = 2.0, free_sigma_px: float = 20.0) -> tuple[ObjectProblem, np.ndarray]:
     """Pad one object's faces into an :class:`ObjectProblem` (numpy, outside jit).
 
     ``polygons``: per face an (n, 2) array of pixel vertices in order (3 <= n <= MAX_SIDES).
     Vertices of different faces closer than ``merge_px`` become one shared vertex (greedy, in order).
-    ``planes``: per face (4,) (n, d) or None; ``points``: per face (m, 3) camera-frame metres or None.
+    ``planes``: per face (4,) (n, d) or None; ``points``: per face (m, 3) camera-frame metres or None
+    (more than MAX_POINTS are merged into weighted cell means, see ``_compress``).
     ``use_edges``: per face whether an edge field guides its sides (default all True); a vertex that
     no edge-guided face uses keeps the prior spread ``boundary_sigma_px`` (perception's own error),
     the others a weak ``free_sigma_px``. Returns the problem and the (F, S) map from each face's
@@ -130,10 +145,10 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
         if planes[f] is not None and points[f] is not None and len(points[f]) >= 3:
             plane_arr[f] = np.asarray(planes[f], np.float64)
             has_plane[f] = True
-            p = _take(np.asarray(points[f], np.float64), MAX_POINTS, seed + f)
+            p, w = _compress(np.asarray(points[f], np.float64), MAX_POINTS, intrinsics)
             pts[f, : len(p)] = p
-            pw[f, : len(p)] = 1.0
-            pivots[f] = p.mean(0)
+            pw[f, : len(p)] = w
+            pivots[f] = (p * w[:, None]).sum(0) / w.sum()
     adj = np.zeros((MAX_FACES, MAX_FACES), bool)
     links = np.zeros((MAX_LINKS, 3), np.int32)
     lmask = np.zeros(MAX_LINKS, bool)

@@ -95,7 +95,7 @@ def param_covariance(params: Params, prob: ObjectProblem, field: Float[Array, "H
     jac = eqx.tree_at(lambda j: j.edge, jac, jax.jacfwd(line_residuals)(flat))
     p_edge, p_plane = _dof(prob)
     n_edge = jnp.sum(edge_mask(prob)) * EDGE_SAMPLES
-    n_depth = jnp.sum(prob.point_weight * (prob.has_plane & prob.face_mask)[:, None])
+    n_depth = jnp.sum((prob.point_weight > 0) * (prob.has_plane & prob.face_mask)[:, None])  # cells, not readings
 
     def scale2(r, n, p):
         return jnp.maximum(jnp.sum(r * r) / jnp.maximum(n - p, 1.0), MIN_SCALE2)

@@ -11,9 +11,9 @@
 
     A program is a list of items: sub(MetaruleName, Subs, BodyLength) while learning, cl(Head, Body)
     when fixed (Head an atom list, Body a list of atom lists).  Iterative deepening is on the total
-    number of body literals, and within it on the number of clauses (smallest programs first).  A proof's confidence combines the confidences
-    of the facts it used (option combine: product or min); an atom is proved only while that
-    confidence stays >= the threshold.
+    number of body literals, and within it on the number of clauses (smallest programs first).
+    A proof's confidence combines the confidences of the facts it used (option combine: product
+    or min); an atom is proved only while that confidence stays >= the threshold.
 */
 :- module(mil, [ learn/3,            % +Task, +Settings, -Program   (Metagol: consistent with all examples)
                  learn_noisy/4,      % +Task, +Settings, -Program, -Score  (samples, scored on all)
@@ -35,7 +35,7 @@ default(max_clauses(3)).        % iterative deepening bound on the number of cla
 default(max_literals(6)).       % and on the number of body literals of all clauses together
 default(max_inventions(1)).     % invented predicate symbols allowed
 default(max_depth(10)).         % bound on nested clause applications in one proof (recursion)
-default(time_limit(10)).        % seconds for a whole search; exceeding it throws mil_error(time_limit(S))
+default(time_limit(10)).        % seconds for a search (learn_noisy: shared by its samples)
 default(threshold(0.5)).        % an example is covered when its best proof's confidence >= this
 default(combine(product)).      % how a proof's confidence combines its facts' confidences
 default(samples(8)).            % noisy learning: random samples of the examples
@@ -82,7 +82,8 @@ size(Settings, Ctx0, Ctx) :-
 
 %!  learn_noisy(+Task, +Settings, -Program, -Score) is semidet.
 %   Hypotheses learned from seeded random samples of the examples, each scored on all of them
-%   (mil_score:score/5); the best is kept.  Fails when no sample gives any hypothesis.
+%   (score/6, then support/4, literal_cost/3); the best is kept.  Fails when no sample gives any
+%   hypothesis.
 %   Each sample's search has an equal share of the time limit; a sample that runs out gives no
 %   hypothesis (a mislabelled example can make a sample's search exhaustive), and only when every
 %   sample runs out is it an error.

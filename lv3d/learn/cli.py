@@ -90,9 +90,8 @@ def fit(data: Path, modality: str, facts: str, classes: str | None, out: Path, s
     for c, p in model.programs.items():
         click.echo(f"% {c}: covers {p.score['tp']}/{p.score['n_pos']} positives, "
                    f"{p.score['fp']}/{p.score['n_neg']} negatives\n{p}\n")
-    missing = sorted(set(wanted or set(labels)) - set(model.programs))
-    if missing:
-        click.echo(f"no program found for: {', '.join(missing)}", err=True)
+    for c, why in model.failures.items():
+        click.echo(f"no program for {c}: {why}", err=True)
 
 
 @learn.command()

@@ -127,22 +127,24 @@ class Model:
     """One program per class. ``predict`` names the class whose program proves the scene's target
     with the highest confidence (ties: the program with the higher training J), "unknown" if none."""
 
-    def __init__(self, programs: dict[str, Program], settings: dict | None = None):
+    def __init__(self, programs: dict[str, Program], settings: dict | None = None,
+                 failures: dict[str, str] | None = None):
         self.programs = dict(programs)
         self.settings = dict(settings or {})
+        self.failures = dict(failures or {})  # class -> why no program was learned
 
     @classmethod
     def fit(cls, scenes: list[SceneFacts], labels: list[str], settings: dict | None = None, seed: int = 0,
             classes: list[str] | None = None) -> "Model":
         """A program for each class in ``classes`` (default: every label). A class whose search finds
-        nothing gets no program (it is never predicted)."""
-        programs = {}
+        nothing or runs out of time gets no program (it is never predicted); ``failures`` says why."""
+        programs, failures = {}, {}
         for c in classes or sorted(set(labels)):
             try:
                 programs[c] = fit(scenes, labels, c, settings=settings, seed=seed)
-            except LearnError:
-                continue
-        return cls(programs, settings)
+            except LearnError as e:
+                failures[c] = str(e)
+        return cls(programs, settings, failures)
 
     def _proofs(self, scene: SceneFacts) -> list[dict]:
         if scene.target is None:

@@ -65,12 +65,13 @@ def noise_threshold(z_m: float) -> float:
 
 
 def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up: float = 0.3,
-                  min_frac: float = 0.08, max_points: int = 4000) -> Plane | None:
+                  min_frac: float = 0.08, max_points: int = 4000, min_share: float = 0.35) -> Plane | None:
     """The support plane of camera-frame points (m, 3) metres, or None if no plane holds ``min_frac`` of them.
 
     Up to ``max_planes`` planes are peeled off by RANSAC. Among those whose normal points up in the image
-    (``-n_y >= min_up``, camera y is down) the one nearest the camera wins: a table stands above the floor it
-    is on. Without an upward plane the largest plane wins."""
+    (``-n_y >= min_up``, camera y is down) and that hold at least ``min_share`` of the largest such plane's
+    points, the one nearest the camera wins: a table stands above the floor it is on, and an object's top face
+    is nearer still but much smaller. Without an upward plane the largest plane wins."""
     rng = np.random.default_rng(seed)
     if len(points) > max_points:
         points = points[np.sort(rng.choice(len(points), max_points, replace=False))]
@@ -78,16 +79,19 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
         return None
     dist_m = noise_threshold(float(np.median(points[:, 2])))
     remaining = points
-    found: list[Plane] = []
+    found: list[tuple[Plane, int]] = []
     for _ in range(max_planes):
         if len(remaining) < min_frac * len(points):
             break
         plane, mask = ransac_plane(remaining, dist_m, rng, iterations=200)
         if mask.sum() < min_frac * len(points):
             break
-        found.append(plane)
+        found.append((plane, int(mask.sum())))
         remaining = remaining[~mask]
-    up = [p for p in found if -p.normal[1] >= min_up]
+    up = [(p, c) for p, c in found if -p.normal[1] >= min_up]
     if up:
-        return min(up, key=lambda p: p.offset)
-    return found[0] if found else None
+        # the top face of a large object near the camera faces up too: a support must also be among the
+        # larger upward planes (>= min_share of the largest), and of those the nearest wins
+        most = max(c for _, c in up)
+        return min((p for p, c in up if c >= min_share * most), key=lambda p: p.offset)
+    return found[0][0] if found else None

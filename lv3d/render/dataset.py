@@ -18,6 +18,7 @@ from ..errors import InputError
 from ..rgbd import RGBD
 from .frame import render_scene
 from .noise import NoiseConfig, as_config
+from .raycast import rays_from_origin
 from .solids import CLASSES
 
 SCHEMA = "lv3d.dataset/1"
@@ -137,6 +138,8 @@ def make_dataset(out: Path, classes, per_class: int, noise: str | NoiseConfig, s
         else:
             # fork: workers start at once, without importing open3d again; each builds its own scenes
             ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+            if ctx.get_start_method() == "fork":  # fill the per-process caches once, before the workers copy them
+                rays_from_origin(Intrinsics.realsense_d435(int(width), int(height)))
             with ctx.Pool(n_workers) as pool:
                 for _ in pool.imap_unordered(_render_job, jobs, chunksize=1):
                     bar.update()

@@ -81,7 +81,7 @@ def as_config(noise: str | NoiseConfig) -> NoiseConfig:
 def gaussian(shape: tuple[int, ...], rng: np.random.Generator, sigma: float = 1.0) -> np.ndarray:
     """Normal float32 samples of ``shape`` with mean 0 and standard deviation ``sigma``, seeded from
     ``rng``. OpenCV's generator (per thread, reseeded here on every call, so still reproducible) is
-    several times faster than numpy's."""
+    several times faster than numpy's (a 16-bit quantile table lookup was tried: no faster)."""
     cv2.setRNGSeed(int(rng.integers(1, 2**31 - 1)))
     out = np.empty((int(np.prod(shape)), 1), np.float32)  # one channel: a scalar std applies to channel 0 only
     cv2.randn(out, 0.0, float(sigma))

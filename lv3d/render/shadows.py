@@ -53,6 +53,32 @@ def shadow_polygon(v: np.ndarray, edges: np.ndarray, n: np.ndarray, d: float, li
     return p[hull.ravel()]
 
 
+def convex_mask(uv: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """(h, w) bool: the pixel centres (integer coordinates) inside or on the convex polygon ``uv`` (m, 2),
+    either orientation. Exact, unlike cv2.fillPoly, which also fills pixels up to half a pixel outside
+    (a shadow polygon's outline often runs along a solid's silhouette: that would draw a false line)."""
+    h, w = shape
+    p = np.asarray(uv, np.float64)
+    q = np.roll(p, -1, axis=0)
+    area2 = float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
+    if abs(area2) < 1e-12:
+        return np.zeros(shape, bool)
+    # inside: nx u + ny v >= c for every edge (normals pointing inwards); per row a span of u
+    nx, ny = (p[:, 1] - q[:, 1]) * np.sign(area2), (q[:, 0] - p[:, 0]) * np.sign(area2)
+    c = nx * p[:, 0] + ny * p[:, 1]
+    rhs = c[None, :] - ny[None, :] * np.arange(h, dtype=np.float64)[:, None]  # nx u >= rhs, (h, m)
+    tol = 1e-9
+    with np.errstate(divide="ignore", invalid="ignore"):
+        bound = rhs / nx[None, :]
+    lo = np.max(np.where(nx > tol, bound, -np.inf), axis=1)
+    hi = np.min(np.where(nx < -tol, bound, np.inf), axis=1)
+    row_ok = np.all((np.abs(nx) > tol)[None, :] | (rhs <= 0), axis=1)  # edges along the rows
+    lo = np.clip(np.ceil(lo - 1e-9), 0, w).astype(np.int64)
+    hi = np.where(row_ok, np.clip(np.floor(hi + 1e-9) + 1, 0, w).astype(np.int64), lo)
+    cols = np.arange(w)
+    return (cols[None, :] >= lo[:, None]) & (cols[None, :] < hi[:, None])
+
+
 def _edges(body: Body) -> np.ndarray:
     if len(body.solid.faces) == 1:  # a one-sided quad: its loop
         f = body.solid.faces[0]
@@ -122,11 +148,9 @@ def shadow_mask(bodies: list[Body], gface: np.ndarray, face_normal: np.ndarray, 
             if np.any(hi <= lo):
                 continue
             win = (slice(lo[1], hi[1]), slice(lo[0], hi[0]))
-            fill = np.zeros((hi[1] - lo[1], hi[0] - lo[0]), np.uint8)
-            pts = np.round((np.clip(uv, -1e6, 1e6) - lo) * 16).astype(np.int32)
-            cv2.fillPoly(fill, [pts], 1, cv2.LINE_8, shift=4)
-            fill &= (gface[win] == g).view(np.uint8)
-            out[win] |= fill
+            fill = convex_mask(uv - lo, (hi[1] - lo[1], hi[0] - lo[0]))
+            fill &= gface[win] == g
+            out[win] |= fill.view(np.uint8)
     return out
 
 

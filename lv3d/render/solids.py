@@ -39,15 +39,16 @@ class Solid:
 
     @cached_property
     def _normals(self) -> np.ndarray:
-        # Newell's method: robust for any planar loop
-        out = np.zeros((len(self.faces), 3))
-        for i, f in enumerate(self.faces):
-            p = self.vertices[list(f)]
-            q = np.roll(p, -1, axis=0)
-            n = np.stack([((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])).sum(),
-                          ((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])).sum(),
-                          ((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1])).sum()])
-            out[i] = n / np.linalg.norm(n)
+        # Newell's method (robust for any planar loop), over the edges of all faces at once
+        loops = [(f, f[1:] + f[:1]) for f in self.faces]
+        a = np.concatenate([f for f, _ in loops])
+        b = np.concatenate([g for _, g in loops])
+        face = np.repeat(np.arange(len(self.faces)), [len(f) for f in self.faces])
+        p, q = self.vertices[a], self.vertices[b]
+        parts = ((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2]), (p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0]),
+                 (p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1]))
+        out = np.stack([np.bincount(face, weights=w, minlength=len(self.faces)) for w in parts], axis=1)
+        out /= np.linalg.norm(out, axis=1, keepdims=True)
         out.setflags(write=False)
         return out
 

@@ -1,6 +1,6 @@
 """Shape concepts from one positive and a few negatives per class, checked on held-out scenes."""
 
-from conftest import SHAPES
+from learn_scenes import SHAPES
 
 from lv3d.learn import Model, fit
 
