@@ -20,7 +20,7 @@ MAX_SIDES = 8
 MAX_VERTICES = 24
 MAX_POINTS = 128
 MAX_LINKS = 24
-EDGE_SAMPLES = 8  # points sampled along each polygon edge
+EDGE_SAMPLES = 12  # points sampled along each polygon edge
 
 
 class Settings(eqx.Module):

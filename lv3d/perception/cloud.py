@@ -104,6 +104,5 @@ def crop_normals(grid: PointGrid, i0: int, j0: int, i1: int, j1: int, margin: in
     (objects are small: normals of the whole grid would cost more than everything else)."""
     h, w = grid.shape
     a0, b0, a1, b1 = max(0, i0 - margin), max(0, j0 - margin), min(h, i1 + margin), min(w, j1 + margin)
-    # a 3x3 window: thin faces seen at a grazing angle are only a few grid cells wide
-    n = grid_normals(np.ascontiguousarray(grid.xyz[a0:a1, b0:b1]), grid.valid[a0:a1, b0:b1], smooth=3)
+    n = grid_normals(np.ascontiguousarray(grid.xyz[a0:a1, b0:b1]), grid.valid[a0:a1, b0:b1])
     return n[i0 - a0:i1 - a0, j0 - b0:j1 - b0]

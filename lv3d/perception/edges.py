@@ -38,11 +38,16 @@ def color_edge_map(color: np.ndarray) -> np.ndarray:
 def edge_map(gray: np.ndarray, low_ratio: float = 0.5) -> np.ndarray:
     """Canny edges (H, W) uint8 in {0, 255}. The high threshold is the 90th percentile of the gradient
     magnitude (clipped to [40, 400]), so that it adapts to contrast; the low one is ``low_ratio`` of it."""
+    return edges_and_gradient(gray, low_ratio)[0]
+
+
+def edges_and_gradient(gray: np.ndarray, low_ratio: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`edge_map` and the Sobel gradient magnitude (H, W) float32 it was thresholded from."""
     gx = cv2.Sobel(gray, cv2.CV_32F, 1, 0, ksize=3)
     gy = cv2.Sobel(gray, cv2.CV_32F, 0, 1, ksize=3)
     mag = cv2.magnitude(gx, gy)
     high = float(np.clip(np.percentile(mag[::4, ::4], 90), 40.0, 400.0))  # Canny uses the same 3x3 Sobel
-    return cv2.Canny(gray, low_ratio * high, high, L2gradient=True)
+    return cv2.Canny(gray, low_ratio * high, high, L2gradient=True), mag
 
 
 def edge_distance(edges: np.ndarray) -> np.ndarray:

@@ -39,8 +39,8 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     """Objects above ``support`` on the grid, largest first. Points within the noise band of the support plane
     or below it are removed; the rest splits at depth jumps larger than ``rel_jump`` * depth; pieces with fewer
     than ``min_points`` grid points, lower than ``min_height_m``, or cut by the image border along more than
-``max_border`` of their outline (walls, furniture, the floor beyond a table: scenery, not objects) are dropped. Without a support plane every
-    valid point counts as foreground."""
+    ``max_border`` of their outline (walls, furniture, the floor beyond a table: scenery, not objects) are
+    dropped. Without a support plane every valid point counts as foreground."""
     valid = grid.valid
     if support is not None:
         h_above = np.where(valid, grid.xyz @ support.n.astype(np.float32) + np.float32(support.offset), 0)

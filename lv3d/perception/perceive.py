@@ -122,7 +122,8 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
                 continue  # a patch of print or shadow on a plane that depth already has: not a face
             if a in match:
                 p = o.planes[match[a]]
-                face = Face("", _pick_polygon(f.polygon, o.polygons[match[a]], poly_px[i], off), "rgbd", plane=p.plane, points=p.points, edge_support=f.edge_support,
+                poly = _pick_polygon(f.polygon, o.polygons[match[a]], poly_px[i], off)
+                face = Face("", poly, "rgbd", plane=p.plane, points=p.points, edge_support=f.edge_support,
                             plane_rms_m=p.rms_m)
                 plane_face[match[a]] = len(faces)
             else:
@@ -170,11 +171,8 @@ def _pick_polygon(colour: np.ndarray, depth: np.ndarray | None, colour_px: np.nd
     and covers nearly the same pixels (IoU >= ``min_iou``; ``colour_px``: its mask over the crop at pixel
     offset ``off``): then the depth outline has a rounded or cut-off corner, while a colour face that merged two
     faces would reach over the neighbouring plane."""
-    import os
     if depth is None or len(colour) == len(depth):
         return colour
-    if os.environ.get("LV3D_PICK") == "depth":
-        return depth
     if len(colour) < len(depth):
         dm = rasterize(depth - off, colour_px.shape)
         inter = np.count_nonzero(dm & colour_px)

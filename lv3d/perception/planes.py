@@ -99,7 +99,8 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     return out
 
 
-def plane_adjacency(planes: list[DepthPlane], min_contact: int = 4, min_angle_deg: float = 15.0) -> list[tuple[int, int]]:
+def plane_adjacency(planes: list[DepthPlane], min_contact: int = 4,
+                    min_angle_deg: float = 15.0) -> list[tuple[int, int]]:
     """Pairs (i, j), i < j, of planes whose masks touch along at least ``min_contact`` grid cells and whose
     normals differ by at least ``min_angle_deg`` (two parallel touching pieces are one face, not an edge)."""
     out = []

@@ -8,11 +8,11 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .edges import channels, edge_distance, edge_map, edge_support
+from .edges import channels, edge_distance, edge_support, edges_and_gradient
 from .faces import bounded_faces, build_graph
 from .polygons import area, clockwise, drop_short_sides, is_simple, simplify
 from .segments import detect_color_segments, union_find_labels
-from .split import gradient_magnitude, split_by_diagonal, split_concave
+from .split import split_by_diagonal, split_concave
 
 
 @dataclass(frozen=True)
@@ -61,9 +61,10 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     u0, v0, u1, v1 = box if box is not None else (0, 0, w, h)
     crop = np.ascontiguousarray(color[v0:v1, u0:u1])
     chans = channels(crop)
-    edges = np.maximum.reduce([edge_map(c) for c in chans])
+    per_channel = [edges_and_gradient(c) for c in chans]
+    edges = np.maximum.reduce([e for e, _ in per_channel])
+    grad = np.maximum.reduce([g for _, g in per_channel])  # for cutting merged faces (split.py)
     dist = edge_distance(edges)
-    grad = gradient_magnitude(chans)
     t1 = time.perf_counter()
     segs = detect_color_segments(chans)
     t2 = time.perf_counter()

@@ -50,11 +50,13 @@ def ransac_plane(points: np.ndarray, dist_m: float, rng: np.random.Generator, it
     plane = Plane.from_arrays(n[best], d[best])
     mask = np.zeros(m, bool)
     for _ in range(4):
-        mask = np.abs(plane.distance(points)) <= dist_m
+        new = np.abs(plane.distance(points)) <= dist_m
         if normals is not None:
-            mask &= np.abs(normals @ plane.n) >= np.cos(np.radians(max_angle_deg))
-        if mask.sum() < 3:
-            break
+            new &= np.abs(normals @ plane.n) >= np.cos(np.radians(max_angle_deg))
+        if new.sum() < 3 or np.array_equal(new, mask):
+            mask = new
+            break  # a stable inlier set refits to the same plane
+        mask = new
         plane = refine(points[mask])
     return plane, mask
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import multiprocessing as mp
+import sys
 import os
 import shutil
 from pathlib import Path
@@ -136,8 +137,10 @@ def make_dataset(out: Path, classes, per_class: int, noise: str | NoiseConfig, s
                 _render_job(job)
                 bar.update()
         else:
-            # fork: workers start at once, without importing open3d again; each builds its own scenes
-            ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+            # fork: workers start at once, without importing open3d again; each builds its own scenes.
+            # Not once JAX or torch run threads in this process: a forked copy of their locks can deadlock.
+            threaded = any(m in sys.modules for m in ("jax", "torch"))
+            ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() and not threaded else "spawn")
             if ctx.get_start_method() == "fork":  # fill the per-process caches once, before the workers copy them
                 rays_from_origin(Intrinsics.realsense_d435(int(width), int(height)))
             with ctx.Pool(n_workers) as pool:

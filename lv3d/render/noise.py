@@ -134,12 +134,14 @@ def noisy_color(color: np.ndarray, cfg: NoiseConfig, rng: np.random.Generator) -
     """Apply colour nuisances (exposure, blur, sensor noise, JPEG) to an (H, W, 3) float image in 0..255;
     returns uint8 RGB."""
     img = color.astype(np.float32, copy=False)
-    if cfg.exposure > 0:
-        img = img * np.float32(np.exp(rng.normal(0.0, cfg.exposure)))
+    gain = float(np.exp(rng.normal(0.0, cfg.exposure))) if cfg.exposure > 0 else 1.0
     if cfg.blur_px > 0:
         s = cfg.blur_px * img.shape[1] / 640.0
         r = max(1, int(np.ceil(2.5 * s)))  # OpenCV's default kernel reaches 4 sigma: weights there are < 1e-3
-        img = cv2.GaussianBlur(img, (2 * r + 1, 2 * r + 1), s)
+        kernel = cv2.getGaussianKernel(2 * r + 1, s, cv2.CV_32F)
+        img = cv2.sepFilter2D(img, -1, kernel * np.float32(gain), kernel)  # blur and exposure in one pass
+    elif gain != 1.0:
+        img = img * np.float32(gain)
     # one pass: add the noise, round to nearest (ties to even, as np.round) and saturate to 0..255
     noise = gaussian(img.shape, rng, cfg.color_sigma) if cfg.color_sigma > 0 else np.zeros_like(img)
     out = cv2.add(img, noise, dtype=cv2.CV_8U)

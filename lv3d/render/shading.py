@@ -74,32 +74,42 @@ def _coords(hits: Hits, idx: np.ndarray, cam_to_frame: np.ndarray, n: int = 3) -
     return tuple(z * (a[i, 0] * rx + a[i, 1] * ry + a[i, 2]) + a[i, 3] for i in range(n))
 
 
-class _HalfRes:
-    """Hit points on every second pixel in each direction, for the slowly varying textures: they are
-    computed on a quarter of the pixels and upsampled bilinearly (their wavelengths span many pixels)."""
+class _LowRes:
+    """Hit points on every ``step``-th pixel in each direction, for the slowly varying textures: they are
+    computed on a fraction of the pixels and upsampled bilinearly (their wavelengths span many pixels)."""
 
-    def __init__(self, hits: Hits):
+    def __init__(self, hits: Hits, step: int):
         self.shape = hits.depth.shape
-        self.z = hits.depth[::2, ::2]
-        self.rx, self.ry = (np.ascontiguousarray(c[::2, ::2]) for c in ray_planes(self.shape, hits.rays))
+        self.z = hits.depth[::step, ::step]
+        self.rx, self.ry = (np.ascontiguousarray(c[::step, ::step]) for c in ray_planes(self.shape, hits.rays))
 
     def coords(self, cam_to_frame: np.ndarray) -> tuple[np.ndarray, ...]:
-        """(x, y, z), each (H/2, W/2) float32 metres, in the frame ``cam_to_frame`` (4, 4) maps into."""
+        """(x, y, z), each (H/step, W/step) float32 metres, in the frame ``cam_to_frame`` (4, 4) maps into."""
         a = cam_to_frame.astype(np.float32)
         return tuple(self.z * (a[i, 0] * self.rx + a[i, 1] * self.ry + a[i, 2]) + a[i, 3] for i in range(3))
 
+    def plane_coords(self, cam_to_frame: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Like :meth:`coords`, but of the points where the rays meet the plane z = 0 of that frame
+        (not of what they hit): smooth across silhouettes, so upsampling blends nothing unrelated. Rays
+        that never meet the plane get the camera centre."""
+        a = cam_to_frame.astype(np.float32)
+        # z = 0 in the frame: a[2] . (t * ray) + a[2, 3] = 0
+        den = a[2, 0] * self.rx + a[2, 1] * self.ry + a[2, 2]
+        t = np.where(den * a[2, 3] < 0, -a[2, 3] / np.where(den == 0, np.float32(1), den), np.float32(0))
+        return tuple(t * (a[i, 0] * self.rx + a[i, 1] * self.ry + a[i, 2]) + a[i, 3] for i in range(3))
+
     def up(self, field: np.ndarray, idx: np.ndarray) -> np.ndarray:
-        """The half-resolution ``field`` upsampled to full resolution, at flat pixel indices ``idx``."""
+        """The low-resolution ``field`` upsampled to full resolution, at flat pixel indices ``idx``."""
         h, w = self.shape
         return cv2.resize(field, (w, h), interpolation=cv2.INTER_LINEAR).ravel()[idx]
 
 
-def _table(hits: Hits, half: _HalfRes, idx: np.ndarray, cam_to_table: np.ndarray, cfg: NoiseConfig,
+def _table(hits: Hits, low: _LowRes, idx: np.ndarray, cam_to_table: np.ndarray, cfg: NoiseConfig,
            rng: np.random.Generator) -> np.ndarray:
     """Texture factor (m,) of the table at flat pixel indices ``idx``: wood grain and painted lines."""
     f32 = np.float32
-    xh, yh, _ = half.coords(cam_to_table)
-    warp = half.up(wood_warp(xh, yh, rng), idx)
+    xl, yl, _ = low.plane_coords(cam_to_table)  # the table top's plane
+    warp = low.up(wood_warp(xl, yl, rng), idx)
     xt, yt = _coords(hits, idx, cam_to_table, 2)
     m = f32(1.0) - f32(cfg.table_grain) * wood_grain(yt, warp, rng)
     for _ in range(cfg.distractor_lines):
@@ -131,8 +141,8 @@ def shade(hits: Hits, layout: Layout, roles: list[str], albedo: list[np.ndarray]
     body = hits.body.ravel()
     w2c = layout.world_to_camera
     c2w = np.linalg.inv(w2c)
-    half = _HalfRes(hits)
-    half_world = half.coords(c2w)
+    half = _LowRes(hits, 2)  # blotches: 2-8 cm, also on the solids up close
+    quarter = _LowRes(hits, 4)  # wood warp (>= 3 cm, on the table) and the wall's shading (>= 0.5 m)
     for i, role in enumerate(roles):
         if role not in ("floor", "wall", "table"):
             continue
@@ -141,14 +151,14 @@ def shade(hits: Hits, layout: Layout, roles: list[str], albedo: list[np.ndarray]
             x, y = _coords(hits, idx, c2w, 2)
             mod[idx] = f32(0.9) + f32(0.1) * ((np.floor(x / f32(0.3)) + np.floor(y / f32(0.3))) % 2)
         elif role == "wall":
-            x, y, z = half_world
-            mod[idx] = f32(0.95) + f32(0.05) * half.up(_wavy(x + y, z, rng, 2, (0.5, 2.0)), idx)
+            x, y, z = quarter.coords(c2w)
+            mod[idx] = f32(0.95) + f32(0.05) * quarter.up(_wavy(x + y, z, rng, 2, (0.5, 2.0)), idx)
         else:
-            mod[idx] = _table(hits, half, idx, np.linalg.inv(w2c @ layout.table_to_world), cfg, rng)
+            mod[idx] = _table(hits, quarter, idx, np.linalg.inv(w2c @ layout.table_to_world), cfg, rng)
     if cfg.texture > 0:  # on the table and the solids (roles after the background)
         first_solid = next(i for i, r in enumerate(roles) if r not in ("table", "floor", "wall"))
         idx = np.flatnonzero((body >= first_solid) | (body == roles.index("table")))
-        x, y, z = half_world
+        x, y, z = half.coords(c2w)
         blotch = f32(0.5) + f32(0.5) * np.tanh(f32(1.5) * _wavy(x + f32(0.7) * z, y - f32(0.5) * z, rng, 4,
                                                                  (0.02, 0.08)))
         mod[idx] *= f32(1.0) - f32(cfg.texture) * half.up(blotch, idx)

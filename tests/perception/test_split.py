@@ -41,3 +41,16 @@ def test_a_corner_traced_as_two_goes_back_to_one():
     assert np.abs(out - np.array([0.0, 100.0])).sum(axis=1).min() < 1e-9
     pentagon = np.array([[50.0, 0.0], [100.0, 36.0], [81.0, 95.0], [19.0, 95.0], [0.0, 36.0]])
     assert len(drop_short_sides(pentagon)) == 5  # real sides stay
+
+
+def test_fused_face_keeps_the_colour_outline_only_where_the_depth_one_just_lost_a_corner():
+    from lv3d.perception.perceive import _pick_polygon
+    from lv3d.perception.polygons import rasterize
+
+    off = np.zeros(2)
+    triangle = np.array([[50.0, 10.0], [90.0, 90.0], [10.0, 90.0]])
+    cut_apex = np.array([[46.0, 18.0], [54.0, 18.0], [90.0, 90.0], [10.0, 90.0]])  # depth: tip cut off
+    assert _pick_polygon(triangle, cut_apex, rasterize(triangle, (100, 100)), off) is triangle
+    merged = np.array([[10.0, 10.0], [90.0, 10.0], [90.0, 90.0]])  # colour reaching over the neighbour
+    own = np.array([[10.0, 10.0], [90.0, 10.0], [90.0, 30.0], [30.0, 30.0]])
+    assert _pick_polygon(merged, own, rasterize(merged, (100, 100)), off) is own
