@@ -87,13 +87,16 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
                 planes: list[np.ndarray | None] | None = None, points: list[np.ndarray | None] | None = None,
                 use_edges: list[bool] | None = None, edge_support: list[float | None] | None = None,
                 adjacency: list[tuple[int, int]] = (), support_plane: np.ndarray | None = None,
-                merge_px: float = 6.0, boundary_sigma_px: float = 2.0, free_sigma_px: float = 20.0) -> tuple[ObjectProblem, np.ndarray]:
+                merge_px: float = 6.0, boundary_sigma_px: float = 2.0, free_sigma_px: float = 20.0,
+                gate_m: float = 0.015) -> tuple[ObjectProblem, np.ndarray]:
     """Pad one object's faces into an :class:`ObjectProblem` (numpy, outside jit).
 
     ``polygons``: per face an (n, 2) array of pixel vertices in order (3 <= n <= MAX_SIDES).
     Vertices of different faces closer than ``merge_px`` become one shared vertex (greedy, in order).
     ``planes``: per face (4,) (n, d) or None; ``points``: per face (m, 3) camera-frame metres or None
-    (more than MAX_POINTS are merged into weighted cell means, see ``_compress``).
+    (more than MAX_POINTS are merged into weighted cell means, see ``_compress``; before that, points
+    farther than ``gate_m`` from the first-guess plane are dropped, since a cell mean would hide them
+    from the robust loss).
     ``use_edges``: per face whether an edge field guides its sides (default all True); a vertex that
     no edge-guided face uses keeps the prior spread ``boundary_sigma_px`` (perception's own error),
     the others a weak ``free_sigma_px``. Returns the problem and the (F, S) map from each face's
@@ -145,7 +148,11 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
         if planes[f] is not None and points[f] is not None and len(points[f]) >= 3:
             plane_arr[f] = np.asarray(planes[f], np.float64)
             has_plane[f] = True
-            p, w = _compress(np.asarray(points[f], np.float64), MAX_POINTS, intrinsics)
+            p = np.asarray(points[f], np.float64)
+            if len(p) > MAX_POINTS:
+                near = np.abs(p @ plane_arr[f, :3] + plane_arr[f, 3]) <= gate_m
+                p = p[near] if near.sum() >= 3 else p
+            p, w = _compress(p, MAX_POINTS, intrinsics)
             pts[f, : len(p)] = p
             pw[f, : len(p)] = w
             pivots[f] = (p * w[:, None]).sum(0) / w.sum()

@@ -53,15 +53,22 @@ def _simplify(poly: np.ndarray, max_sides: int) -> np.ndarray:
     return poly
 
 
-def edge_field(frame: RGBD, modality: str) -> np.ndarray:
+def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px: float = 24.0) -> np.ndarray:
     """The edge-distance field a system that sees ``modality`` may use: colour edges for rgb and rgbd,
-    edges of the depth image's surface normals and depth steps for depth."""
+    edges of the depth image's surface normals and depth steps for depth. With ``scene``, only the box
+    around its polygons (plus ``margin_px``) is computed."""
     import grounding
 
+    roi = None
+    if scene is not None:
+        polys = [np.asarray(f.polygon, float).reshape(-1, 2) for o in scene.objects for f in o.faces if len(f.polygon)]
+        if polys:
+            allp = np.concatenate(polys)
+            roi = (*(allp.min(0) - margin_px), *(allp.max(0) + margin_px))
     if modality == "depth":
         k = frame.intrinsics
-        return grounding.normal_edge_field(frame.depth, (k.fx, k.fy, k.cx, k.cy))
-    return grounding.edge_distance_field(frame.color)
+        return grounding.normal_edge_field(frame.depth, (k.fx, k.fy, k.cx, k.cy), roi=roi)
+    return grounding.edge_distance_field(frame.color, roi=roi)
 
 
 def _chunks(faces: list[Face], size: int) -> list[list[Face]]:
@@ -78,7 +85,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     k = scene.intrinsics
     intr = (k.fx, k.fy, k.cx, k.cy)
     if field is None:
-        field = edge_field(frame, scene.modality)
+        field = edge_field(frame, scene.modality, scene)
     field_j = jnp.asarray(field, jnp.float32)
     support = None if scene.support_plane is None else np.r_[scene.support_plane.n, scene.support_plane.offset]
     cands: list[tuple[str, tuple[str, ...], float, float | None]] = []

@@ -73,11 +73,11 @@ def _convex(poly: np.ndarray) -> bool:
 
 def snap_polygon(poly: np.ndarray, plane: Plane, others: list[Plane], k: Intrinsics, near_m: float,
                  max_move_px: float = 14.0, short_frac: float = 0.2) -> np.ndarray:
-    """``poly`` (n, 2) pixels, the traced outline of the face on ``plane``, with its sides that run within
-    ``near_m`` metres (both ends, in 3D on ``plane``) of one of ``others`` (neighbour and support planes) moved
-    onto that intersection line, sides shorter than ``short_frac`` of the mean side dropped, and corners
-    recomputed. Returns the input when the result is not convex or moves a corner more than ``max_move_px`` plus a
-    tenth of the face's size (square root of its area, px)."""
+    """``poly`` (n, 2) pixels, the traced outline of the face on ``plane``, with each side whose two ends lie on
+    average within ``near_m`` metres (in 3D, on ``plane``) of one of ``others`` (neighbour and support planes)
+    moved onto that intersection line, unsnapped sides shorter than ``short_frac`` of the mean side dropped, and
+    the corners recomputed. Returns the input when the result is not convex or moves a corner more than
+    ``max_move_px`` plus a tenth of the face's size (square root of its area, px). ``k``: the camera."""
     n = len(poly)
     if n < 3:
         return poly
