@@ -11,6 +11,7 @@ from ._field import normal_edge_field as normal_edge_field
 from ._ground import Grounding as Grounding
 from ._ground import fit_plane as fit_plane
 from ._ground import ground_object as ground_object
+from ._ground import ground_objects as ground_objects
 from ._ground import refine_polygon as refine_polygon
 from ._problem import MAX_FACES as MAX_FACES
 from ._problem import MAX_POINTS as MAX_POINTS

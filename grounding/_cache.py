@@ -1,11 +1,14 @@
-"""Persistent XLA compilation cache, so that a new process reuses the programs an earlier one compiled."""
+"""Persistent caches, so that a new process reuses the programs an earlier one traced and compiled."""
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import os
 from pathlib import Path
 
 import jax
+import numpy as np
 
 _enabled: Path | None = None
 
@@ -32,3 +35,71 @@ def enable_cache(path: str | os.PathLike | None = None) -> Path:
     jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
     _enabled = path
     return path
+
+
+_programs: dict[str, object] = {}
+
+try:  # jax.export needs flatbuffers to serialise; without it programs are traced once per process
+    import flatbuffers  # noqa: F401
+
+    _CAN_SAVE = True
+except ImportError:
+    _CAN_SAVE = False
+
+
+@functools.cache
+def _source_digest() -> str:
+    """Digest of this package's sources: a saved program is reused only by the code that wrote it."""
+    h = hashlib.sha256(jax.__version__.encode())
+    for p in sorted(Path(__file__).parent.glob("*.py")):
+        h.update(p.name.encode())
+        h.update(p.read_bytes())
+    return h.hexdigest()
+
+
+def _leaf(x):
+    """A pytree leaf as an array of a fixed dtype (Python scalars become float32 / int32 / bool)."""
+    if isinstance(x, bool):
+        return np.asarray(x, np.bool_)
+    if isinstance(x, int):
+        return np.asarray(x, np.int32)
+    if isinstance(x, float):
+        return np.asarray(x, np.float32)
+    return x
+
+
+def call_saved(name: str, fn, args: tuple) -> list:
+    """``jax.tree.leaves(fn(*args))``, through a program traced once and kept on disk.
+
+    Tracing a program that holds an optimistix solver takes seconds, and JAX's compilation cache keeps
+    only what comes after tracing. So the traced program is exported (``jax.export``) to the cache
+    folder, keyed by the package's sources, the JAX version and the arguments' structure, shapes and
+    dtypes; a new process deserialises it instead of tracing, and its compilation comes from the
+    persistent cache. Without :func:`enable_cache`, or without the ``flatbuffers`` package that
+    serialisation needs, the program is traced once per process and not saved.
+    """
+    leaves, treedef = jax.tree.flatten(args)
+    leaves = [_leaf(x) for x in leaves]
+    spec = [(tuple(np.shape(x)), str(x.dtype)) for x in leaves]
+    key = hashlib.sha256(f"{name}|{_source_digest()}|{treedef}|{spec}".encode()).hexdigest()[:24]
+    call = _programs.get(key)
+    if call is None and not (_CAN_SAVE and _enabled is not None):
+        def flat_jit(*lv):
+            return jax.tree.leaves(fn(*jax.tree.unflatten(treedef, lv)))
+
+        call = _programs[key] = jax.jit(flat_jit)
+    if call is None:
+        path = _enabled / f"{name}-{key}.jaxexport"
+        if path.is_file():
+            exp = jax.export.deserialize(bytearray(path.read_bytes()))
+        else:
+            def flat(*lv):
+                return jax.tree.leaves(fn(*jax.tree.unflatten(treedef, lv)))
+
+            exp = jax.export.export(jax.jit(flat))(*[jax.ShapeDtypeStruct(np.shape(x), x.dtype) for x in leaves])
+            tmp = path.with_suffix(f".tmp{os.getpid()}")
+            tmp.write_bytes(exp.serialize())
+            tmp.replace(path)  # atomic: a concurrent reader sees the whole file or none
+        call = jax.jit(exp.call)
+        _programs[key] = call
+    return call(*leaves)

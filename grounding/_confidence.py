@@ -29,7 +29,7 @@ PLANE_ANGLE_DEG = 10.0       # horizontal, vertical, parallel: within this of th
 ACUTE_BELOW_DEG = 80.0       # acute: interior dihedral below this
 OBTUSE_ABOVE_DEG = 100.0     # obtuse: interior dihedral above this
 SUPPORT_FULL = 0.75          # side-count facts: edge support at or above this costs no confidence
-MC_DRAWS = 512
+MC_DRAWS = 256
 
 
 class Floors(eqx.Module):

@@ -3,12 +3,15 @@ single polygon or a single plane."""
 
 from __future__ import annotations
 
+from dataclasses import fields
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Bool, Float, Int
 
+from ._cache import call_saved
 from ._confidence import Confidences, Floors, confidences
 from ._joint import edge_distances, edge_mask, geometry, solve
 from ._plane import OFFSET_UNIT_M, TILT_UNIT
@@ -30,14 +33,38 @@ class Grounding(eqx.Module):
     conf: Confidences
 
 
-@jax.jit
-def ground_object(prob: ObjectProblem, field: Float[Array, "H W"], refine: Bool[Array, ""] = True,
+def ground_object(prob: ObjectProblem, field: Float[Array, "H W"], refine: bool = True,
                   settings: Settings = Settings(), floors: Floors = Floors()) -> Grounding:
     """Refine one object (when ``refine``), then compute covariances and predicate probabilities.
 
     ``field``: edge-distance field (pixels), e.g. :func:`grounding.edge_distance_field` of the colour
     image. With ``refine=False`` the first guess is kept and its uncertainty is computed all the same.
+    One compiled program per field size serves every object; it is traced once and kept on disk when
+    :func:`grounding.enable_cache` is on.
     """
+    leaves = call_saved("ground_object", _ground_object, (prob, jnp.asarray(field, jnp.float32), bool(refine),
+                                                          settings, floors))
+    return jax.tree.unflatten(_out_structure(), leaves)
+
+
+def ground_objects(probs: list[ObjectProblem], field: Float[Array, "H W"], refine: bool = True,
+                   settings: Settings = Settings(), floors: Floors = Floors()) -> list[Grounding]:
+    """:func:`ground_object` for each object of one frame; results hold numpy arrays. (One call per
+    object: a vmapped batch was measured slower on the CPU, as the batched solver runs every member for
+    as many steps as the slowest needs.)"""
+    field = jnp.asarray(field, jnp.float32)
+    return [jax.tree.map(np.asarray, ground_object(p, field, refine, settings, floors)) for p in probs]
+
+
+def _out_structure():
+    """The pytree structure of a :class:`Grounding`, built without tracing anything."""
+    q = Quantities(*[0] * len(fields(Quantities)))
+    c = Confidences(*[0] * len(fields(Confidences)))
+    return jax.tree.structure(Grounding(*[0] * 6, q, q, c))
+
+
+def _ground_object(prob: ObjectProblem, field: Float[Array, "H W"], refine: Bool[Array, ""],
+                   settings: Settings, floors: Floors) -> Grounding:
     params, status = solve(prob, field, settings, jnp.asarray(refine))
     cov, scale2 = param_covariance(params, prob, field, settings)
     q, jq, std = propagate(params, prob, cov)

@@ -18,7 +18,7 @@ from jaxtyping import Array, Bool, Float, Int
 MAX_FACES = 6
 MAX_SIDES = 8
 MAX_VERTICES = 24
-MAX_POINTS = 128
+MAX_POINTS = 64
 MAX_LINKS = 24
 EDGE_SAMPLES = 12  # points sampled along each polygon edge
 

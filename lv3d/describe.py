@@ -79,29 +79,23 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     """Ground every object of ``scene``: (candidate facts with their probabilities, before any is dropped;
     per-object results). Candidates are ``(pred, args, probability, value)``."""
     import grounding
-    import jax.numpy as jnp
 
     grounding.enable_cache()
     k = scene.intrinsics
     intr = (k.fx, k.fy, k.cx, k.cy)
     if field is None:
         field = edge_field(frame, scene.modality, scene)
-    field_j = jnp.asarray(field, jnp.float32)
     support = None if scene.support_plane is None else np.r_[scene.support_plane.n, scene.support_plane.offset]
     cands: list[tuple[str, tuple[str, ...], float, float | None]] = []
     results: list[ObjectResult] = []
-    for obj in scene.objects:
+    # pack every object (in chunks of MAX_FACES faces), ground them all in batched calls, then read facts
+    jobs = []
+    for oi, obj in enumerate(scene.objects):
         usable = [f for f in obj.faces if len(f.polygon) >= 3]
-        face_conf: dict[str, float] = {}
-        face_results: list[FaceResult] = []
-        dihedrals: dict[tuple[str, str], float] = {}
-        raw: list[tuple[list[str], dict]] = []
-        status = 0
         for chunk in _chunks(usable, grounding.MAX_FACES):
             if not chunk:
                 continue
-            ids = [f.id for f in chunk]
-            pos = {fid: i for i, fid in enumerate(ids)}
+            pos = {f.id: i for i, f in enumerate(chunk)}
             polys = [_simplify(f.polygon, grounding.MAX_SIDES) for f in chunk]
             has_plane = [f.plane is not None and f.points is not None and len(f.points) >= 3 for f in chunk]
             prob, index = grounding.pack_object(
@@ -110,9 +104,19 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 points=[f.points if hp else None for f, hp in zip(chunk, has_plane)],
                 adjacency=[(pos[a], pos[b]) for a, b in obj.adjacency if a in pos and b in pos],
                 support_plane=support)
-            g = grounding.ground_object(prob, field_j, refine)
+            jobs.append((oi, chunk, polys, has_plane, index, prob))
+    grounded = grounding.ground_objects([j[5] for j in jobs], field, refine) if jobs else []
+    for oi, obj in enumerate(scene.objects):
+        face_conf: dict[str, float] = {}
+        face_results: list[FaceResult] = []
+        dihedrals: dict[tuple[str, str], float] = {}
+        raw: list[tuple[list[str], dict]] = []
+        status = 0
+        for (oj, chunk, polys, has_plane, index, _), g in zip(jobs, grounded):
+            if oj != oi:
+                continue
             g = _to_numpy(g)
-            raw.append((ids, g))
+            raw.append(([f.id for f in chunk], g))
             status = max(status, int(g["status"]))
             c = g["conf"]
             for i, f in enumerate(chunk):

@@ -1,0 +1,96 @@
+"""Per-class binary and multi-class accuracy of lv3d on a DEV set, per modality, beside the targets (issue 6).
+
+    .venv/bin/python benchmarks/dev_facts.py --preset clean --seed 777 --out /work/runs/dev_clean
+    .venv/bin/python benchmarks/dev_facts.py --preset realsense --seed 778 --out /work/runs/dev_realsense
+    .venv/bin/python benchmarks/bench_pipeline_accuracy.py /work/runs/dev_clean /work/runs/dev_realsense
+
+The study's protocol on a smaller DEV set (never the study's data): stratified folds, per class task
+positives + 1.5 negatives per positive spread over the other classes, a multi-class task, tested on
+the held-out fold; the figure is the mean over folds. ``--facts truth`` learns from ground-truth facts
+instead (the learner's ceiling). ``--explain`` prints the programs learned and the misclassified scenes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import pickle
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stratified_folds  # noqa: E402
+from lv3d.experiment.runner import score_binary  # noqa: E402
+from lv3d.experiment.systems import LogicSystem, negative_label  # noqa: E402
+
+TARGETS = {"clean": 0.95, "realsense": 0.85}
+
+
+def evaluate(data: dict, folds: int, positives: int, seed: int, settings: dict, explain: bool) -> dict:
+    """{task: [accuracy per fold]} for the scenes ``data`` (id -> (label, SceneFacts))."""
+    items = [Item(i, y, i) for i, (y, _) in sorted(data.items())]
+    facts = {i: f for i, (_, f) in data.items()}
+    classes = sorted({it.cls for it in items})
+    system = LogicSystem("lv3d", facts, settings)
+    out: dict = {}
+    for k, fold in enumerate(stratified_folds(items, folds, seed)):
+        train, test = split(stratified_folds(items, folds, seed), k)
+        ids = [it.id for it in test]
+        for j, cls in enumerate(classes):
+            ex, positive = class_task(train, cls, positives, 1.5, seed + 10 * k + j)
+            fitted = system.fit([it.id for it in ex], [cls if p else negative_label(cls) for p in positive],
+                                seed, positive=cls)
+            preds = fitted.predict(ids)
+            out.setdefault(cls, []).append(score_binary(preds, test, cls)["accuracy"])
+            if explain:
+                prog = fitted.model.programs.get(cls)
+                print(f"  fold {k} {cls}: " + (" | ".join(prog.clauses).replace("\n", " ") if prog else
+                                               f"no program {fitted.model.failures}"), prog.score if prog else "")
+                for (lab, conf), it in zip(preds, test):
+                    if (lab == cls) != (it.cls == cls):
+                        print(f"     wrong {it.id} {it.cls} -> {lab} {conf:.2f}")
+        ex = multiclass_task(train, positives, seed + 10 * k + 9)
+        fitted = system.fit([it.id for it in ex], [it.cls for it in ex], seed)
+        preds = fitted.predict(ids)
+        out.setdefault("multiclass", []).append(float(np.mean([p == it.cls for (p, _), it in zip(preds, test)])))
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("dev", nargs="+", type=Path, help="DEV data sets written by benchmarks/dev_facts.py")
+    ap.add_argument("--modalities", default="rgbd,depth,rgb")
+    ap.add_argument("--facts", choices=("pipeline", "truth"), default="pipeline")
+    ap.add_argument("--folds", type=int, default=3)
+    ap.add_argument("--positives", type=int, default=20)
+    ap.add_argument("--seed", type=int, default=5)
+    ap.add_argument("--explain", action="store_true")
+    ap.add_argument("--set", action="append", default=[], help="learner setting name=value (Python literal)")
+    a = ap.parse_args()
+    import ast
+    settings = {k: ast.literal_eval(v) for k, v in (s.split("=", 1) for s in a.set)}
+    for dev in a.dev:
+        preset = "realsense" if "realsense" in dev.name else "clean"
+        target = TARGETS[preset]
+        print(f"== {dev} ({preset}; facts: {a.facts}; target rgbd mean >= {target:.2f}, rgbd >= rgb, depth)")
+        rows = {}
+        for mod in a.modalities.split(","):
+            raw = pickle.loads((dev / f"facts_{mod}.pkl").read_bytes())
+            col = 1 if a.facts == "pipeline" else 2
+            data = {i: (v[0], v[col]) for i, v in raw.items() if v[col] is not None}
+            if a.explain:
+                print(f" -- {mod}")
+            rows[mod] = evaluate(data, a.folds, a.positives, a.seed, settings, a.explain)
+        tasks = list(next(iter(rows.values())))
+        print(f"{'modality':9s}" + "".join(f"{t[:16]:>18s}" for t in tasks) + f"{'mean':>8s}")
+        for mod, r in rows.items():
+            means = [float(np.mean(r[t])) for t in tasks]
+            flag = "" if mod != "rgbd" else ("  ok" if np.mean(means) >= target else f"  < target {target}")
+            print(f"{mod:9s}" + "".join(f"{m:10.3f} [{min(r[t]):.2f}-{max(r[t]):.2f}]" for m, t in zip(means, tasks))
+                  + f"{np.mean(means):8.3f}{flag}")
+
+
+if __name__ == "__main__":
+    main()
