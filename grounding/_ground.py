@@ -3,6 +3,7 @@ single polygon or a single plane."""
 
 from __future__ import annotations
 
+import functools
 from dataclasses import fields
 
 import equinox as eqx
@@ -56,6 +57,7 @@ def ground_objects(probs: list[ObjectProblem], field: Float[Array, "H W"], refin
     return [jax.tree.map(np.asarray, ground_object(p, field, refine, settings, floors)) for p in probs]
 
 
+@functools.cache
 def _out_structure():
     """The pytree structure of a :class:`Grounding`, built without tracing anything."""
     q = Quantities(*[0] * len(fields(Quantities)))

@@ -53,32 +53,81 @@ def _simplify(poly: np.ndarray, max_sides: int) -> np.ndarray:
     return poly
 
 
+def _boxes(scene: Scene, margin_px: float, only: SceneObject | None = None) -> list[tuple[float, float, float, float]]:
+    """Boxes (u0, v0, u1, v1) around each object's polygons (or ``only``'s) plus ``margin_px``, overlapping
+    ones merged: the field is needed only near the sides that are sampled, and one box around objects
+    spread over the frame would cover most of it."""
+    boxes = []
+    for o in scene.objects if only is None else [only]:
+        polys = [np.asarray(f.polygon, float).reshape(-1, 2) for f in o.faces if len(f.polygon)]
+        if polys:
+            p = np.concatenate(polys)
+            boxes.append([*(p.min(0) - margin_px), *(p.max(0) + margin_px)])
+    merged = True
+    while merged:  # merge until no two boxes overlap, so each pixel is computed once with its full context
+        merged = False
+        for i in range(len(boxes)):
+            for j in range(i + 1, len(boxes)):
+                a, b = boxes[i], boxes[j]
+                if a[0] <= b[2] and b[0] <= a[2] and a[1] <= b[3] and b[1] <= a[3]:
+                    boxes[i] = [min(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3])]
+                    del boxes[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return [tuple(b) for b in boxes]
+
+
 def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px: float = 24.0) -> np.ndarray:
-    """The edge-distance field a system that sees ``modality`` may use: colour edges for rgb and rgbd,
-    edges of the depth image's surface normals and depth steps for depth. With ``scene``, only the box
-    around its polygons (plus ``margin_px``) is computed."""
+    """The edge-distance field (H, W) float32 pixels a system that sees ``modality`` may use: colour edges
+    for rgb and rgbd, edges of the depth image's surface normals and depth steps for depth. With ``scene``,
+    only the boxes around its objects' polygons (plus ``margin_px``) are computed; the rest is the cap."""
     import grounding
 
-    roi = None
-    if scene is not None:
-        polys = [np.asarray(f.polygon, float).reshape(-1, 2) for o in scene.objects for f in o.faces if len(f.polygon)]
-        if polys:
-            allp = np.concatenate(polys)
-            roi = (*(allp.min(0) - margin_px), *(allp.max(0) + margin_px))
-    if modality == "depth":
-        k = frame.intrinsics
-        return grounding.normal_edge_field(frame.depth, (k.fx, k.fy, k.cx, k.cy), roi=roi)
-    return grounding.edge_distance_field(frame.color, roi=roi)
+    k = frame.intrinsics
+
+    def one(roi):
+        if modality == "depth":
+            return grounding.normal_edge_field(frame.depth, (k.fx, k.fy, k.cx, k.cy), roi=roi)
+        return grounding.edge_distance_field(frame.color, roi=roi)
+
+    boxes = _boxes(scene, margin_px) if scene is not None else []
+    if modality == "depth" or len(boxes) <= 1:
+        # the depth field smooths the whole image anyway; one box needs no stitching
+        if scene is None or not boxes:
+            return one(None)
+        if len(boxes) == 1 or modality == "depth":
+            b = np.array(boxes)
+            return one((*b[:, :2].min(0), *b[:, 2:].max(0)))
+    h, w = frame.color.shape[:2]
+    out = None
+    for b in boxes:
+        u0, v0 = max(0, int(b[0])), max(0, int(b[1]))
+        u1, v1 = min(w, int(np.ceil(b[2]))), min(h, int(np.ceil(b[3])))
+        part = one(b)
+        if out is None:
+            out = part
+        else:
+            out[v0:v1, u0:u1] = part[v0:v1, u0:u1]
+    return out
 
 
 def _chunks(faces: list[Face], size: int) -> list[list[Face]]:
     return [faces[i: i + size] for i in range(0, len(faces), size)] or [[]]
 
 
-def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray | None = None):
+def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray | None = None,
+           refine_all: bool = False):
     """Ground every object of ``scene``: (candidate facts with their probabilities, before any is dropped;
-    per-object results). Candidates are ``(pred, args, probability, value)``."""
+    per-object results). Candidates are ``(pred, args, probability, value)``.
+
+    With ``refine``, only the scene's target object (:meth:`Scene.target`, the one a label speaks of) is
+    refined unless ``refine_all``: the others keep perception's geometry, and their facts still get
+    confidences from its Laplace covariance (the solver is three quarters of an object's cost)."""
     import grounding
+    import jax
+    import jax.numpy as jnp
 
     grounding.enable_cache()
     k = scene.intrinsics
@@ -90,6 +139,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     results: list[ObjectResult] = []
     # pack every object (in chunks of MAX_FACES faces), ground them all in batched calls, then read facts
     jobs = []
+    target = scene.target()
     for oi, obj in enumerate(scene.objects):
         usable = [f for f in obj.faces if len(f.polygon) >= 3]
         for chunk in _chunks(usable, grounding.MAX_FACES):
@@ -104,15 +154,16 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 points=[f.points if hp else None for f, hp in zip(chunk, has_plane)],
                 adjacency=[(pos[a], pos[b]) for a, b in obj.adjacency if a in pos and b in pos],
                 support_plane=support)
-            jobs.append((oi, chunk, polys, has_plane, index, prob))
-    grounded = grounding.ground_objects([j[5] for j in jobs], field, refine) if jobs else []
+            jobs.append((oi, chunk, polys, has_plane, index, prob, refine and (refine_all or obj is target)))
+    field = jnp.asarray(field, jnp.float32)  # moved to the device once for every object
+    grounded = [jax.tree.map(np.asarray, grounding.ground_object(j[5], field, j[6])) for j in jobs]
     for oi, obj in enumerate(scene.objects):
         face_conf: dict[str, float] = {}
         face_results: list[FaceResult] = []
         dihedrals: dict[tuple[str, str], float] = {}
         raw: list[tuple[list[str], dict]] = []
         status = 0
-        for (oj, chunk, polys, has_plane, index, _), g in zip(jobs, grounded):
+        for (oj, chunk, polys, has_plane, index, _, _), g in zip(jobs, grounded):
             if oj != oi:
                 continue
             g = _to_numpy(g)

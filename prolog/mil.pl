@@ -43,6 +43,7 @@ default(sample_pos(2)).         % positives per sample
 default(sample_neg(12)).        % negatives per sample
 default(solutions(200)).        % hypotheses kept per sample (smallest size found)
 default(clause_penalty(0.02)).  % score lost per clause (Occam), see docs/learner.md
+default(disjunctions(0)).       % learn_noisy: pair this many best one-clause hypotheses (0: off)
 default(seed(0)).
 
 %!  metarule(?Name, ?Subs, ?Head, ?Body) is nondet.  The library of metarules; the first element
@@ -106,7 +107,40 @@ learn_noisy(Task, Settings0, Best, Score) :-
                            literal_cost(Ctx, Prog, Cost), NCost is -Cost, NOrder is -Order,
                            Key = k(J, Soft, W, NCost, NOrder)), Scored),
     Scored \== [],
-    max_member(_-(Best-Score), Scored).
+    option(disjunctions(KD), Settings),
+    disjunctions(Ctx, Lambda, KD, Pos, Neg, Scored, Pairs),
+    append(Scored, Pairs, All),
+    max_member(_-(Best-Score), All).
+
+%   Two-clause programs: one view of a solid seldom shows every pose's evidence (a triangular prism
+%   lying on a side shows no triangle), and a sample of two positives rarely needs two clauses, so
+%   the search seldom proposes them.  The KD best one-clause, non-recursive hypotheses are paired;
+%   a pair proves what either clause proves, so its best confidence per example is the larger of
+%   the two, and it is scored like any program (its second clause pays clause_penalty).  Support
+%   is the sum of the two clauses' supports and cost the sum of their literal costs.
+disjunctions(_, _, 0, _, _, _, []) :- !.
+disjunctions(Ctx, Lambda, KD, Pos, Neg, Scored, Pairs) :-
+    ctx(Ctx, targets, Ts),
+    include(single_clause(Ts), Scored, Singles),
+    sort(1, @>=, Singles, Ranked),
+    findall(h(Prog, CP, CN, W, C, O),
+            ( limit(KD, member(k(_, _, W, C, O)-(Prog-_), Ranked)),
+              maplist(best_conf(Ctx, Prog), Pos, CP), maplist(best_conf(Ctx, Prog), Neg, CN) ), Hs),
+    length(Pos, NP), length(Neg, NN),
+    findall(k(J, Soft, W, NC, NO)-(Prog-score(J, Soft, TP/NP, FP/NN)),
+            ( append(_, [h(P1, CP1, CN1, W1, C1, O1)|Rest], Hs), member(h(P2, CP2, CN2, W2, C2, O2), Rest),
+              maplist(max_of, CP1, CP2, CP), maplist(max_of, CN1, CN2, CN),
+              include(<(0), CP, TPs), include(<(0), CN, FPs), length(TPs, TP), length(FPs, FP),
+              rate(TP, NP, TPR), rate(FP, NN, FPR), mean(CP, MP), mean(CN, MN),
+              J is TPR - FPR - 2 * Lambda, Soft is MP - MN,
+              W is W1 + W2, NC is C1 + C2, NO is min(O1, O2), append(P1, P2, Prog) ),
+            Pairs).
+
+single_clause(Ts, _-([sub(_, [P|Syms], _)]-_)) :-
+    memberchk(P/_, Ts),
+    \+ ( member(S, Syms), memberchk(S/_, Ts) ).
+
+max_of(A, B, C) :- C is max(A, B).
 
 %!  score(+Ctx, +Lambda, +Prog, +Pos, +Neg, -Score) is det.
 %   Score = score(J, Soft, TP/NPos, FP/NNeg): J = TP/NPos - FP/NNeg - Lambda * clauses

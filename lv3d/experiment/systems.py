@@ -97,7 +97,7 @@ class PixelSystem:
         else:
             settings = CNNSettings(epochs=b["epochs"], batch_size=b["batch_size"], lr=b["lr"],
                                    weight_decay=b["weight_decay"], augment=b["augment"], width=b["width"],
-                                   threads=b["threads"])
+                                   threads=b["threads"], patience=b["patience"], val_fraction=b["val_fraction"])
             model = CNNClassifier(self.modality, "twostream" if self.name.endswith("-2s") else "early", settings)
         model.fit(self._x(ids), labels, seed=seed)
         return FittedPixels(model, self)

@@ -138,11 +138,13 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
                  if a in plane_face and b in plane_face}
         pairs |= {tuple(sorted((colour_face[a], colour_face[b]))) for a, b in res.adjacency
                   if a in colour_face and b in colour_face}
+        keep = _reliable(faces)
+        pairs = {(a, b) for a, b in pairs if a in keep and b in keep}
         # stable ids: faces largest first
-        order = sorted(range(len(faces)), key=lambda i: (-area(faces[i].polygon), float(faces[i].polygon[0, 0])))
+        order = sorted(keep, key=lambda i: (-area(faces[i].polygon), float(faces[i].polygon[0, 0])))
         rank = {i: r for r, i in enumerate(order)}
-        for i, f in enumerate(faces):
-            f.id = face_id(scene_id, k, rank[i] + 1)
+        for i in order:
+            faces[i].id = face_id(scene_id, k, rank[i] + 1)
         faces = [faces[i] for i in order]
         adj = sorted((min(faces[rank[a]].id, faces[rank[b]].id), max(faces[rank[a]].id, faces[rank[b]].id))
                      for a, b in pairs)
@@ -150,6 +152,22 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         out.append(SceneObject(object_id(scene_id, k), faces, adj, count, centroid))
         timings["fuse"] += (time.perf_counter() - t0) * 1e3
     return out
+
+
+# A face seen by one sensor only and small beside the object's faces is most often a face seen at a
+# grazing angle, cut into slivers whose outlines (a quadrilateral's two triangles) and missing plane
+# give wrong side counts; a solid's view keeps its large faces, which carry what the concept needs.
+_MIN_COLOUR_ONLY_FRACTION = 0.12   # of the object's total face area (px), colour face with no depth plane
+_MIN_DEPTH_ONLY_FRACTION = 0.05    # depth plane with no colour face
+
+
+def _reliable(faces: list[Face]) -> list[int]:
+    """Indices of the faces to keep: every face seen by both sensors, a one-sensor face only when it is not
+    small beside the others (fractions of the summed polygon areas above)."""
+    areas = [area(f.polygon) for f in faces]
+    total = max(sum(areas), 1e-9)
+    floor = {"rgb": _MIN_COLOUR_ONLY_FRACTION, "depth": _MIN_DEPTH_ONLY_FRACTION}
+    return [i for i, f in enumerate(faces) if areas[i] >= floor.get(f.provenance, 0.0) * total]
 
 
 def _inside(poly_px: np.ndarray, mask_px: np.ndarray) -> float:
