@@ -12,3 +12,16 @@ class InputError(Exception):
         self.where = str(where)
         self.problem = problem
         super().__init__(f"{self.where}: {problem}")
+
+
+def read_json(path: str | Path, what: str = "JSON file"):
+    """Parse the JSON file at ``path``; a missing or malformed file is an InputError naming it."""
+    import json
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(path, f"{what} not found")
+    try:
+        return json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise InputError(path, f"{what} is not valid JSON: {e}") from None

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -11,7 +10,7 @@ import cv2
 import numpy as np
 
 from .camera import Intrinsics
-from .errors import InputError
+from .errors import InputError, read_json
 
 
 @dataclass(frozen=True)
@@ -93,12 +92,7 @@ def read_intrinsics(path: Path, frame: str | None = None) -> tuple[Intrinsics, f
     """Intrinsics and depth scale from JSON. Accepts ``{"fx", "fy", "cx", "cy", "width", "height",
     "depth_scale_m"?}`` or the real-data layout ``{"width", "height", "frames": {name: {...}}}``."""
     path = Path(path)
-    if not path.is_file():
-        raise InputError(path, "intrinsics file not found")
-    try:
-        d = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise InputError(path, f"not valid JSON: {e}") from None
+    d = read_json(path, "intrinsics file")
     if not isinstance(d, dict):
         raise InputError(path, "intrinsics must be a JSON object")
     if "intrinsics" in d and isinstance(d["intrinsics"], dict):  # a data set's meta.json
@@ -116,13 +110,8 @@ def load_item(item_dir: Path) -> RGBD:
     """One item of an lv3d data set (color.png, depth.png, meta.json); ``meta`` holds the ground truth."""
     item_dir = Path(item_dir)
     meta_path = item_dir / "meta.json"
-    if not meta_path.is_file():
-        raise InputError(meta_path, "meta.json not found")
-    try:
-        meta = json.loads(meta_path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise InputError(meta_path, f"not valid JSON: {e}") from None
-    if "intrinsics" not in meta:
+    meta = read_json(meta_path, "meta.json")
+    if not isinstance(meta, dict) or "intrinsics" not in meta:
         raise InputError(meta_path, "no intrinsics")
     k = Intrinsics.from_dict(meta["intrinsics"], str(meta_path))
     return load_frame(item_dir / "color.png", item_dir / "depth.png", k, float(meta.get("depth_scale_m", 0.001)),

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from ..errors import InputError
+from ..errors import InputError, read_json
 from ..facts import MODALITIES
 
 
@@ -48,10 +48,7 @@ def _dataset_scenes(data: Path, modality: str, facts: str):
         item_dir = data / it["dir"]
         if facts == "truth":
             meta_path = item_dir / "meta.json"
-            try:
-                meta = json.loads(meta_path.read_text())
-            except (OSError, json.JSONDecodeError) as e:
-                raise InputError(meta_path, f"cannot be read: {e}") from None
+            meta = read_json(meta_path, "meta.json")
             scenes.append(truth_facts(meta, it["id"], modality))
         else:
             from ..pipeline import scene_facts
