@@ -113,8 +113,19 @@ def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px
     return out
 
 
-def _chunks(faces: list[Face], size: int) -> list[list[Face]]:
-    return [faces[i: i + size] for i in range(0, len(faces), size)] or [[]]
+def _chunks(faces: list[Face], max_faces: int, max_vertices: int, max_sides: int) -> list[list[Face]]:
+    """Consecutive runs of faces that fit one padded problem: at most ``max_faces`` faces and at most
+    ``max_vertices`` polygon vertices in all (counted before shared vertices merge, so always enough)."""
+    chunks: list[list[Face]] = [[]]
+    used = 0
+    for f in faces:
+        n = min(len(f.polygon), max_sides)
+        if chunks[-1] and (len(chunks[-1]) == max_faces or used + n > max_vertices):
+            chunks.append([])
+            used = 0
+        chunks[-1].append(f)
+        used += n
+    return chunks
 
 
 def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray | None = None,
@@ -142,7 +153,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     target = scene.target()
     for oi, obj in enumerate(scene.objects):
         usable = [f for f in obj.faces if len(f.polygon) >= 3]
-        for chunk in _chunks(usable, grounding.MAX_FACES):
+        for chunk in _chunks(usable, grounding.MAX_FACES, grounding.MAX_VERTICES, grounding.MAX_SIDES):
             if not chunk:
                 continue
             pos = {f.id: i for i, f in enumerate(chunk)}

@@ -125,3 +125,16 @@ def test_every_emitted_predicate_is_allowed_for_the_modality(modality):
     scene, frame = _scene(modality, np.random.default_rng(3))
     sf = describe(scene, frame)
     assert sf.facts and all(modality in PREDICATES[f.pred][1] for f in sf.facts)
+
+
+def test_objects_with_many_vertices_are_split_into_problems_that_fit():
+    import grounding
+    from lv3d.describe import _chunks
+    from lv3d.scene import Face
+
+    octagon = np.stack([np.cos(np.arange(8) * np.pi / 4), np.sin(np.arange(8) * np.pi / 4)], 1) * 20 + 100
+    faces = [Face(f"s_o1_f{i}", octagon + 50 * i, "rgb") for i in range(5)]  # 40 vertices, none shared
+    chunks = _chunks(faces, grounding.MAX_FACES, grounding.MAX_VERTICES, grounding.MAX_SIDES)
+    assert [f for c in chunks for f in c] == faces
+    for c in chunks:
+        grounding.pack_object([f.polygon for f in c], intrinsics=(600.0, 600.0, 320.0, 240.0))

@@ -50,7 +50,7 @@ class CNNSettings:
         return asdict(self)
 
 
-POOL_CELLS = 1
+POOL_CELLS = 2  # the tower's last map is pooled to 2x2 cells: the head still knows centre from edge
 MIN_PER_CLASS_FOR_VAL = 10  # below this a validation split costs more training data than it is worth
 
 
@@ -169,6 +169,10 @@ class CNNClassifier:
             opt = torch.optim.Adam(self.net.parameters(), lr=s.lr, weight_decay=s.weight_decay)
             tr, val = validation_split(y, len(self.classes), s.val_fraction if s.patience > 0 else 0.0, gen)
             x_tr, y_tr = xt[tr], y[tr]
+            # inverse-frequency class weights: a class task's 40 positives vs 60 negatives must not
+            # settle on "always negative"
+            counts = torch.bincount(y_tr, minlength=len(self.classes)).float().clamp(min=1)
+            weight = counts.sum() / (len(self.classes) * counts)
             best, best_state, stale = float("inf"), None, 0
             for epoch in range(s.epochs):
                 self.net.train()
@@ -181,7 +185,7 @@ class CNNClassifier:
                     if s.augment:
                         with torch.no_grad():
                             xb = augment_batch(xb, gen, color)
-                    loss = nn.functional.cross_entropy(self.net(xb), y_tr[idx])
+                    loss = nn.functional.cross_entropy(self.net(xb), y_tr[idx], weight=weight)
                     opt.zero_grad(set_to_none=True)
                     loss.backward()
                     opt.step()
