@@ -90,7 +90,7 @@ def plot_accuracy(acc: dict[str, float], path: Path) -> None:
 @click.option("--seed", default=0, show_default=True)
 @click.option("--systems", default="lv3d-rgb,lv3d-depth,lv3d-rgbd,cnn-rgbd,tree-rgbd", show_default=True,
               help="comma-separated systems to compare")
-@click.option("--threads", default=2, show_default=True, help="CPU threads for the CNN")
+@click.option("--threads", default=1, show_default=True, help="CPU threads for the CNN")
 def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int, systems: str, threads: int):
     """Learn four shape classes from a few RGB-D images and explain an answer."""
     from ..errors import InputError
