@@ -91,9 +91,8 @@ class FakeModel:
         (Path(folder) / "program.pl").write_text("% fake program\n")
 
 
-@pytest.fixture
-def fake_world(monkeypatch):
-    """Route the runner's data set, pipeline and learner to the synthetic stand-ins above."""
+def _synthetic_data_and_facts(monkeypatch):
+    """Route the runner's data set and pipeline to the synthetic stand-ins above."""
     from lv3d.experiment import data as data_mod
 
     def ensure_dataset(cfg, out):
@@ -104,6 +103,12 @@ def fake_world(monkeypatch):
 
     monkeypatch.setattr(data_mod, "ensure_dataset", ensure_dataset)
     monkeypatch.setattr("lv3d.pipeline.scene_facts", fake_scene_facts)
+
+
+@pytest.fixture
+def fake_world(monkeypatch):
+    """Route the runner's data set, pipeline and learner to the synthetic stand-ins above."""
+    _synthetic_data_and_facts(monkeypatch)
     learn = types.ModuleType("lv3d.learn")
     learn.Model = FakeModel
     monkeypatch.setitem(sys.modules, "lv3d.learn", learn)
@@ -132,13 +137,4 @@ def tiny_config(tmp_path):
 @pytest.fixture
 def synthetic_facts(monkeypatch):
     """The synthetic data set and facts of ``fake_world``, but the real learner."""
-    from lv3d.experiment import data as data_mod
-
-    def ensure_dataset(cfg, out):
-        target = data_mod.dataset_dir(cfg, out)
-        if not (target / "manifest.json").is_file():
-            write_dataset(target, cfg["data"]["classes"], cfg["data"]["per_class"], cfg["seed"])
-        return target
-
-    monkeypatch.setattr(data_mod, "ensure_dataset", ensure_dataset)
-    monkeypatch.setattr("lv3d.pipeline.scene_facts", fake_scene_facts)
+    _synthetic_data_and_facts(monkeypatch)
