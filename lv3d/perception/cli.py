@@ -36,6 +36,9 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
         raise InputError("--depth", f"modality {modality!r} needs a depth image")
     if intrinsics is None:
         raise InputError("--intrinsics", "an intrinsics JSON file is required")
+    for image in (color, depth if modality != "rgb" else None):
+        if image is not None and not Path(image).is_file():
+            raise InputError(image, "image not found")
     frame_name = Path(color).stem.removesuffix("_rgb")
     k, scale = read_intrinsics(intrinsics, frame_name)
     frame = load_frame(color, depth if modality != "rgb" else None, k,

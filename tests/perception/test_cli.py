@@ -43,3 +43,13 @@ def test_extract_rejects_a_missing_image(tmp_path, box_frame, capsys):
                "--out", str(tmp_path / "o")])
     assert rc == 2
     assert "nope.png" in capsys.readouterr().err
+
+
+def test_extract_names_the_missing_image_before_looking_up_its_intrinsics(tmp_path, capsys):
+    k = tmp_path / "intrinsics.json"
+    k.write_text('{"width": 640, "height": 480, "frames": {"a": {"fx": 525, "fy": 525, "cx": 320, "cy": 240}}}')
+    rc = main(["extract", str(tmp_path / "nope_rgb.png"), "--modality", "rgb", "--intrinsics", str(k),
+               "--out", str(tmp_path / "o")])
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert "nope_rgb.png: image not found" in err and not (tmp_path / "o").exists()
