@@ -7,7 +7,7 @@ import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, read_json
 from ..facts import PREDICATES, SceneFacts
 from . import engine
 from .engine import LearnError
@@ -198,10 +198,10 @@ class Model:
         index = in_dir / "model.json"
         if not index.is_file():
             raise InputError(in_dir, "not a model directory (no model.json)")
+        meta = read_json(index, "model.json")
         try:
-            meta = json.loads(index.read_text())
             classes = list(meta["classes"])
-        except (json.JSONDecodeError, KeyError, TypeError) as e:
+        except (KeyError, TypeError) as e:
             raise InputError(index, f"malformed: {e}") from None
         programs = {}
         for c in classes:

@@ -3,14 +3,13 @@ class under every noise preset (docs/contact_sheet.png: ``python -m lv3d.render.
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, read_json
 from ..rgbd import load_item
 
 DEPTH_RANGE_M = (0.3, 3.0)
@@ -61,10 +60,10 @@ def dataset_sheet(folder: Path, out: Path, max_items: int = 48, cols: int = 4) -
     mpath = folder / "manifest.json"
     if not mpath.is_file():
         raise InputError(folder, "not a data set (no manifest.json)")
+    manifest = read_json(mpath, "data set manifest")
     try:
-        manifest = json.loads(mpath.read_text())
         items = manifest["items"]
-    except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError) as e:
+    except (KeyError, TypeError) as e:
         raise InputError(mpath, f"not a valid data set manifest: {e}") from None
     if not items:
         raise InputError(mpath, "the data set has no items")

@@ -4,18 +4,8 @@ import numpy as np
 import pytest
 
 from lv3d.camera import Intrinsics
+from lv3d.render.sampler import look_at
 from lv3d.rgbd import RGBD
-
-
-def _look_at(eye, target):
-    """World-to-camera rotation R and translation t (camera: x right, y down, z forward; world z up)."""
-    f = target - eye
-    f /= np.linalg.norm(f)
-    r = np.cross(f, [0, 0, 1.0])
-    r /= np.linalg.norm(r)
-    d = np.cross(f, r)
-    R = np.stack([r, d, f])
-    return R, -R @ eye
 
 
 def box_on_table(width=320, height=240, half=(0.05, 0.05), top=0.1, yaw_deg=30.0, noise_m=0.0, seed=0):
@@ -25,7 +15,8 @@ def box_on_table(width=320, height=240, half=(0.05, 0.05), top=0.1, yaw_deg=30.0
     k = Intrinsics(fx=300.0 * width / 320, fy=300.0 * width / 320, cx=(width - 1) / 2, cy=(height - 1) / 2,
                    width=width, height=height)
     eye = np.array([0.6 * np.cos(np.radians(40)), 0.0, 0.6 * np.sin(np.radians(40))]) + np.array([0, 0, 0.03])
-    R, t = _look_at(eye, np.array([0, 0, 0.04]))
+    m = look_at(eye, np.array([0, 0, 0.04]))  # world-to-camera
+    R, t = m[:3, :3], m[:3, 3]
     u, v = np.meshgrid(np.arange(width), np.arange(height))
     rays_c = np.stack([(u - k.cx) / k.fx, (v - k.cy) / k.fy, np.ones_like(u, float)], -1).reshape(-1, 3)
     rays_w = rays_c @ R  # R^T applied to each ray
