@@ -2,8 +2,9 @@
 
 - the data set: rendered with :func:`lv3d.render.make_dataset` into ``<cache>/<digest>/`` (the
   digest covers classes, per_class, noise and seed), reused when its manifest is there;
-- facts: ``<facts root>/<data digest>/<modality>-refine<0|1>/<id>.json``, one file per image, so
-  the expensive pipeline runs once per (image, modality, refine) and an interrupted run resumes;
+- facts: ``<facts root>/<data digest>/<code version>/<modality>-refine<0|1>/<id>.json``, one file
+  per image, so the expensive pipeline runs once per (image, modality, refine, version of the
+  perception and grounding code) and an interrupted run resumes;
 - pixels: ``<cache>/<digest>/pixels-<size>.npz``, the (N, 4, S, S) rgbd tensors of the baselines.
 """
 
@@ -20,6 +21,7 @@ from tqdm import tqdm
 
 from ..errors import InputError
 from ..facts import SceneFacts
+from .code_version import facts_version
 from .config import digest
 from .folds import Item
 
@@ -61,7 +63,7 @@ def read_items(data: Path) -> list[Item]:
 
 def facts_dir(cfg: dict, out: Path, modality: str, refine: bool) -> Path:
     root = Path(cfg["data"]["cache"]) / "facts" if cfg["data"]["cache"] else Path(out) / "facts"
-    return root / digest(data_key(cfg)) / f"{modality}-refine{int(refine)}"
+    return root / digest(data_key(cfg)) / facts_version() / f"{modality}-refine{int(refine)}"
 
 
 def _facts_job(args) -> str:

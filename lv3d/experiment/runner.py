@@ -1,6 +1,7 @@
 """Run a study: for every condition, system and fold, train each class task (and the multi-class
 task) on the training folds and test on the held-out fold; one JSON per (condition, system, fold)
-under ``<out>/folds/``, skipped on a rerun when it was made from the same settings.
+under ``<out>/folds/``, skipped on a rerun when it was made from the same settings (and, for lv3d
+systems, the same version of lv3d's code: see code_version.py).
 
 Every system sees the same images, folds and training samples: the samples are drawn from seeds
 that depend on (study seed, fold, class) only, never on the system.
@@ -18,6 +19,7 @@ import yaml
 from tqdm import tqdm
 
 from . import data as data_mod
+from .code_version import learner_version
 from .config import LOGIC_SYSTEMS, conditions, digest, load_config
 from .folds import Item, class_task, multiclass_task, split, stratified_folds
 from .systems import make_system, modality_of, negative_label
@@ -39,6 +41,7 @@ def result_key(cfg: dict, system: str, fold: int) -> str:
     relevant["fold"] = fold
     if system in LOGIC_SYSTEMS:
         relevant["settings"] = {k: v for k, v in cfg["lv3d"].items() if k != "workers"}  # workers: speed only
+        relevant["code"] = learner_version()  # changed perception, grounding or learner: recompute
     else:
         relevant["settings"] = cfg["baselines"]
     relevant["data"] = data_mod.data_key(cfg)

@@ -1,0 +1,51 @@
+"""Which version of lv3d's own code a cached result was made with.
+
+Facts and lv3d fold results are cached between runs; a cache keyed by settings alone would hand
+back results of code that has since changed. Their keys therefore include a digest of the source
+files they depend on, so that a change to perception, grounding, the fact writer or the learner
+recomputes them, while baseline results (which depend on none of that) are kept.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from functools import lru_cache
+from pathlib import Path
+
+_ROOT = Path(__file__).resolve().parents[2]      # the checkout (or site-packages) holding lv3d/
+
+# What the facts of an image depend on: perception, grounding and the fact writer.
+FACT_SOURCES = ("lv3d/perception", "lv3d/describe.py", "lv3d/facts.py", "lv3d/pipeline.py", "lv3d/scene.py",
+                "lv3d/plane.py", "lv3d/camera.py", "lv3d/rgbd.py", "grounding")
+# What learning from those facts depends on: the Python side of the learner and the Prolog files.
+LEARNER_SOURCES = ("lv3d/learn", "prolog")
+
+
+def _files(part: str) -> list[Path]:
+    base = _ROOT / part  # lv3d/, grounding/ and prolog/ sit side by side in a checkout and when installed
+    if base.is_file():
+        return [base]
+    return sorted(p for p in base.rglob("*") if p.suffix in (".py", ".pl") and p.is_file())
+
+
+@lru_cache(maxsize=None)
+def source_digest(parts: tuple[str, ...]) -> str:
+    """A 12-hex digest of the contents of every .py/.pl file under ``parts`` (paths relative to
+    the checkout). Raises FileNotFoundError when a part is missing, rather than hashing nothing."""
+    h = hashlib.sha256()
+    for part in parts:
+        files = _files(part)
+        if not files:
+            raise FileNotFoundError(f"no source files under {part} (looked in {_ROOT})")
+        for p in files:
+            h.update(p.relative_to(p.parents[0].parent).as_posix().encode())  # name and folder: a rename counts
+            h.update(p.read_bytes())
+    return h.hexdigest()[:12]
+
+
+def facts_version() -> str:
+    return source_digest(FACT_SOURCES)
+
+
+def learner_version() -> str:
+    return source_digest(FACT_SOURCES + LEARNER_SOURCES)
