@@ -59,6 +59,7 @@ def summarise(out: Path, cfg: dict) -> tuple[dict, list[dict]]:
         m, sd = mean_std([sum(r["tasks"][c]["accuracy"] for c in classes) / len(classes) for r in recs])
         per["mean"] = {"mean": m, "std": sd}
         per["seconds"] = sum(r["seconds"] for r in recs)
+        per["code"] = sorted({r["code"] for r in recs if r.get("code")})
         summary["systems"][s] = per
     for a, b in cfg["stats"]["pairs"] or default_pairs(cfg["systems"]):
         common = sorted(set(cells[a]) & set(cells[b]))
@@ -93,6 +94,11 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
                 sg = t["sign"]
                 lines.append(f"| {t['a']} | {t['b']} | {t['cells']} | {100 * t['mean_diff']:+.1f} | {sg['wins']} | "
                              f"{sg['losses']} | {sg['ties']} | {sg['p']:.4g} | {t['wilcoxon']['p']:.4g} |")
+        lines.append("")
+    versions = sorted({v for summ in summaries.values() for per in summ["systems"].values() for v in per.get("code", [])})
+    if versions:
+        lines.append("lv3d results made with lv3d code version " + ", ".join(f"`{v}`" for v in versions) +
+                     " (a digest of its source: lv3d/experiment/code_version.py).")
         lines.append("")
     return "\n".join(lines)
 

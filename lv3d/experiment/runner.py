@@ -172,7 +172,8 @@ def run_study(config: Path, out: Path, overrides: list[str] = (), progress: bool
             record = run_fold(system, ccfg, train, test, k, programs)
             record.update(key=result_key(ccfg, sname, k), condition=cname, system=sname, fold=k,
                           test_ids=[it.id for it in test], seconds=round(time.perf_counter() - t0, 3),
-                          pipeline_errors=inputs.errors.get(modality_of(sname), {}) if sname in LOGIC_SYSTEMS else {})
+                          pipeline_errors=inputs.errors.get(modality_of(sname), {}) if sname in LOGIC_SYSTEMS else {},
+                          code=learner_version() if sname in LOGIC_SYSTEMS else None)
             _write_json(fold_path(out, cname, sname, k), record)
             done.setdefault(record["key"], fold_path(out, cname, sname, k))
             ran += 1

@@ -20,3 +20,6 @@ def test_real_learner_learns_side_counts(tmp_path, tiny_config, synthetic_facts,
     programs = out / "programs" / "base" / "lv3d-rgb" / "fold0"
     assert (programs / "cube" / "cube.pl").is_file() and (programs / "multiclass" / "cube.pl").is_file()
     assert "quadrilateral" in (programs / "cube" / "cube.pl").read_text()
+    # the report names the version of lv3d's code the figures came from
+    from lv3d.experiment.code_version import learner_version
+    assert rec["code"] == learner_version() and f"`{learner_version()}`" in (out / "results.md").read_text()
