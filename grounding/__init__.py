@@ -2,6 +2,7 @@
 uncertainty into the confidences of facts. Pure functions over arrays; knows nothing of lv3d."""
 
 from ._cache import enable_cache as enable_cache
+from ._calibration import calibrate as calibrate
 from ._confidence import Confidences as Confidences
 from ._confidence import Floors as Floors
 from ._confidence import SUPPORT_FULL as SUPPORT_FULL

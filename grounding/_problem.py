@@ -21,6 +21,7 @@ MAX_VERTICES = 24
 MAX_POINTS = 64
 MAX_LINKS = 24
 EDGE_SAMPLES = 12  # points sampled along each polygon edge
+SIZES = [(MAX_FACES, MAX_SIDES, MAX_VERTICES, MAX_POINTS, MAX_LINKS)]
 
 
 class Settings(eqx.Module):
@@ -88,7 +89,8 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
                 use_edges: list[bool] | None = None, edge_support: list[float | None] | None = None,
                 adjacency: list[tuple[int, int]] = (), support_plane: np.ndarray | None = None,
                 merge_px: float = 6.0, boundary_sigma_px: float = 2.0, free_sigma_px: float = 20.0,
-                gate_m: float = 0.015) -> tuple[ObjectProblem, np.ndarray]:
+                gate_m: float = 0.015, size: tuple[int, int, int, int, int] | None = None
+                ) -> tuple[ObjectProblem, np.ndarray]:
     """Pad one object's faces into an :class:`ObjectProblem` (numpy, outside jit).
 
     ``polygons``: per face an (n, 2) array of pixel vertices in order (3 <= n <= MAX_SIDES).
@@ -99,9 +101,11 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
     from the robust loss).
     ``use_edges``: per face whether an edge field guides its sides (default all True); a vertex that
     no edge-guided face uses keeps the prior spread ``boundary_sigma_px`` (perception's own error),
-    the others a weak ``free_sigma_px``. Returns the problem and the (F, S) map from each face's
-    polygon slot to its union vertex id.
+    the others a weak ``free_sigma_px``. ``size`` = (F, S, U, P, L) pads to other shapes than the
+    ``MAX_*`` ones (each shape is its own compiled program). Returns the problem and the (F, S) map from
+    each face's polygon slot to its union vertex id.
     """
+    MAX_FACES, MAX_SIDES, MAX_VERTICES, MAX_POINTS, MAX_LINKS = size or SIZES[-1]  # noqa: N806
     nf = len(polygons)
     if not 1 <= nf <= MAX_FACES:
         raise ValueError(f"an object needs 1..{MAX_FACES} faces, got {nf}")

@@ -8,7 +8,7 @@ the probability of every predicate, and each predicate the faces support becomes
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field as dc_field
 
 import cv2
 import numpy as np
@@ -29,6 +29,7 @@ class FaceResult:
     polygon: np.ndarray          # refined polygon (n, 2), pixels
     plane: np.ndarray | None     # refined plane (n, d), camera frame, metres
     vertex_std_px: np.ndarray    # (n,) largest standard deviation of each vertex, pixels
+    features: dict = dc_field(default_factory=dict)  # measurements the confidence calibration reads (calibration_features)
 
 
 @dataclass
@@ -129,13 +130,16 @@ def _chunks(faces: list[Face], max_faces: int, max_vertices: int, max_sides: int
 
 
 def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray | None = None,
-           refine_all: bool = False):
+           refine_all: bool = False, calibrate: bool = True):
     """Ground every object of ``scene``: (candidate facts with their probabilities, before any is dropped;
     per-object results). Candidates are ``(pred, args, probability, value)``.
 
     With ``refine``, only the scene's target object (:meth:`Scene.target`, the one a label speaks of) is
     refined unless ``refine_all``: the others keep perception's geometry, and their facts still get
-    confidences from its Laplace covariance (the solver is three quarters of an object's cost)."""
+    confidences from its Laplace covariance (the solver is three quarters of an object's cost).
+
+    With ``calibrate``, each probability goes through the per-(modality, predicate) calibration map fitted on
+    dev scenes (:func:`grounding.calibrate`, docs/grounding.md); without it, the raw Gaussian probabilities."""
     import grounding
     import jax
     import jax.numpy as jnp
@@ -185,7 +189,8 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 n = len(polys[i])
                 ids_i = index[i, :n]
                 vstd = np.sqrt(np.linalg.eigvalsh(g["vertex_cov"][ids_i]).max(-1).clip(0))
-                face_results.append(FaceResult(f, g["vertices"][ids_i], g["planes"][i] if has_plane[i] else None, vstd))
+                face_results.append(FaceResult(f, g["vertices"][ids_i], g["planes"][i] if has_plane[i] else None, vstd,
+                                               _face_features(g, i, n, g["vertices"][ids_i], len(chunk))))
                 support_term = float(np.clip(c["edge_support"][i] / grounding.SUPPORT_FULL, 0.0, 1.0))
                 face_conf[f.id] = support_term
                 cands.append(("face_of", (obj.id, f.id), support_term, None))
@@ -222,7 +227,40 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 cands.append(("adjacent", (b, a), p, None))
         cands.append(("object", (obj.id,), max(face_conf.values(), default=0.0), None))
         results.append(ObjectResult(obj, face_results, dihedrals, status, raw))
+    if calibrate:
+        feats = calibration_features(cands, results)
+        cands = [(pred, args, grounding.calibrate(scene.modality, pred, p, x), value)
+                 for (pred, args, p, value), x in zip(cands, feats)]
     return cands, results
+
+
+def _face_features(g: dict, i: int, n: int, poly: np.ndarray, faces_in_problem: int) -> dict:
+    """Measurements of face ``i`` of a grounding result that the calibration may read: the weakest corner's
+    turn in units of its spread (how sure the side count is), edge support, image area and shortest side."""
+    turn = 180.0 - g["quantities"]["corner_deg"][i, :n]
+    sd = np.hypot(g["std"]["corner_deg"][i, :n], 1.2)
+    area = 0.5 * abs(float(np.dot(poly[:, 0], np.roll(poly[:, 1], -1)) - np.dot(poly[:, 1], np.roll(poly[:, 0], -1))))
+    return {"sides": n, "min_turn_deg": float(turn.min()), "min_turn_z": float(((turn - 15.0) / sd).min()),
+            "support": float(g["conf"]["edge_support"][i]), "log_area_px": float(np.log(max(area, 1.0))),
+            "min_side_px": float(np.linalg.norm(np.roll(poly, -1, 0) - poly, axis=1).min()),
+            "faces": faces_in_problem}
+
+
+def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]:
+    """Per candidate the face measurements its calibration may read (:func:`_face_features`); for a fact
+    about two faces, the weaker of each (smaller value), for ``object`` the object's best face."""
+    by_face = {fr.face.id: fr.features for res in results for fr in res.faces}
+    by_obj = {res.obj.id: [fr.features for fr in res.faces] for res in results}
+    out = []
+    for pred, args, _, _ in cands:
+        fs = by_obj.get(args[0], []) if pred == "object" else [by_face[a] for a in args if a in by_face]
+        if not fs:
+            out.append({})
+        elif pred == "object":
+            out.append(max(fs, key=lambda f: f["support"]))
+        else:
+            out.append({k: min(f[k] for f in fs) for k in fs[0]})
+    return out
 
 
 def _to_numpy(tree) -> dict:

@@ -59,12 +59,12 @@ drop_scene(M) :-
            retractall(M:H)).
 
 %!  fit(+M, +Target, +BodyPreds, +Metarules, +PosObjs, +NegObjs, +Settings, -Result) is semidet.
-%   Learn Target/1 over the objects in M.  Result = result(Clauses, J, Soft, TP, NPos, FP, NNeg),
-%   Clauses as atoms (portray_clause text).  Fails when no hypothesis covers any sample.
-fit(M, Target, BodyPreds, MRs, PosObjs, NegObjs, Settings, result(Texts, J, Soft, TP, NP, FP, NN)) :-
+%   Learn Target/1 over the objects in M.  Result = result(Clauses, J, Soft, TP, NPos, FP, NNeg, Thr),
+%   Clauses as atoms (portray_clause text), Thr the coverage threshold the program takes.  Fails when no hypothesis covers any sample.
+fit(M, Target, BodyPreds, MRs, PosObjs, NegObjs, Settings, result(Texts, J, Soft, TP, NP, FP, NN, Thr)) :-
     maplist(example(Target), PosObjs, Pos), maplist(example(Target), NegObjs, Neg),
     Task = task(M, [Target/1], BodyPreds, MRs, Pos, Neg),
-    learn_noisy(Task, Settings, Prog, score(J, Soft, TP/NP, FP/NN)),
+    learn_noisy(Task, Settings, Prog, score(J, Soft, TP/NP, FP/NN, Thr)),
     program_clauses(Task, Prog, Clauses),
     maplist(clause_text, Clauses, Texts).
 
@@ -76,7 +76,8 @@ clause_text(C, Text) :-
 
 %!  classify(+M, +Programs, +BodyPreds, +Obj, +Settings, -Results) is det.
 %   Programs = [Label-ClauseTexts, ...].  Results = [[Label, Conf, Trace], ...] for the labels
-%   whose program proves Label(Obj) (best proof); Trace = [[Kind, AtomText, Conf], ...]
+%   whose program proves Label(Obj) (best proof); Trace = [[Kind, AtomText, Conf], ...], Kind
+%   fact, derived, call, clause or missing (a fact the scene lacks, under option miss(Eps))
 %   (lists, which pyswip hands back as lists; compound terms would come back as text).
 classify(M, Programs, BodyPreds, Obj, Settings, Results) :-
     findall([Label, C, Trace],
@@ -97,6 +98,7 @@ program_heads(Clauses, Heads) :-
 trace_item(fact(G, C), [fact, A, C]) :- term_to_atom(G, A).
 trace_item(bk(G), [derived, A, 1.0]) :- term_to_atom(G, A).
 trace_item(call(G), [call, A, 1.0]) :- term_to_atom(G, A).
+trace_item(miss(G, E), [missing, A, E]) :- term_to_atom(G, A).
 trace_item(clause(I), [clause, I, 1.0]).
 
 %!  check_program(+File, +Known, +Target, -Texts) is det.

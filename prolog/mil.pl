@@ -44,6 +44,8 @@ default(sample_neg(12)).        % negatives per sample
 default(solutions(200)).        % hypotheses kept per sample (smallest size found)
 default(clause_penalty(0.02)).  % score lost per clause (Occam), see docs/learner.md
 default(disjunctions(0)).       % learn_noisy: pair this many best one-clause hypotheses (0: off)
+default(thresholds([])).        % learn_noisy: candidate coverage thresholds, one chosen per program ([]: threshold)
+default(miss(0)).               % near misses: an absent fact counts as holding with this confidence (0: off)
 default(seed(0)).
 
 %!  metarule(?Name, ?Subs, ?Head, ?Body) is nondet.  The library of metarules; the first element
@@ -101,16 +103,28 @@ learn_noisy(Task, Settings0, Best, Score) :-
     append(Found0, Found),
     list_to_set(Found, Unique),                     % in the order found: it breaks ties
     option(clause_penalty(Lambda), Settings),
+    scoring(Settings, Ctx, SCtx, Ts),
     findall(Key-(Prog-S), (nth1(Order, Unique, Prog),
-                           score(Ctx, Lambda, Prog, Pos, Neg, S),
-                           S = score(J, Soft, _, _), support(Ctx, Prog, Pos, W),
+                           score(SCtx, Lambda-Ts, Prog, Pos, Neg, S),
+                           S = score(J, Soft, _, _, _), support(Ctx, Prog, Pos, W),
                            literal_cost(Ctx, Prog, Cost), NCost is -Cost, NOrder is -Order,
                            Key = k(J, Soft, W, NCost, NOrder)), Scored),
     Scored \== [],
     option(disjunctions(KD), Settings),
-    disjunctions(Ctx, Lambda, KD, Pos, Neg, Scored, Pairs),
+    disjunctions(SCtx, Lambda-Ts, KD, Pos, Neg, Scored, Pairs),
     append(Scored, Pairs, All),
     max_member(_-(Best-Score), All).
+
+%   The coverage thresholds a program may take and the context to score with: with
+%   thresholds(Ts) \== [], best proofs are found down to the lowest of them and each program
+%   takes the one that scores it best on the training examples (a fixed threshold would let
+%   confidences that are calibrated differently in another noise condition decide coverage);
+%   else the one threshold.  The search itself keeps the threshold option.
+scoring(Settings, Ctx, SCtx, Ts) :-
+    option(threshold(T0), Settings), option(thresholds(Ts0), Settings),
+    (   Ts0 == [] -> Ts = [T0] ; Ts = Ts0 ),
+    min_list(Ts, TMin),
+    Ctx = ctx(A, B, C, D, E, _, G, H, I, J, K), SCtx = ctx(A, B, C, D, E, TMin, G, H, I, J, K).
 
 %   Two-clause programs: one view of a solid seldom shows every pose's evidence (a triangular prism
 %   lying on a side shows no triangle), and a sample of two positives rarely needs two clauses, so
@@ -119,20 +133,17 @@ learn_noisy(Task, Settings0, Best, Score) :-
 %   the two, and it is scored like any program (its second clause pays clause_penalty).  Support
 %   is the sum of the two clauses' supports and cost the sum of their literal costs.
 disjunctions(_, _, 0, _, _, _, []) :- !.
-disjunctions(Ctx, Lambda, KD, Pos, Neg, Scored, Pairs) :-
-    ctx(Ctx, targets, Ts),
-    include(single_clause(Ts), Scored, Singles),
+disjunctions(Ctx, Lambda-Ts, KD, Pos, Neg, Scored, Pairs) :-
+    ctx(Ctx, targets, Targets),
+    include(single_clause(Targets), Scored, Singles),
     sort(1, @>=, Singles, Ranked),
     findall(h(Prog, CP, CN, W, C, O),
             ( limit(KD, member(k(_, _, W, C, O)-(Prog-_), Ranked)),
               maplist(best_conf(Ctx, Prog), Pos, CP), maplist(best_conf(Ctx, Prog), Neg, CN) ), Hs),
-    length(Pos, NP), length(Neg, NN),
-    findall(k(J, Soft, W, NC, NO)-(Prog-score(J, Soft, TP/NP, FP/NN)),
+    findall(k(J, Soft, W, NC, NO)-(Prog-S),
             ( append(_, [h(P1, CP1, CN1, W1, C1, O1)|Rest], Hs), member(h(P2, CP2, CN2, W2, C2, O2), Rest),
               maplist(max_of, CP1, CP2, CP), maplist(max_of, CN1, CN2, CN),
-              include(<(0), CP, TPs), include(<(0), CN, FPs), length(TPs, TP), length(FPs, FP),
-              rate(TP, NP, TPR), rate(FP, NN, FPR), mean(CP, MP), mean(CN, MN),
-              J is TPR - FPR - 2 * Lambda, Soft is MP - MN,
+              Penalty is 2 * Lambda, best_threshold(Ts, Penalty, CP, CN, S), S = score(J, Soft, _, _, _),
               W is W1 + W2, NC is C1 + C2, NO is min(O1, O2), append(P1, P2, Prog) ),
             Pairs).
 
@@ -142,17 +153,33 @@ single_clause(Ts, _-([sub(_, [P|Syms], _)]-_)) :-
 
 max_of(A, B, C) :- C is max(A, B).
 
-%!  score(+Ctx, +Lambda, +Prog, +Pos, +Neg, -Score) is det.
-%   Score = score(J, Soft, TP/NPos, FP/NNeg): J = TP/NPos - FP/NNeg - Lambda * clauses
-%   (Youden's J, a balanced accuracy: why in docs/learner.md); Soft = mean best-proof confidence
-%   over positives minus that over negatives, which breaks ties between equal J.
-score(Ctx, Lambda, Prog, Pos, Neg, score(J, Soft, TP/NP, FP/NN)) :-
+%!  score(+Ctx, +Lambda-Thresholds, +Prog, +Pos, +Neg, -Score) is det.
+%   Score = score(J, Soft, TP/NPos, FP/NNeg, Thr): at coverage threshold Thr (the one of
+%   Thresholds that scores best), J = TP/NPos - FP/NNeg - Lambda * clauses (Youden's J, a
+%   balanced accuracy: why in docs/learner.md); Soft = mean best-proof confidence over positives
+%   minus that over negatives (a proof below Thr counts 0), which breaks ties between equal J.
+score(Ctx, Lambda-Ts, Prog, Pos, Neg, S) :-
     maplist(best_conf(Ctx, Prog), Pos, CP), maplist(best_conf(Ctx, Prog), Neg, CN),
-    include(<(0), CP, TPs), include(<(0), CN, FPs),
-    length(Pos, NP), length(Neg, NN), length(TPs, TP), length(FPs, FP), length(Prog, L),
-    rate(TP, NP, TPR), rate(FP, NN, FPR), mean(CP, MP), mean(CN, MN),
-    J is TPR - FPR - Lambda * L,
-    Soft is MP - MN.
+    length(Prog, L), Penalty is Lambda * L,
+    best_threshold(Ts, Penalty, CP, CN, S).
+
+%   The best score over the candidate thresholds: highest J, then Soft, then the higher threshold
+%   (the stricter reading of the same evidence).
+best_threshold(Ts, Penalty, CP, CN, Best) :-
+    findall(k(J, Soft, T)-score(J, Soft, TP/NP, FP/NN, T),
+            ( member(T, Ts),
+              covered(T, CP, TP, MP), covered(T, CN, FP, MN),
+              length(CP, NP), length(CN, NN), rate(TP, NP, TPR), rate(FP, NN, FPR),
+              J is TPR - FPR - Penalty, Soft is MP - MN ), Ks),
+    max_member(_-Best, Ks).
+
+%   How many confidences reach T, and their mean with those below T counted 0.
+covered(T, Cs, K, M) :-
+    foldl(count_covered(T), Cs, 0-0, K-S),
+    length(Cs, N), ( N =:= 0 -> M = 0.0 ; M is S / N ).
+
+count_covered(T, C, K0-S0, K1-S1) :-
+    (   C > 0, C >= T -> K1 is K0 + 1, S1 is S0 + C ; K1 = K0, S1 = S0 ).
 
 %   Support: the mean number of proofs of a positive (at most 16 counted).  Between programs equal
 %   so far it prefers the one that holds for more parts of each positive, so that it still holds
@@ -210,8 +237,17 @@ consistent(Ctx, Neg, Prog0, Prog) :-
     ctx(Ctx, max, N), length(Prog0, N),
     ctx(Ctx, lits, L), prog_lits(Prog0, L),
     sort(Prog0, Sorted), length(Sorted, N),
+    \+ ( member(Item, Prog0), repeated_literal(Ctx, Item) ),
     \+ (member(E, Neg), covers(Ctx, Prog0, E, _, _)),
     reverse(Prog0, Prog).
+
+%   A clause whose body holds one literal twice (part2 with R = S) says no more than a shorter one
+%   found before it, but under combine(product) its proofs are less confident, which can game
+%   the coverage threshold: it is not a hypothesis.
+repeated_literal(Ctx, sub(Name, Subs, _)) :-
+    ctx(Ctx, metarules, MRs), template(Name, MRs, MR),
+    copy_term(MR, metarule(Name, Subs, _, Body)),
+    append(_, [L1|Rest], Body), member(L2, Rest), L1 == L2, !.
 
 prog_lits(Prog, L) :- foldl(add_lits, Prog, 0, L).
 add_lits(sub(_, _, K), L0, L) :- L is L0 + K.
@@ -255,6 +291,16 @@ prove_aux(fact, [P|Args], Ctx, _, Prog, Prog, C1, C2, [fact(G, Cf)|T], T) :-
     call(BK:G1),
     combine(Ctx, C1, Cf, C2),
     G =.. [P|Args].
+% near misses (option miss(Eps) > 0, for classifying what no program covers): a fact the scene
+% lacks is taken to hold with confidence Eps, the chance that perception missed a true fact, so
+% the best proof is the one missing the fewest facts, then the most confident; bindings the
+% missing fact would bind are bound by BK:near_miss(BK, G) when BK defines it (shape_bk: to the
+% same object's faces), else left open
+prove_aux(fact, [P|Args], Ctx, _, Prog, Prog, C1, C2, [miss(G, Eps)|T], T) :-
+    ctx(Ctx, miss, Eps), Eps > 0,
+    C2 is C1 * Eps, ctx(Ctx, threshold, Thr), C2 >= Thr,
+    G =.. [P|Args], ctx(Ctx, bk, BK),
+    catch(BK:near_miss(BK, G), error(existence_error(procedure, _), _), true).
 % a derived background predicate: BK:bk_rule(Head, Body), its body proved by this interpreter
 prove_aux(rule, [P|Args], Ctx, D, Prog, Prog, C1, C2, [bk(G)|T1], T2) :-
     G =.. [P|Args], ctx(Ctx, bk, BK),
@@ -321,19 +367,21 @@ task_ctx(task(BK, Targets, BodyPreds, MRs0, _, _), Settings, Ctx) :-
     option(max_depth(D), Settings), option(threshold(Thr), Settings),
     option(combine(How), Settings), option(max_inventions(Inv), Settings),
     option(max_clauses(Max), Settings), option(max_literals(Lits), Settings),
-    Ctx = ctx(BK, Targets, BPs, MRs, D, Thr, How, Inv, Max, Lits).
+    option(miss(Eps), Settings),
+    Ctx = ctx(BK, Targets, BPs, MRs, D, Thr, How, Inv, Max, Lits, Eps).
 
-ctx(ctx(BK, _, _, _, _, _, _, _, _, _), bk, BK).
-ctx(ctx(_, Ts, _, _, _, _, _, _, _, _), targets, Ts).
-ctx(ctx(_, _, BPs, _, _, _, _, _, _, _), bps, BPs).
-ctx(ctx(_, _, _, MRs, _, _, _, _, _, _), metarules, MRs).
-ctx(ctx(_, _, _, _, D, _, _, _, _, _), depth, D).
-ctx(ctx(_, _, _, _, _, Thr, _, _, _, _), threshold, Thr).
-ctx(ctx(_, _, _, _, _, _, How, _, _, _), combine, How).
-ctx(ctx(_, _, _, _, _, _, _, Inv, _, _), inventions, Inv).
-ctx(ctx(_, _, _, _, _, _, _, _, Max, _), max, Max).
-ctx(ctx(_, _, _, _, _, _, _, _, _, L), lits, L).
-ctx_size(ctx(A, B, C, E, F, G, H, I, _, _), Max, L, ctx(A, B, C, E, F, G, H, I, Max, L)).
+ctx(ctx(BK, _, _, _, _, _, _, _, _, _, _), bk, BK).
+ctx(ctx(_, Ts, _, _, _, _, _, _, _, _, _), targets, Ts).
+ctx(ctx(_, _, BPs, _, _, _, _, _, _, _, _), bps, BPs).
+ctx(ctx(_, _, _, MRs, _, _, _, _, _, _, _), metarules, MRs).
+ctx(ctx(_, _, _, _, D, _, _, _, _, _, _), depth, D).
+ctx(ctx(_, _, _, _, _, Thr, _, _, _, _, _), threshold, Thr).
+ctx(ctx(_, _, _, _, _, _, How, _, _, _, _), combine, How).
+ctx(ctx(_, _, _, _, _, _, _, Inv, _, _, _), inventions, Inv).
+ctx(ctx(_, _, _, _, _, _, _, _, Max, _, _), max, Max).
+ctx(ctx(_, _, _, _, _, _, _, _, _, L, _), lits, L).
+ctx(ctx(_, _, _, _, _, _, _, _, _, _, E), miss, E).
+ctx_size(ctx(A, B, C, E, F, G, H, I, _, _, M), Max, L, ctx(A, B, C, E, F, G, H, I, Max, L, M)).
 
 %   Each body predicate is a fact with a confidence (BK defines P/(A+1)), a derived rule
 %   (BK:bk_rule/2 has a head P/A) or plain Prolog (BK defines P/A, confidence 1).  The predicates

@@ -5,10 +5,23 @@
     rests on, exactly as a learned clause's does, and an explanation lists those facts.
     A scene module imports this one (lv3d_bridge:load_scene/3) to see these rules.
 */
-:- module(shape_bk, [derived/1]).
+:- module(shape_bk, [derived/1, near_miss/2]).
 
 %!  derived(?Name/Arity) is nondet.  The derived body predicates.
 derived(P/A) :- clause(bk_rule(H, _), true), functor(H, P, A).
+
+%!  near_miss(+M, ?Fact) is nondet.  Fact, absent from scene module M, may be taken for a fact
+%   perception missed (mil's option miss/1): never the structure (object/1, face_of/2), so that a
+%   near proof still speaks of the object's own faces, and its open arguments range over the
+%   object's other faces (other than the face it names).
+near_miss(M, G) :-
+    G =.. [P|Args], P \== object, P \== face_of,
+    once(( member(F, Args), nonvar(F), M:face_of(O, F, _) )),
+    include(nonvar, Args, Bound),
+    maplist(sibling(M, O, Bound), Args).
+
+sibling(_, _, _, X) :- nonvar(X), !.
+sibling(M, O, Bound, X) :- M:face_of(O, X, _), \+ memberchk(X, Bound).
 
 % two adjacent faces of the object meet at a right angle (cube, cuboid, prism caps)
 bk_rule(right_corner(O), [face_of(O, F), adjacent(F, G), perpendicular(F, G)]).

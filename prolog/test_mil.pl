@@ -64,7 +64,7 @@ test(learns_consistent_shape_program, [nondet]) :-
 test(noisy_labels_best_program_kept, [nondet]) :-
     % o3 (triangles only) is wrongly labelled a cube: the kept program must still be the square one
     shape_task([cube(o1), cube(o4), cube(o3)], [cube(o2)], T),
-    learn_noisy(T, [max_clauses(1), sample_pos(1), sample_neg(1), samples(6)], Prog, score(J, _, TP/3, FP/1)),
+    learn_noisy(T, [max_clauses(1), sample_pos(1), sample_neg(1), samples(6)], Prog, score(J, _, TP/3, FP/1, _)),
     program_clauses(T, Prog, [(cube(_) :- face_of(_, _), square(_))]),
     TP =:= 2, FP =:= 0, J > 0.
 

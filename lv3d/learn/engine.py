@@ -69,14 +69,22 @@ def derived_preds() -> tuple[tuple[str, int], ...]:
     return tuple((r["P"], int(r["A"])) for r in query("shape_bk:derived(P/A)"))
 
 
+def _value(v) -> str:
+    if isinstance(v, str):
+        return quote(v)
+    if isinstance(v, (list, tuple)):
+        return plist(_value(x) for x in v)
+    return repr(float(v) if isinstance(v, float) else int(v))
+
+
 def settings_term(settings: dict | None) -> str:
-    """A settings dict ({"max_clauses": 2, "combine": "min", ...}) as a Prolog option list."""
+    """A settings dict ({"max_clauses": 2, "combine": "min", "thresholds": [0.3, 0.5], ...}) as a
+    Prolog option list."""
     if not settings:
         return "[]"
     out = []
     for k, v in settings.items():
         if not re.match(r"^[a-z][a-z_]*$", k):
             raise InputError("settings", f"bad setting name {k!r}")
-        val = quote(v) if isinstance(v, str) else repr(float(v) if isinstance(v, float) else int(v))
-        out.append(f"{k}({val})")
+        out.append(f"{k}({_value(v)})")
     return plist(out)

@@ -18,6 +18,10 @@ from .program import Program
 SHAPE_METARULES = ("part", "part2", "part_pair")
 SHAPE_SETTINGS = {"max_clauses": 1, "max_inventions": 0, "time_limit": 20, "disjunctions": 20}
 FIT_MODULE, SCENE_MODULE = "lv3d_fit", "lv3d_scene"
+# When no program proves a scene, a model of several classes names the class whose program it
+# misses by least (docs/learner.md, "Classifying"): a fact the scene lacks counts as holding with
+# this confidence, the chance that perception missed a true fact.
+NEAR_MISS = 0.1
 
 
 # Search order of the body predicates, which decides among equally good hypotheses (the first
@@ -85,7 +89,7 @@ def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: d
     mrs = engine.plist(opts.pop("metarules", SHAPE_METARULES))
     goal = (f"{_load(FIT_MODULE, scenes)}, "
             f"lv3d_bridge:fit({FIT_MODULE}, {target}, {preds}, {mrs}, {engine.plist(pos)}, {engine.plist(neg)}, "
-            f"{engine.settings_term(opts)}, result(Texts, J, Soft, TP, NP, FP, NN)), "
+            f"{engine.settings_term(opts)}, result(Texts, J, Soft, TP, NP, FP, NN, Thr)), "
             f"lv3d_bridge:drop_scene({FIT_MODULE})")
     try:
         ans = engine.query(goal, where=f"learning {target}")
@@ -95,7 +99,7 @@ def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: d
         raise LearnError(f"learning {target}: no program covers any sample of the positives")
     a = ans[0]
     score = {"j": float(a["J"]), "soft": float(a["Soft"]), "tp": int(a["TP"]), "n_pos": int(a["NP"]),
-             "fp": int(a["FP"]), "n_neg": int(a["NN"])}
+             "fp": int(a["FP"]), "n_neg": int(a["NN"]), "threshold": float(a["Thr"])}
     return Program(target, tuple(str(t) for t in a["Texts"]), score, modality, opts)
 
 
@@ -110,13 +114,19 @@ class Explanation:
     facts: list[tuple[str, float]] = field(default_factory=list)
     derived: list[str] = field(default_factory=list)
     others: dict[str, float] = field(default_factory=dict)
+    missing: list[str] = field(default_factory=list)  # facts the scene lacks (a near miss)
 
     def __str__(self) -> str:
         if self.label == "unknown":
             return f"{self.target}: unknown (no class's program proves it)"
-        lines = [f"{self.target} is a {self.label} (confidence {self.confidence:.3f}) because"]
+        if self.missing:
+            lines = [f"{self.target} is most likely a {self.label} (confidence {self.confidence:.3f}): no program "
+                     f"proves it, and this one misses by {len(self.missing)} fact(s) the fewest"]
+        else:
+            lines = [f"{self.target} is a {self.label} (confidence {self.confidence:.3f}) because"]
         lines += ["  " + c.replace("\n", "\n  ") for c in self.clauses]
         lines += [f"  with {a} ({c:.3f})" for a, c in self.facts]
+        lines += [f"  but not {a} (absent)" for a in self.missing]
         lines += [f"  where {d} (background)" for d in self.derived]
         if self.others:
             lines.append("  also proved: " + ", ".join(f"{k} {v:.3f}" for k, v in self.others.items()))
@@ -125,7 +135,10 @@ class Explanation:
 
 class Model:
     """One program per class. ``predict`` names the class whose program proves the scene's target
-    with the highest confidence (ties: the program with the higher training J), "unknown" if none."""
+    with the highest confidence (ties: the program with the higher training J). When none proves
+    it: with one program, "unknown" (the negative answer of a class task); with several, the class
+    whose program it misses by least (fewest absent facts, then most confident), with that near
+    proof's confidence, which is below the coverage threshold."""
 
     def __init__(self, programs: dict[str, Program], settings: dict | None = None,
                  failures: dict[str, str] | None = None):
@@ -146,30 +159,47 @@ class Model:
                 failures[c] = str(e)
         return cls(programs, settings, failures)
 
-    def _proofs(self, scene: SceneFacts) -> list[dict]:
+    def _proofs(self, scene: SceneFacts, near: bool = False) -> list[dict]:
         if scene.target is None:
             raise InputError(scene.scene, "scene has no target object")
         progs = engine.plist(f"{p.target}-{engine.plist(engine.quote(c) for c in p.clauses)}"
                              for p in self.programs.values())
         preds = engine.plist(f"{p}/{a}" for p, a in body_preds(scene.modality))
         opts = {k: v for k, v in {**SHAPE_SETTINGS, **self.settings}.items() if k != "metarules"}
+        thr = self._thresholds(opts)
+        # every program proves it when near, missing facts at NEAR_MISS each
+        opts["threshold"] = 0.0 if near else min(thr.values(), default=0.5)
+        if near:
+            opts["miss"] = NEAR_MISS
         goal = (f"{_load(SCENE_MODULE, [scene])}, lv3d_bridge:classify({SCENE_MODULE}, {progs}, {preds}, "
                 f"{scene.target}, {engine.settings_term(opts)}, Rs), lv3d_bridge:drop_scene({SCENE_MODULE})")
         ans = engine.query(goal, where=f"classifying {scene.scene}")
         out = []
         for r in ans[0]["Rs"] if ans else []:
             label, conf, trace = _result_parts(r)
-            out.append({"label": label, "conf": conf, "trace": trace})
+            if near or conf >= thr[label]:
+                out.append({"label": label, "conf": conf, "trace": trace})
         j = {k: p.score.get("j", 0.0) for k, p in self.programs.items()}
         out.sort(key=lambda r: (r["conf"], j.get(r["label"], 0.0)), reverse=True)
         return out
 
-    def predict(self, scene: SceneFacts) -> tuple[str, float]:
+    def _decide(self, scene: SceneFacts) -> list[dict]:
         proofs = self._proofs(scene)
+        if not proofs and len(self.programs) > 1:
+            proofs = self._proofs(scene, near=True)
+        return proofs
+
+    def _thresholds(self, opts: dict) -> dict[str, float]:
+        """Each program's coverage threshold: the one it was learned with, else the settings'."""
+        default = float(opts.get("threshold", 0.5))
+        return {k: float(p.score.get("threshold", default)) for k, p in self.programs.items()}
+
+    def predict(self, scene: SceneFacts) -> tuple[str, float]:
+        proofs = self._decide(scene)
         return (proofs[0]["label"], proofs[0]["conf"]) if proofs else ("unknown", 0.0)
 
     def explain(self, scene: SceneFacts) -> Explanation:
-        proofs = self._proofs(scene)
+        proofs = self._decide(scene)
         if not proofs:
             return Explanation("unknown", 0.0, scene.target)
         best = proofs[0]
@@ -180,7 +210,8 @@ class Model:
             clauses=[prog.clauses[i - 1] for i in used if 0 < i <= len(prog.clauses)],
             facts=[(a, c) for k, a, c in best["trace"] if k == "fact"],
             derived=[a for k, a, _ in best["trace"] if k == "derived"],
-            others={p["label"]: p["conf"] for p in proofs[1:]})
+            others={p["label"]: p["conf"] for p in proofs[1:]},
+            missing=[a for k, a, _ in best["trace"] if k == "missing"])
 
     def save(self, out_dir: Path) -> Path:
         out_dir = Path(out_dir)

@@ -40,7 +40,8 @@ class Program:
         if self.score:
             s = self.score
             head.append(f"% training: covers {s.get('tp')}/{s.get('n_pos')} positives, "
-                        f"{s.get('fp')}/{s.get('n_neg')} negatives; J = {s.get('j', 0):.3f}")
+                        f"{s.get('fp')}/{s.get('n_neg')} negatives; J = {s.get('j', 0):.3f}"
+                        + (f"; threshold {s['threshold']:g}" if "threshold" in s else ""))
         if self.settings:
             head.append("% settings: " + ", ".join(f"{k}={v}" for k, v in sorted(self.settings.items())))
         return "\n".join(head) + "\n\n" + "\n".join(self.clauses) + "\n"

@@ -12,7 +12,7 @@ from ..plane import Plane
 from ..rgbd import RGBD
 from .boundary import mask_polygon
 from .cloud import PointGrid, point_grid
-from .objects import DepthObject, segment_objects
+from .objects import DepthObject, segment_objects, support_band
 from .planes import DepthPlane, object_planes, plane_adjacency
 from .snap import snap_polygons
 from .support import noise_threshold
@@ -46,7 +46,8 @@ def depth_scene(frame: RGBD, stride: int = 2, seed: int = 0, max_objects: int = 
     t1 = time.perf_counter()
     support = _support(grid, seed)
     t2 = time.perf_counter()
-    objs = segment_objects(grid, support)[:max_objects]
+    band = support_band(grid, support) if support is not None else None
+    objs = segment_objects(grid, support, band_m=band)[:max_objects]
     t3 = time.perf_counter()
     h, w = frame.shape
     results = []

@@ -35,17 +35,21 @@ def border_contact(mask: np.ndarray) -> float:
 
 
 def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60, min_height_m: float = 0.015,
-                    rel_jump: float = 0.02, max_border: float = 0.12) -> list[DepthObject]:
+                    rel_jump: float = 0.02, max_border: float = 0.12,
+                    band_m: float | None = None, regrow: int = 5) -> list[DepthObject]:
     """Objects above ``support`` on the grid, largest first. Points within the noise band of the support plane
     or below it are removed; the rest splits at depth jumps larger than ``rel_jump`` * depth; pieces with fewer
     than ``min_points`` grid points, lower than ``min_height_m``, or cut by the image border along more than
     ``max_border`` of their outline (walls, furniture, the floor beyond a table: scenery, not objects) are
-    dropped. Without a support plane every valid point counts as foreground."""
+    dropped. ``band_m``: the noise band (metres) above the support that counts as support; by default the
+    noise expected of a consumer sensor at the scene's depth (see :func:`support_band`). Each piece then takes
+    back the foreground cells left out of every piece (depth jumps, the opening) within ``regrow`` cells of it. Without a support
+    plane every valid point counts as foreground."""
     valid = grid.valid
     if support is not None:
         h_above = np.where(valid, grid.xyz @ support.n.astype(np.float32) + np.float32(support.offset), 0)
         z_med = float(np.median(grid.xyz[..., 2][valid])) if valid.any() else 1.0
-        band = 1.5 * noise_threshold(z_med)
+        band = 1.5 * noise_threshold(z_med) if band_m is None else band_m
         fg = valid & (h_above > band)
     else:
         h_above = np.where(valid, 1.0, 0)
@@ -60,6 +64,10 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     fg_cut = fg & ~jump
     fg_cut = cv2.morphologyEx(fg_cut.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)).astype(bool)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(fg_cut.astype(np.uint8), connectivity=4)
+    # foreground cells outside every piece: the cuts themselves, and what the opening removed. A face seen
+    # nearly edge-on is all depth jumps between neighbouring cells, and a few cells wide: without these cells
+    # it is lost whole
+    free = fg & (labels == 0)
     out = []
     for lab in range(1, n):
         if stats[lab, cv2.CC_STAT_AREA] < min_points:
@@ -70,8 +78,33 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
         height = float(np.percentile(h_above[m], 95)) if support is not None else np.inf
         if height < min_height_m:
             continue
-        # give back the cut pixels that touch this piece and sit at its depth
-        grown = cv2.dilate(m.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool) & fg & ~fg_cut
-        out.append(DepthObject(m | grown, height))
+        # give back the free cells within ``regrow`` cells of this piece, through free cells only
+        grown = m.copy()
+        for _ in range(regrow):
+            ring = cv2.dilate(grown.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool) & free & ~grown
+            if not ring.any():
+                break
+            grown |= ring
+        free &= ~grown
+        out.append(DepthObject(grown, height))
     out.sort(key=lambda o: (-o.size, int(np.argmax(o.mask))))
     return out
+
+
+def support_band(grid: PointGrid, support: Plane, min_band_m: float = 0.004, k: float = 4.0) -> float:
+    """The height (metres) above ``support`` within which points are the support itself: ``k`` times the noise (a
+    robust standard deviation of the distances to the plane of the grid points near it), between ``min_band_m`` and the default band. A fixed band
+    sized for the noisiest sensors cuts the bottom few centimetres off every object of a cleaner depth image;
+    the pixels lost there are the lower parts of the side faces, often all of a small face."""
+    valid = grid.valid[::2, ::2]
+    pts = grid.xyz[::2, ::2][valid]
+    if len(pts) < 50:
+        return 1.5 * noise_threshold(1.0)
+    z_med = float(np.median(pts[:, 2]))
+    wide = 1.5 * noise_threshold(z_med)
+    d = np.abs(pts @ support.n.astype(np.float32) + np.float32(support.offset))
+    near = d[d <= noise_threshold(z_med)]
+    if len(near) < 50:
+        return wide
+    sigma = 1.4826 * float(np.median(near))  # robust: the near set also holds the feet of objects and walls
+    return float(np.clip(k * sigma, min_band_m, wide))

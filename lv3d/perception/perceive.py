@@ -12,9 +12,11 @@ from ..rgbd import RGBD
 from ..scene import Face, Scene, SceneObject
 from .depth import DepthObjectResult, DepthResult, depth_scene
 from .boundary import grid_to_pixels
+from .face_plane import angle_deg, fit_face_plane
 from .fuse import match_faces
 from .polygons import area, rasterize
 from .rgb import RGBFace, rgb_faces
+from .support import noise_threshold
 
 _CROP_MARGIN_PX = 14
 
@@ -116,18 +118,41 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         plane_face: dict[int, int] = {}
         colour_face: dict[int, int] = {}
         on_plane = [max((_inside(poly_px[i], q) for q in plane_px), default=0.0) for i in mine]
+        claimed = set(match.values())
+        matched_poly = {a: _matched_polygon(res.faces[mine[a]].polygon, m, o, poly_px[mine[a]], plane_px, off,
+                                            dres, seed=k) for a, m in match.items()}
+        matched_px = np.zeros(shape, bool)  # the pixels that colour faces matched to a plane explain
+        for a, poly in matched_poly.items():
+            matched_px |= poly_px[mine[a]] if poly is res.faces[mine[a]].polygon else rasterize(poly - off, shape)
         for a, i in enumerate(mine):
             f = res.faces[i]
-            if a not in match and on_plane[a] >= 0.5:
-                continue  # a patch of print or shadow on a plane that depth already has: not a face
             if a in match:
                 p = o.planes[match[a]]
-                poly = _pick_polygon(f.polygon, o.polygons[match[a]], poly_px[i], off)
+                poly = matched_poly[a]
                 face = Face("", poly, "rgbd", plane=p.plane, points=p.points, edge_support=f.edge_support,
                             plane_rms_m=p.rms_m)
                 plane_face[match[a]] = len(faces)
             else:
-                face = Face("", f.polygon, "rgb", edge_support=f.edge_support)
+                own = _own_plane(f.polygon, o, dres, on_plane[a], plane_px, poly_px[i], claimed, seed=k)
+                if own is None and on_plane[a] >= 0.5:
+                    continue  # a patch of print or shadow on a plane that depth already has: not a face
+                if own is None:
+                    face = Face("", f.polygon, "rgb", edge_support=f.edge_support)
+                else:
+                    (plane, pts, rms), absorbed = own
+                    face = Face("", f.polygon, "rgbd", plane=plane, points=pts, edge_support=f.edge_support,
+                                plane_rms_m=rms)
+                    whole = [j for j in absorbed if o.polygons[j] is not None
+                             and _inside(plane_px[j] & ~poly_px[i], matched_px) < 0.5]
+                    if whole:
+                        # the plane reaches well beyond the colour face into pixels no other face explains:
+                        # the colour face is a piece of it (cut off by texture or a shadow), the plane is the face
+                        p = o.planes[whole[0]]
+                        face = Face("", o.polygons[whole[0]], "rgbd", plane=p.plane, points=p.points,
+                                    edge_support=f.edge_support, plane_rms_m=p.rms_m)
+                    for j in absorbed:
+                        plane_face[j] = len(faces)
+                        claimed.add(j)
             colour_face[i] = len(faces)
             faces.append(face)
         for j, (p, poly) in enumerate(zip(o.planes, o.polygons)):
@@ -138,7 +163,11 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
                  if a in plane_face and b in plane_face}
         pairs |= {tuple(sorted((colour_face[a], colour_face[b]))) for a, b in res.adjacency
                   if a in colour_face and b in colour_face}
-        keep = _reliable(faces)
+        alias = _merge_coplanar(faces, pairs)
+        pairs = {tuple(sorted((alias.get(a, a), alias.get(b, b)))) for a, b in pairs}
+        pairs = {(a, b) for a, b in pairs if a != b}
+        keep = [i for i in _reliable(faces) if i not in alias]
+        keep = _drop_covered(faces, keep, shape, off)
         pairs = {(a, b) for a, b in pairs if a in keep and b in keep}
         # stable ids: faces largest first
         order = sorted(keep, key=lambda i: (-area(faces[i].polygon), float(faces[i].polygon[0, 0])))
@@ -168,6 +197,123 @@ def _reliable(faces: list[Face]) -> list[int]:
     total = max(sum(areas), 1e-9)
     floor = {"rgb": _MIN_COLOUR_ONLY_FRACTION, "depth": _MIN_DEPTH_ONLY_FRACTION}
     return [i for i, f in enumerate(faces) if areas[i] >= floor.get(f.provenance, 0.0) * total]
+
+
+# a colour face that depth segmentation missed is a face of its own when the points inside it fit a plane that
+# is not the plane it was drawn on (an edge between two planes turns the normal by far more than this)
+_DISTINCT_PLANE_DEG = 15.0
+_SAME_PLANE_DEG = 12.0     # an unmatched depth plane this close to a colour face's own plane is that face
+
+
+def _own_plane(poly: np.ndarray, o: DepthObjectResult, dres: DepthResult, on_plane: float,
+               plane_px: list[np.ndarray], poly_px: np.ndarray, claimed: set[int], seed: int):
+    """For a colour face that no depth plane matched: its own plane fitted to the depth points inside it, and
+    the unmatched depth planes that are that face badly segmented; None when the points do not make a plane,
+    when it is the plane the face was drawn on (print, shadow) or the support plane."""
+    # the object's cells grown a little: a face seen edge-on loses cells to the depth-jump cuts of segmentation
+    fit = fit_face_plane(poly, dres.grid, seed=seed, on_mask=_dilate(o.obj.mask))
+    if fit is None:
+        return None
+    plane, pts, _ = fit
+    if dres.support is not None:
+        # on the support plane, or a patch of it whose few noisy points tilt the fit: a shadow or the table
+        height = float(np.median(dres.support.distance(pts)))
+        if angle_deg(plane, dres.support) < _SAME_PLANE_DEG or \
+                height < 0.5 * noise_threshold(float(np.median(pts[:, 2]))):
+            return None
+    # drawn on a plane that another colour face already has, and not turned away from it: print or shadow
+    over = [j for j, q in enumerate(plane_px) if j in claimed and _inside(poly_px, q) >= 0.5]
+    if any(angle_deg(plane, o.planes[j].plane) < _DISTINCT_PLANE_DEG for j in over):
+        return None
+    absorbed = [j for j, q in enumerate(o.planes) if j not in claimed
+                and angle_deg(plane, q.plane) < _SAME_PLANE_DEG and np.count_nonzero(plane_px[j] & poly_px)]
+    return fit, absorbed
+
+
+def _matched_polygon(colour: np.ndarray, j: int, o: DepthObjectResult, colour_px: np.ndarray,
+                     plane_px: list[np.ndarray], off: np.ndarray, dres: DepthResult, seed: int) -> np.ndarray:
+    """The polygon of a colour face matched to plane ``j``: see :func:`_pick_polygon`; the depth one when the
+    colour outline swallowed another plane (and the points inside it do not make one plane)."""
+    depth = o.polygons[j]
+    if depth is None:
+        return colour
+    if _swallows_plane(colour_px, j, o, plane_px) and fit_face_plane(colour, dres.grid, seed=seed) is None:
+        return depth
+    if len(colour) > len(depth):
+        # more colour corners: the depth outline may have lost a corner region of a face seen obliquely (its
+        # mask thins out there); the colour one is right when it holds the depth one and is all on its plane
+        dm = rasterize(depth - off, colour_px.shape)
+        fit = fit_face_plane(colour, dres.grid, seed=seed)
+        if _inside(dm, colour_px) >= 0.9 and fit is not None and \
+                angle_deg(fit[0], o.planes[j].plane) < _SAME_PLANE_DEG:
+            return colour
+    return _pick_polygon(colour, depth, colour_px, off)
+
+
+def _swallows_plane(poly_px: np.ndarray, own: int, o: DepthObjectResult, plane_px: list[np.ndarray]) -> bool:
+    """True when a colour face matched to plane ``own`` also holds most of another plane that is turned away
+    from it: the colour outline merged two faces whose shared edge had too little contrast."""
+    return any(j != own and angle_deg(q.plane, o.planes[own].plane) >= _DISTINCT_PLANE_DEG
+               and _inside(plane_px[j], poly_px) >= 0.5 for j, q in enumerate(o.planes))
+
+
+_COPLANAR_DEG = 5.0
+
+
+def _merge_coplanar(faces: list[Face], pairs: set[tuple[int, int]], max_excess: float = 0.1) -> dict[int, int]:
+    """Merges, in place, neighbouring faces that lie on one plane (normals within ``_COPLANAR_DEG``, each one's
+    points within the depth noise of the other's plane) and together tile a convex region (their hull exceeds
+    the sum of their areas by at most ``max_excess``): a face cut in two by a line the colour image suggested (a
+    shading step, a missed diagonal). Returns merged-away index -> the index it went into."""
+    import cv2
+
+    from .polygons import clockwise, simplify
+    from .support import refine
+
+    alias: dict[int, int] = {}
+    for a, b in sorted(pairs):
+        a, b = alias.get(a, a), alias.get(b, b)
+        fa, fb = faces[a], faces[b]
+        if a == b or fa.plane is None or fb.plane is None or fa.points is None or fb.points is None:
+            continue
+        if angle_deg(fa.plane, fb.plane) >= _COPLANAR_DEG:
+            continue
+        tol = noise_threshold(float(np.median(fa.points[:, 2])))
+        if np.median(np.abs(fa.plane.distance(fb.points))) > tol or \
+                np.median(np.abs(fb.plane.distance(fa.points))) > tol:
+            continue
+        hull = cv2.convexHull(np.concatenate([fa.polygon, fb.polygon]).astype(np.float32)).reshape(-1, 2)
+        hull = clockwise(simplify(hull.astype(np.float64)))
+        if area(hull) > (1 + max_excess) * (area(fa.polygon) + area(fb.polygon)):
+            continue
+        pts = np.concatenate([fa.points, fb.points])
+        plane = refine(pts.astype(np.float64))
+        rms = float(np.sqrt(np.mean(plane.distance(pts) ** 2)))
+        prov = "rgbd" if "rgbd" in (fa.provenance, fb.provenance) else fa.provenance
+        faces[a] = Face("", hull, prov, plane=plane, points=pts, edge_support=fa.edge_support, plane_rms_m=rms)
+        alias[b] = a
+        for k, v in alias.items():
+            if v == b:
+                alias[k] = a
+    return alias
+
+
+def _drop_covered(faces: list[Face], keep: list[int], shape: tuple[int, int], off: np.ndarray,
+                  max_covered: float = 0.5) -> list[int]:
+    """``keep`` without the depth-only faces lying mostly (> ``max_covered`` of their pixels) on other kept
+    faces: a plane that straddles an edge, left over when colour faces took the pixels on both sides."""
+    masks = {i: rasterize(faces[i].polygon - off, shape) for i in keep}
+    out = []
+    for i in keep:
+        if faces[i].provenance == "depth":
+            others = np.zeros(shape, bool)
+            for j in keep:
+                if j != i and faces[j].provenance == "rgbd":
+                    others |= masks[j]
+            if _inside(masks[i], others) > max_covered:
+                continue
+        out.append(i)
+    return out
 
 
 def _inside(poly_px: np.ndarray, mask_px: np.ndarray) -> float:

@@ -1,0 +1,82 @@
+"""How a model decides: near misses when no program proves a scene, learned coverage thresholds,
+and no clause that repeats a body literal."""
+
+import pytest
+
+from lv3d.facts import Fact, SceneFacts
+from lv3d.learn import LearnError, Model, Program, fit
+
+
+def _scene(k: int, faces: list[list[tuple[str, float]]], pairs=()) -> SceneFacts:
+    """One object (plus a clutter object with a square face) whose faces hold the given unary
+    facts; ``pairs`` = [(pred, i, j, conf)] relate face i to face j."""
+    s, o = f"s{k:06d}", f"s{k:06d}_o1"
+    facts = [Fact("object", (o,), 1.0), Fact("object", (f"{s}_o2",), 1.0),
+             Fact("face_of", (f"{s}_o2", f"{s}_o2_f1"), 1.0), Fact("square", (f"{s}_o2_f1",), 1.0)]
+    for i, props in enumerate(faces, 1):
+        f = f"{o}_f{i}"
+        facts.append(Fact("face_of", (o, f), 1.0))
+        facts += [Fact(p, (f,), c) for p, c in props]
+    facts += [Fact(p, (f"{o}_f{i}", f"{o}_f{j}"), c) for p, i, j, c in pairs]
+    return SceneFacts(s, "rgbd", facts, target=o)
+
+
+def _model() -> Model:
+    tri = Program("tri", ("tri(A) :- face_of(A, B), triangle(B), perpendicular(B, C), square(C).",),
+                  {"j": 0.9})
+    pent = Program("pent", ("pent(A) :- face_of(A, B), pentagon(B), regular(B).",), {"j": 0.8})
+    return Model({"tri": tri, "pent": pent})
+
+
+def test_near_miss_names_the_class_missed_by_fewest_facts():
+    # a triangle face next to a square one, but perception lost the right angle between them: the
+    # tri program misses one fact, the pent program two
+    scene = _scene(1, [[("triangle", 1.0)], [("square", 1.0)]])
+    model = _model()
+    assert model._proofs(scene) == []
+    label, conf = model.predict(scene)
+    assert label == "tri" and 0 < conf < 0.5
+    e = model.explain(scene)
+    assert e.missing == ["perpendicular(s000001_o1_f1,s000001_o1_f2)"]  # the object's own faces only
+    assert "misses by 1" in str(e) and "but not perpendicular" in str(e)
+
+
+def test_near_miss_never_for_one_program_or_structure():
+    scene = _scene(2, [[("triangle", 1.0)], [("square", 1.0)]])
+    one = Model({"tri": _model().programs["tri"]})
+    assert one.predict(scene) == ("unknown", 0.0)  # a class task's negative answer
+    # an object with no faces: face_of is never assumed, so no near proof exists
+    bare = SceneFacts("s000003", "rgbd", [Fact("object", ("s000003_o1",), 1.0)], target="s000003_o1")
+    assert _model().predict(bare) == ("unknown", 0.0)
+
+
+def test_proved_class_wins_over_near_misses():
+    scene = _scene(4, [[("pentagon", 0.9), ("regular", 0.9)], [("triangle", 1.0)]])
+    label, conf = _model().predict(scene)
+    assert label == "pent" and abs(conf - 0.81) < 1e-6
+
+
+def _task(conf_pos: float):
+    """'hit' objects have a triangle face believed with ``conf_pos``, the others a square one."""
+    scenes = [_scene(k, [[("triangle", conf_pos)]]) for k in range(4)]
+    scenes += [_scene(k, [[("pentagon", 1.0)]]) for k in range(4, 10)]
+    return scenes, ["hit"] * 4 + ["miss"] * 6
+
+
+def test_thresholds_choose_per_program_and_classify_with_it():
+    scenes, labels = _task(0.4)  # below the default threshold 0.5: nothing covers
+    prog = fit(scenes, labels, "hit", settings={"threshold": 0.3, "thresholds": [0.3, 0.6]})
+    assert prog.score["threshold"] == 0.3 and prog.score["tp"] == 4 and prog.score["fp"] == 0
+    model = Model({"hit": prog})
+    assert model.predict(scenes[0])[0] == "hit" and model.predict(scenes[5])[0] == "unknown"
+    # the same program read with a stricter threshold no longer covers the weak triangle
+    strict = Model({"hit": Program("hit", prog.clauses, {**prog.score, "threshold": 0.6})})
+    assert strict.predict(scenes[0])[0] == "unknown"
+
+
+def test_no_clause_repeats_a_literal():
+    # part2 can only say "a face that is a triangle and a triangle": that is no hypothesis
+    scenes, labels = _task(0.8)
+    with pytest.raises(LearnError):
+        fit(scenes, labels, "hit", settings={"metarules": ["part2"], "disjunctions": 0})
+    assert "triangle(B)" in fit(scenes, labels, "hit", settings={"metarules": ["part"]}).clauses[0]
