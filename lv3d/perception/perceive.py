@@ -119,8 +119,11 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         colour_face: dict[int, int] = {}
         on_plane = [max((_inside(poly_px[i], q) for q in plane_px), default=0.0) for i in mine]
         claimed = set(match.values())
+        colour_px = np.zeros(shape, bool)
+        for i in mine:
+            colour_px |= poly_px[i]
         matched_poly = {a: _matched_polygon(res.faces[mine[a]].polygon, m, o, poly_px[mine[a]], plane_px, off,
-                                            dres, seed=k) for a, m in match.items()}
+                                            dres, colour_px, seed=k) for a, m in match.items()}
         matched_px = np.zeros(shape, bool)  # the pixels that colour faces matched to a plane explain
         for a, poly in matched_poly.items():
             matched_px |= poly_px[mine[a]] if poly is res.faces[mine[a]].polygon else rasterize(poly - off, shape)
@@ -231,18 +234,26 @@ def _own_plane(poly: np.ndarray, o: DepthObjectResult, dres: DepthResult, on_pla
 
 
 def _matched_polygon(colour: np.ndarray, j: int, o: DepthObjectResult, colour_px: np.ndarray,
-                     plane_px: list[np.ndarray], off: np.ndarray, dres: DepthResult, seed: int) -> np.ndarray:
+                     plane_px: list[np.ndarray], off: np.ndarray, dres: DepthResult, all_colour_px: np.ndarray,
+                     seed: int) -> np.ndarray:
     """The polygon of a colour face matched to plane ``j``: see :func:`_pick_polygon`; the depth one when the
-    colour outline swallowed another plane (and the points inside it do not make one plane)."""
+    colour outline swallowed another plane (and the points inside it do not make one plane); the colour one
+    when the depth outline reaches over the other colour faces (``all_colour_px``: their pixels, with this
+    face's own ``colour_px``, over the crop)."""
     depth = o.polygons[j]
     if depth is None:
         return colour
     if _swallows_plane(colour_px, j, o, plane_px) and fit_face_plane(colour, dres.grid, seed=seed) is None:
         return depth
+    if len(depth) == len(colour):
+        return colour
+    dm = rasterize(depth - off, colour_px.shape)
+    beyond = dm & ~colour_px
+    if np.count_nonzero(beyond) >= 0.1 * max(1, np.count_nonzero(dm)) and _inside(beyond, all_colour_px) >= 0.5:
+        return colour
     if len(colour) > len(depth):
         # more colour corners: the depth outline may have lost a corner region of a face seen obliquely (its
         # mask thins out there); the colour one is right when it holds the depth one and is all on its plane
-        dm = rasterize(depth - off, colour_px.shape)
         fit = fit_face_plane(colour, dres.grid, seed=seed)
         if _inside(dm, colour_px) >= 0.9 and fit is not None and \
                 angle_deg(fit[0], o.planes[j].plane) < _SAME_PLANE_DEG:
@@ -301,17 +312,24 @@ def _merge_coplanar(faces: list[Face], pairs: set[tuple[int, int]], max_excess: 
 def _drop_covered(faces: list[Face], keep: list[int], shape: tuple[int, int], off: np.ndarray,
                   max_covered: float = 0.5) -> list[int]:
     """``keep`` without the depth-only faces lying mostly (> ``max_covered`` of their pixels) on other kept
-    faces: a plane that straddles an edge, left over when colour faces took the pixels on both sides."""
+    faces that have planes: a plane that straddles an edge, or a face's plane found a little off its place,
+    left over when colour faces took the pixels around it. A plane that one colour face covers but that is
+    turned away from that face's plane stays: the colour outline merged it (an edge without contrast)."""
     masks = {i: rasterize(faces[i].polygon - off, shape) for i in keep}
     out = []
     for i in keep:
         if faces[i].provenance == "depth":
+            cover = {j: np.count_nonzero(masks[i] & masks[j]) for j in keep
+                     if j != i and faces[j].provenance == "rgbd"}
             others = np.zeros(shape, bool)
-            for j in keep:
-                if j != i and faces[j].provenance == "rgbd":
-                    others |= masks[j]
+            for j in cover:
+                others |= masks[j]
             if _inside(masks[i], others) > max_covered:
-                continue
+                top = max(cover, key=lambda j: (cover[j], -j))
+                merged = cover[top] > max_covered * np.count_nonzero(masks[i]) and \
+                    angle_deg(faces[top].plane, faces[i].plane) >= _DISTINCT_PLANE_DEG
+                if not merged:
+                    continue
         out.append(i)
     return out
 
