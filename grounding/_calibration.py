@@ -39,6 +39,12 @@ def design(p: float, x: dict, names: list[str]) -> list[float]:
     return [logit(p) if n == "logit_p" else _SCALE.get(n, float)(float(x.get(n, 0.0))) for n in names]
 
 
+def measures_used(modality: str, pred: str) -> list[str]:
+    """The face measurements the map of (modality, pred) reads (empty: it needs only p, or there is no map)."""
+    entry = TABLE.get(modality, {}).get(pred)
+    return [] if entry is None else [n for n in entry["features"] if n != "logit_p"]
+
+
 def calibrate(modality: str, pred: str, p: float, x: dict | None = None) -> float:
     """Calibrated probability of one candidate fact with raw probability ``p`` and face measurements ``x``
     (keys as ``lv3d.describe.calibration_features`` gives them). ``p`` itself where no map was fitted;

@@ -12,8 +12,6 @@ from __future__ import annotations
 import equinox as eqx
 import jax
 import jax.numpy as jnp
-import lineax as lx
-import optimistix as optx
 from jaxtyping import Array, Bool, Float
 
 from ._plane import backproject, depth_residuals, depth_sigma, moved_plane
@@ -97,6 +95,11 @@ def solve(prob: ObjectProblem, field: Float[Array, "H W"], cfg: Settings, refine
           max_steps: int = 16) -> tuple[Params, Array]:
     """Refined updates (zero when ``refine`` is False) and a status: 0 converged or not asked, 1 step limit
     or failure (the last iterate is kept: it is never worse than the first guess by much)."""
+    # imported here, not at the top: only tracing needs them, and a process that loads a saved program
+    # (grounding._cache) skips their import time
+    import lineax as lx
+    import optimistix as optx
+
     y0 = zero_params(prob)
 
     def run(_):

@@ -21,7 +21,14 @@ MAX_VERTICES = 24
 MAX_POINTS = 64
 MAX_LINKS = 24
 EDGE_SAMPLES = 12  # points sampled along each polygon edge
-SIZES = [(MAX_FACES, MAX_SIDES, MAX_VERTICES, MAX_POINTS, MAX_LINKS)]
+# padded shapes (F, S, U, P, L), smallest first: an object goes into the first that holds it. Most targets
+# (3-4 faces of at most 6 sides) fit the small one, whose solver runs ~3x faster than the large one's
+# (the work scales with the padded sizes, not the real ones); each shape is one compiled program
+SIZES = [(4, 6, 16, MAX_POINTS, 16), (MAX_FACES, MAX_SIDES, MAX_VERTICES, MAX_POINTS, MAX_LINKS)]
+
+
+class _TooBig(ValueError):
+    """The object does not fit the padded shape asked for."""
 
 
 class Settings(eqx.Module):
@@ -71,17 +78,25 @@ def _compress(points: np.ndarray, n: int, intrinsics) -> tuple[np.ndarray, np.nd
     z = np.where(np.abs(points[:, 2]) < 1e-9, 1e-9, points[:, 2])
     uv = np.stack([fx * points[:, 0] / z + cx, fy * points[:, 1] / z + cy], 1)
     lo, hi = uv.min(0), uv.max(0) + 1e-6
-    side = np.sqrt(np.prod(hi - lo) / n)  # cell side for about n cells over the bounding box
-    while True:
+
+    def occupied(side):  # (cell of each point, number of occupied cells), by bincount over a dense grid
         cells = np.floor((uv - lo) / side).astype(np.int64)
-        key = cells[:, 0] * 100003 + cells[:, 1]
-        uniq, inv, counts = np.unique(key, return_inverse=True, return_counts=True)
-        if len(uniq) <= n:
+        key = cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]
+        counts = np.bincount(key)
+        return key, counts
+
+    # cell side for about n cells over the area the points cover (a fine grid's occupied cells measure it;
+    # the bounding box would overestimate it for a slanted or triangular face)
+    fine = np.sqrt(np.prod(hi - lo) / (4 * n))
+    side = fine * np.sqrt(np.count_nonzero(occupied(fine)[1]) / n)
+    while True:
+        key, counts = occupied(side)
+        if np.count_nonzero(counts) <= n:
             break
-        side *= 1.15
-    sums = np.zeros((len(uniq), 3))
-    np.add.at(sums, inv, points)
-    return sums / counts[:, None], counts.astype(np.float64)
+        side *= 1.1
+    used = np.flatnonzero(counts)
+    sums = np.stack([np.bincount(key, points[:, c], minlength=len(counts))[used] for c in range(3)], 1)
+    return sums / counts[used, None], counts[used].astype(np.float64)
 
 
 def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, float, float],
@@ -103,10 +118,30 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
     no edge-guided face uses keeps the prior spread ``boundary_sigma_px`` (perception's own error),
     the others a weak ``free_sigma_px``. ``size`` = (F, S, U, P, L) pads to other shapes than the
     ``MAX_*`` ones (each shape is its own compiled program). Returns the problem and the (F, S) map from
-    each face's polygon slot to its union vertex id.
+    each face's polygon slot to its union vertex id. Without ``size``, the first of ``SIZES`` that holds
+    the object.
     """
-    MAX_FACES, MAX_SIDES, MAX_VERTICES, MAX_POINTS, MAX_LINKS = size or SIZES[-1]  # noqa: N806
+    kw = dict(intrinsics=intrinsics, planes=planes, points=points, use_edges=use_edges, edge_support=edge_support,
+              adjacency=adjacency, support_plane=support_plane, merge_px=merge_px, boundary_sigma_px=boundary_sigma_px,
+              free_sigma_px=free_sigma_px, gate_m=gate_m, memo={})  # memo: compressed points, shared by tries
+    if size is None:
+        for small in SIZES[:-1]:
+            try:
+                return _pack(polygons, size=small, strict=True, **kw)
+            except _TooBig:
+                pass
+        size = SIZES[-1]
+    return _pack(polygons, size=size, strict=False, **kw)
+
+
+def _pack(polygons, *, intrinsics, planes, points, use_edges, edge_support, adjacency, support_plane, merge_px,
+          boundary_sigma_px, free_sigma_px, gate_m, size, strict, memo):
+    """:func:`pack_object` into one shape; with ``strict``, _TooBig where the object would not fit whole
+    (more faces, sides, vertices or links than the shape holds)."""
+    MAX_FACES, MAX_SIDES, MAX_VERTICES, MAX_POINTS, MAX_LINKS = size  # noqa: N806
     nf = len(polygons)
+    if strict and (nf > MAX_FACES or max((len(np.asarray(q).reshape(-1, 2)) for q in polygons), default=0) > MAX_SIDES):
+        raise _TooBig("does not fit")
     if not 1 <= nf <= MAX_FACES:
         raise ValueError(f"an object needs 1..{MAX_FACES} faces, got {nf}")
     planes = planes or [None] * nf
@@ -126,7 +161,7 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
             k = int(np.argmin(d)) if d else -1
             if k < 0 or d[k] > merge_px or k in face_index[f, :j][face_vmask[f, :j]]:
                 if len(verts) >= MAX_VERTICES:
-                    raise ValueError(f"an object has more than {MAX_VERTICES} distinct vertices")
+                    raise (_TooBig if strict else ValueError)(f"an object has more than {MAX_VERTICES} distinct vertices")
                 verts.append(p)
                 guided.append(False)
                 k = len(verts) - 1
@@ -152,11 +187,13 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
         if planes[f] is not None and points[f] is not None and len(points[f]) >= 3:
             plane_arr[f] = np.asarray(planes[f], np.float64)
             has_plane[f] = True
-            p = np.asarray(points[f], np.float64)
-            if len(p) > MAX_POINTS:
-                near = np.abs(p @ plane_arr[f, :3] + plane_arr[f, 3]) <= gate_m
-                p = p[near] if near.sum() >= 3 else p
-            p, w = _compress(p, MAX_POINTS, intrinsics)
+            if (f, MAX_POINTS) not in memo:
+                p = np.asarray(points[f], np.float64)
+                if len(p) > MAX_POINTS:
+                    near = np.abs(p @ plane_arr[f, :3] + plane_arr[f, 3]) <= gate_m
+                    p = p[near] if near.sum() >= 3 else p
+                memo[f, MAX_POINTS] = _compress(p, MAX_POINTS, intrinsics)
+            p, w = memo[f, MAX_POINTS]
             pts[f, : len(p)] = p
             pw[f, : len(p)] = w
             pivots[f] = (p * w[:, None]).sum(0) / w.sum()
@@ -171,6 +208,8 @@ def pack_object(polygons: list[np.ndarray], *, intrinsics: tuple[float, float, f
         shared = set(face_index[a][face_vmask[a]]) & set(face_index[b][face_vmask[b]])
         for u in sorted(shared):
             for fa, fb in ((a, b), (b, a)):
+                if strict and nl == MAX_LINKS:
+                    raise _TooBig("too many links")
                 if nl < MAX_LINKS:
                     links[nl] = (u, fa, fb)
                     lmask[nl] = True

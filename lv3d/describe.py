@@ -228,9 +228,12 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         cands.append(("object", (obj.id,), max(face_conf.values(), default=0.0), None))
         results.append(ObjectResult(obj, face_results, dihedrals, status, raw))
     if calibrate:
-        feats = calibration_features(cands, results)
-        cands = [(pred, args, grounding.calibrate(scene.modality, pred, p, x), value)
-                 for (pred, args, p, value), x in zip(cands, feats)]
+        # measurements only for the candidates whose map reads them (they cost more than the maps)
+        needs = {pred: bool(grounding.measures_used(scene.modality, pred)) for pred in PREDICATES}
+        feats = calibration_features([c for c in cands if needs[c[0]]], results)
+        it = iter(feats)
+        cands = [(pred, args, grounding.calibrate(scene.modality, pred, p, next(it) if needs[pred] else None), value)
+                 for pred, args, p, value in cands]
     return cands, results
 
 

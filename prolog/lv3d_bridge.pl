@@ -64,7 +64,10 @@ drop_scene(M) :-
 fit(M, Target, BodyPreds, MRs, PosObjs, NegObjs, Settings, result(Texts, J, Soft, TP, NP, FP, NN, Thr)) :-
     maplist(example(Target), PosObjs, Pos), maplist(example(Target), NegObjs, Neg),
     Task = task(M, [Target/1], BodyPreds, MRs, Pos, Neg),
-    learn_noisy(Task, Settings, Prog, score(J, Soft, TP/NP, FP/NN, Thr)),
+    % the reference population of the size principle (mil:best_specific/6): every object of
+    % the scenes, the clutter around the targets included
+    findall(E, ( distinct(O, M:face_of(O, _, _)), example(Target, O, E) ), Ref),
+    learn_noisy(Task, [reference(Ref)|Settings], Prog, score(J, Soft, TP/NP, FP/NN, Thr)),
     program_clauses(Task, Prog, Clauses),
     maplist(clause_text, Clauses, Texts).
 

@@ -46,6 +46,9 @@ default(clause_penalty(0.02)).  % score lost per clause (Occam), see docs/learne
 default(disjunctions(0)).       % learn_noisy: pair this many best one-clause hypotheses (0: off)
 default(thresholds([])).        % learn_noisy: candidate coverage thresholds, one chosen per program ([]: threshold)
 default(miss(0)).               % near misses: an absent fact counts as holding with this confidence (0: off)
+default(reference([])).         % learn_noisy: unlabelled atoms a hypothesis's extension is measured on ([]: the examples)
+default(extra_literals(0)).     % learn_noisy: also keep consistent hypotheses up to this many literals longer than the smallest
+default(size_principle(true)). % learn_noisy: break ties of J by the size principle (false: by Soft, support, cost)
 default(seed(0)).
 
 %!  metarule(?Name, ?Subs, ?Head, ?Body) is nondet.  The library of metarules; the first element
@@ -113,7 +116,33 @@ learn_noisy(Task, Settings0, Best, Score) :-
     option(disjunctions(KD), Settings),
     disjunctions(SCtx, Lambda-Ts, KD, Pos, Neg, Scored, Pairs),
     append(Scored, Pairs, All),
+    best_specific(SCtx, Settings, Pos, All, Best, Score).
+
+%   Among the hypotheses of the best J, the most probable under the size principle (Tenenbaum
+%   1999; docs/learner.md): the positives are taken as drawn from the objects a hypothesis covers,
+%   so P(positives | h) = prod over covered positives of c(h, e) / |h|, with |h| the hypothesis's soft
+%   extension, the sum of its best-proof confidences over the reference objects (option
+%   reference: the unlabelled objects of the scenes; the examples too).  It prefers, of the
+%   hypotheses the few examples cannot tell apart, the one that covers the positives confidently
+%   (robust to a doubtful fact) and holds of few other objects (not over-general); with many
+%   examples J decides and this only breaks its ties.  Then the old key (Soft, support, cost, order).
+best_specific(_, Settings, _, All, Best, Score) :-
+    option(size_principle(false), Settings), !,
     max_member(_-(Best-Score), All).
+best_specific(Ctx, Settings, Pos, All, Best, Score) :-
+    aggregate_all(max(J), member(k(J, _, _, _, _)-_, All), JMax),
+    option(reference(Ref0), Settings), append(Pos, Ref0, Ref1), sort(Ref1, Ref),
+    findall(k(B, Soft, W, C, O)-(Prog-S),
+            ( member(k(J, Soft, W, C, O)-(Prog-S), All), J >= JMax - 1.0e-9,
+              size_likelihood(Ctx, Prog, Pos, Ref, B) ), Top),
+    max_member(_-(Best-Score), Top).
+
+size_likelihood(Ctx, Prog, Pos, Ref, B) :-
+    maplist(best_conf(Ctx, Prog), Pos, CP), maplist(best_conf(Ctx, Prog), Ref, CR),
+    include(<(0), CR, Covered), length(Covered, Ext),
+    foldl(log_likelihood(Ext), CP, 0.0, B).
+
+log_likelihood(Ext, C, B0, B) :- ( C > 0, Ext > 0 -> B is B0 + log(C / Ext) ; B = B0 ).
 
 %   The coverage thresholds a program may take and the context to score with: with
 %   thresholds(Ts) \== [], best proofs are found down to the lowest of them and each program
@@ -215,12 +244,19 @@ sample_hypotheses(Ctx, Settings, TS, P1-N1, r(Found0, Out0), r(Found, Out)) :-
 %   The smallest hypotheses consistent with one sample, at most `solutions` of them: every program
 %   of the size that proves the positives, once each, then those that prove no negative.
 sample_hypothesis(Ctx0, Settings, Pos, Neg, Prog) :-
-    option(solutions(J), Settings),
+    option(solutions(J), Settings), option(extra_literals(X), Settings),
     size(Settings, Ctx0, Ctx),
-    findall(P, prove_examples(Pos, Ctx, [], P), Ps0), list_to_set(Ps0, Ps),
-    findall(P, limit(J, (member(P0, Ps), consistent(Ctx, Neg, P0, P))), Progs),
-    Progs \== [], !,
+    sized_hypotheses(Ctx, J, Pos, Neg, Progs0),
+    Progs0 \== [], !,
+    ctx(Ctx, lits, L0), Lim is L0 + X,
+    findall(P, ( size(Settings, Ctx0, C1), ctx(C1, lits, L), L > L0, L =< Lim,
+                 sized_hypotheses(C1, J, Pos, Neg, Ps), member(P, Ps) ), More),
+    append(Progs0, More, Progs),
     member(Prog, Progs).
+
+sized_hypotheses(Ctx, J, Pos, Neg, Progs) :-
+    findall(P, prove_examples(Pos, Ctx, [], P), Ps0), list_to_set(Ps0, Ps),
+    findall(P, limit(J, (member(P0, Ps), consistent(Ctx, Neg, P0, P))), Progs).
 
 %   K samples: the whole set when it is small, else random subsets (seeded by the caller).
 samples(_, SP, SN, Pos, Neg, [Pos-Neg]) :-

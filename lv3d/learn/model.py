@@ -16,7 +16,7 @@ from .program import Program
 # Metarules for shape concepts, in search order: a part with a property, a part with two, a
 # conjunction on the object, then a part in a relation with another part.
 SHAPE_METARULES = ("part", "part2", "part_pair")
-SHAPE_SETTINGS = {"max_clauses": 1, "max_inventions": 0, "time_limit": 20, "disjunctions": 20}
+SHAPE_SETTINGS = {"max_clauses": 1, "max_inventions": 0, "time_limit": 20, "disjunctions": 20, "extra_literals": 1}
 FIT_MODULE, SCENE_MODULE = "lv3d_fit", "lv3d_scene"
 # When no program proves a scene, a model of several classes names the class whose program it
 # misses by least (docs/learner.md, "Classifying"): a fact the scene lacks counts as holding with

@@ -67,12 +67,9 @@ def grow_convex(poly: np.ndarray, d: float) -> np.ndarray:
     e /= np.maximum(np.linalg.norm(e, axis=1, keepdims=True), 1e-9)
     out_n = np.stack([e[:, 1], -e[:, 0]], axis=1)  # outward for clockwise order with v down
     q = p + d * out_n                               # a point on each moved side i (from p[i] to p[i+1])
-    res = p.copy()
-    for i in range(len(p)):
-        a, u = q[i - 1], e[i - 1]   # side into corner i
-        b, v = q[i], e[i]           # side out of corner i
-        cross = u[0] * v[1] - u[1] * v[0]
-        if abs(cross) > 1e-3:
-            t = ((b[0] - a[0]) * v[1] - (b[1] - a[1]) * v[0]) / cross
-            res[i] = a + t * u
+    a, u = np.roll(q, 1, axis=0), np.roll(e, 1, axis=0)  # the side into each corner
+    cross = u[:, 0] * e[:, 1] - u[:, 1] * e[:, 0]
+    safe = np.where(np.abs(cross) > 1e-3, cross, 1.0)
+    t = ((q[:, 0] - a[:, 0]) * e[:, 1] - (q[:, 1] - a[:, 1]) * e[:, 0]) / safe
+    res = np.where((np.abs(cross) > 1e-3)[:, None], a + t[:, None] * u, p)
     return res

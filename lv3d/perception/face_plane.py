@@ -36,17 +36,20 @@ def polygon_cells(poly: np.ndarray, grid_shape: tuple[int, int], stride: int, sh
 
 def fit_face_plane(poly: np.ndarray, grid: PointGrid, seed: int = 0, min_points: int = 8,
                    min_inliers: float = 0.85, on_mask: np.ndarray | None = None,
-                   min_on_mask: float = 0.5) -> tuple[Plane, np.ndarray, float] | None:
+                   min_on_mask: float = 0.5, max_points: int = 400) -> tuple[Plane, np.ndarray, float] | None:
     """The plane of the depth points inside colour polygon ``poly`` (n, 2) pixels: (plane, inlier points (m, 3)
     metres, RMS residual in metres), or None when fewer than ``min_points`` valid points lie inside or fewer than
     ``min_inliers`` of them fit one plane within the depth noise (the polygon spans an edge or is not a face).
     With ``on_mask`` (grid-shaped bool, e.g. an object's cells), also None when fewer than ``min_on_mask`` of the
-    polygon's cells are on it (a shadow or a patch of table beside the object)."""
+    polygon's cells are on it (a shadow or a patch of table beside the object). At most ``max_points`` cells,
+    evenly spread, are used."""
     cells = polygon_cells(poly, grid.shape, grid.stride)
     if len(cells) < min_points:
         return None
     if on_mask is not None and np.mean(on_mask[cells[:, 0], cells[:, 1]]) < min_on_mask:
         return None
+    if len(cells) > max_points:  # an evenly thinned set says as much about planarity, for less
+        cells = cells[np.linspace(0, len(cells) - 1, max_points).astype(int)]
     ok = grid.valid[cells[:, 0], cells[:, 1]]
     pts = grid.xyz[cells[ok, 0], cells[ok, 1]].astype(np.float64)
     if len(pts) < min_points:

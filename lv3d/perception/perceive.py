@@ -119,6 +119,7 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         colour_face: dict[int, int] = {}
         on_plane = [max((_inside(poly_px[i], q) for q in plane_px), default=0.0) for i in mine]
         claimed = set(match.values())
+        piece: set[int] = set()  # colour faces on a plane another face has: kept only if merged into it
         colour_px = np.zeros(shape, bool)
         for i in mine:
             colour_px |= poly_px[i]
@@ -142,7 +143,9 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
                 if own is None:
                     face = Face("", f.polygon, "rgb", edge_support=f.edge_support)
                 else:
-                    (plane, pts, rms), absorbed = own
+                    (plane, pts, rms), absorbed, on_claimed = own
+                    if on_claimed:
+                        piece.add(len(faces))
                     face = Face("", f.polygon, "rgbd", plane=plane, points=pts, edge_support=f.edge_support,
                                 plane_rms_m=rms)
                     whole = [j for j in absorbed if o.polygons[j] is not None
@@ -169,7 +172,8 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         alias = _merge_coplanar(faces, pairs)
         pairs = {tuple(sorted((alias.get(a, a), alias.get(b, b)))) for a, b in pairs}
         pairs = {(a, b) for a, b in pairs if a != b}
-        keep = [i for i in _reliable(faces) if i not in alias]
+        merged = set(alias) | set(alias.values())
+        keep = [i for i in _reliable(faces) if i not in alias and (i not in piece or i in merged)]
         keep = _drop_covered(faces, keep, shape, off)
         pairs = {(a, b) for a, b in pairs if a in keep and b in keep}
         # stable ids: faces largest first
@@ -210,9 +214,9 @@ _SAME_PLANE_DEG = 12.0     # an unmatched depth plane this close to a colour fac
 
 def _own_plane(poly: np.ndarray, o: DepthObjectResult, dres: DepthResult, on_plane: float,
                plane_px: list[np.ndarray], poly_px: np.ndarray, claimed: set[int], seed: int):
-    """For a colour face that no depth plane matched: its own plane fitted to the depth points inside it, and
-    the unmatched depth planes that are that face badly segmented; None when the points do not make a plane,
-    when it is the plane the face was drawn on (print, shadow) or the support plane."""
+    """For a colour face that no depth plane matched: its own plane fitted to the depth points inside it, the
+    unmatched depth planes that are that face badly segmented, and whether it lies on (and along) a plane that
+    another colour face has already; None when the points do not make a plane or lie on the support plane."""
     # the object's cells grown a little: a face seen edge-on loses cells to the depth-jump cuts of segmentation
     fit = fit_face_plane(poly, dres.grid, seed=seed, on_mask=_dilate(o.obj.mask))
     if fit is None:
@@ -224,13 +228,14 @@ def _own_plane(poly: np.ndarray, o: DepthObjectResult, dres: DepthResult, on_pla
         if angle_deg(plane, dres.support) < _SAME_PLANE_DEG or \
                 height < 0.5 * noise_threshold(float(np.median(pts[:, 2]))):
             return None
-    # drawn on a plane that another colour face already has, and not turned away from it: print or shadow
+    # drawn on a plane that another colour face already has, and not turned away from it: print or shadow, or
+    # the other part of a face that a false colour edge cut in two (told apart later: see _merge_coplanar)
     over = [j for j, q in enumerate(plane_px) if j in claimed and _inside(poly_px, q) >= 0.5]
     if any(angle_deg(plane, o.planes[j].plane) < _DISTINCT_PLANE_DEG for j in over):
-        return None
+        return fit, [], True
     absorbed = [j for j, q in enumerate(o.planes) if j not in claimed
                 and angle_deg(plane, q.plane) < _SAME_PLANE_DEG and np.count_nonzero(plane_px[j] & poly_px)]
-    return fit, absorbed
+    return fit, absorbed, False
 
 
 def _matched_polygon(colour: np.ndarray, j: int, o: DepthObjectResult, colour_px: np.ndarray,
@@ -254,7 +259,8 @@ def _matched_polygon(colour: np.ndarray, j: int, o: DepthObjectResult, colour_px
     if len(colour) > len(depth):
         # more colour corners: the depth outline may have lost a corner region of a face seen obliquely (its
         # mask thins out there); the colour one is right when it holds the depth one and is all on its plane
-        fit = fit_face_plane(colour, dres.grid, seed=seed)
+        # (nearly every point: a sliver of the next face taken in is a few per cent of them)
+        fit = fit_face_plane(colour, dres.grid, seed=seed, min_inliers=0.97)
         if _inside(dm, colour_px) >= 0.9 and fit is not None and \
                 angle_deg(fit[0], o.planes[j].plane) < _SAME_PLANE_DEG:
             return colour

@@ -73,3 +73,23 @@ def test_grow_convex_moves_every_side_outward():
     grown = grow_convex(sq, 1.0)
     assert np.allclose(np.sort(grown, axis=0), np.sort(np.array([[-1, -1], [11, -1], [11, 11], [-1, 11]]), axis=0))
     assert abs(area(grown) - 144) < 1e-9
+
+
+def test_a_face_seen_edge_on_stays_with_its_object():
+    from lv3d.camera import Intrinsics
+    from lv3d.perception.objects import segment_objects
+
+    k = Intrinsics(200, 200, 79.5, 59.5, 160, 120)
+    depth = np.zeros((120, 160), np.float32)
+    depth[30:90, 40:100] = 1.0
+    # 5 grid columns (10 px) whose depth steps by 2.5 % per column: a face nearly along the line of sight
+    for c in range(5):
+        depth[30:90, 100 + 2 * c:102 + 2 * c] = 1.0 * 1.025 ** (c + 1)
+    grid = point_grid(depth, k, stride=2, normals=False)
+    strip = np.zeros(grid.shape, bool)
+    strip[16:44, 50:55] = True
+    without = segment_objects(grid, None, regrow=0)
+    with_regrow = segment_objects(grid, None)
+    assert len(without) == len(with_regrow) == 1
+    assert np.count_nonzero(without[0].mask & strip) < 0.5 * strip.sum()
+    assert np.count_nonzero(with_regrow[0].mask & strip) > 0.8 * strip.sum()

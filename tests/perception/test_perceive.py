@@ -44,3 +44,17 @@ def test_perceive_is_deterministic(box_frame):
     da, db = a.to_dict(), b.to_dict()
     da.pop("timings_ms"), db.pop("timings_ms")
     assert json.dumps(da, default=float) == json.dumps(db, default=float)
+
+
+def test_a_line_painted_across_a_face_does_not_make_it_two_faces(box_frame):
+    import cv2
+
+    frame, normals = box_frame
+    ref = perceive(frame, "rgbd").target()
+    biggest = max(ref.faces, key=lambda f: len(f.points))
+    a, b = biggest.polygon[0], biggest.polygon[2]  # a diagonal of the largest face, drawn in another colour
+    color = frame.color.copy()
+    cv2.line(color, tuple(int(x) for x in a), tuple(int(x) for x in b), (250, 250, 250), 2)
+    painted = perceive(RGBD(color, frame.depth, frame.intrinsics), "rgbd").target()
+    assert sorted(f.sides for f in painted.faces) == [4, 4, 4]
+    assert all(f.plane is not None for f in painted.faces)
