@@ -1,6 +1,7 @@
 """The learner's accuracy under noise and its speed; prints each figure beside its target (issue 5).
 
     .venv/bin/python benchmarks/bench_learner.py [--seed 778] [--per-class 30] [--root /tmp/lv3d_bench]
+        [--quick | --few-shot] [--settings '{"extra_literals": 0}']
 
 Data: two DEV data sets (never the study's seed 0), 640x480 like the study, rendered from the same
 seed with the clean and the realsense preset, their pipeline and ground-truth rgbd facts cached by
@@ -16,6 +17,8 @@ Rows (pipeline facts, i.e. perception + grounding, unless marked truth):
                        at most 10 points from clean to realsense
   labels-20%           clean, with 20 % of the training labels flipped (seeded); target as above
   one-shot             1 positive + 3 negatives (one of each other class) per class task, 4 draws a fold
+  --few-shot           realsense class tasks of 1, 2, 4 positives, 1.5 negatives a positive (at least
+                       one of each other class), 4, 4, 2 draws a fold
   truth ...            context only: facts from the ground truth, exact or perturbed (lv3d.truth_facts)
   fit-100, classify    seconds to learn one class from 100 scenes, ms to classify one scene
 Timings on a shared machine are pessimistic.
@@ -179,21 +182,30 @@ def main(argv=None) -> int:
     ap.add_argument("--positives", type=int, default=20)
     ap.add_argument("--perturb", type=float, default=0.3, help="strength of the truth-fact perturbation")
     ap.add_argument("--quick", action="store_true", help="clean and realsense rows only")
+    ap.add_argument("--few-shot", action="store_true",
+                    help="realsense class tasks of 1, 2, 4 positives (1.5 negatives each, one of each other class at least) only")
+    ap.add_argument("--settings", type=json.loads, default=None, help="learner settings (JSON) for every fit")
     a = ap.parse_args(argv)
     if a.seed == 0:
         raise SystemExit("seed 0 is the study's; use a dev seed")
+    if a.few_shot:
+        rs = Data(dev_set(a.root, "realsense", a.seed, a.per_class))
+        for positives, draws in ((1, 4), (2, 4), (4, 2)):
+            show(f"{positives}-shot realsense", evaluate(rs, rs.pipeline, positives=positives, npp=1.5, seed=a.seed,
+                                                          multiclass=False, draws=draws, settings=a.settings))
+        return 0
     clean, rs = (Data(dev_set(a.root, p, a.seed, a.per_class)) for p in ("clean", "realsense"))
     print(f"dev sets {clean.folder} and {rs.folder}: {len(clean.items)} scenes each; without a target: "
           f"clean {sum(not _has(clean.pipeline[i.id]) for i in clean.items)}, "
           f"realsense {sum(not _has(rs.pipeline[i.id]) for i in rs.items)}", flush=True)
-    kw = {"positives": a.positives, "seed": a.seed}
+    kw = {"positives": a.positives, "seed": a.seed, "settings": a.settings}
     ref = evaluate(clean, clean.pipeline, **kw)
     show("clean", ref)
     show("realsense", evaluate(rs, rs.pipeline, **kw), ref, check=True)
     if a.quick:
         return 0
     show("labels-20% (clean)", evaluate(clean, clean.pipeline, flip=0.2, **kw), ref, check=True)
-    one = {"positives": 1, "npp": 3.0, "seed": a.seed, "multiclass": False, "draws": 4}
+    one = {"positives": 1, "npp": 3.0, "seed": a.seed, "multiclass": False, "draws": 4, "settings": a.settings}
     show("one-shot clean", evaluate(clean, clean.pipeline, **one))
     show("one-shot realsense", evaluate(rs, rs.pipeline, **one))
     tref = evaluate(clean, clean.truth, **kw)

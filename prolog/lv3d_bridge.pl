@@ -5,6 +5,7 @@
 :- module(lv3d_bridge, [guard/4, learn_task/3, load_scene/3, drop_scene/1, fit/8, classify/6, check_program/4]).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
+:- use_module(library(solution_sequences)).
 :- use_module(mil).
 :- use_module(shape_bk).
 :- use_module(mil_task).

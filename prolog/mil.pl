@@ -48,6 +48,7 @@ default(thresholds([])).        % learn_noisy: candidate coverage thresholds, on
 default(miss(0)).               % near misses: an absent fact counts as holding with this confidence (0: off)
 default(reference([])).         % learn_noisy: unlabelled atoms a hypothesis's extension is measured on ([]: the examples)
 default(extra_literals(0)).     % learn_noisy: also keep consistent hypotheses up to this many literals longer than the smallest
+default(few_shot(4)).          % learn_noisy: extra_literals apply to tasks of at most this many positives
 default(size_principle(true)). % learn_noisy: break ties of J by the size principle (false: by Soft, support, cost)
 default(seed(0)).
 
@@ -101,7 +102,8 @@ learn_noisy(Task, Settings0, Best, Score) :-
     option(samples(K), Settings), option(sample_pos(SP), Settings), option(sample_neg(SN), Settings),
     samples(K, SP, SN, Pos, Neg, Samples),
     option(time_limit(T), Settings), length(Samples, NS), TS is T / NS,
-    foldl(sample_hypotheses(Ctx, Settings, TS), Samples, r([], 0), r(Found0, TimedOut)),
+    few_shot(Settings, Pos, SSettings),
+    foldl(sample_hypotheses(Ctx, SSettings, TS), Samples, r([], 0), r(Found0, TimedOut)),
     (   TimedOut =:= NS -> throw(mil_error(time_limit(T))) ; true ),
     append(Found0, Found),
     list_to_set(Found, Unique),                     % in the order found: it breaks ties
@@ -143,6 +145,13 @@ size_likelihood(Ctx, Prog, Pos, Ref, B) :-
     foldl(log_likelihood(Ext), CP, 0.0, B).
 
 log_likelihood(Ext, C, B0, B) :- ( C > 0, Ext > 0 -> B is B0 + log(C / Ext) ; B = B0 ).
+
+%   Longer hypotheses (extra_literals) only for few-shot tasks, of at most few_shot(K) positives:
+%   there the smallest consistent programs are few and often over-general, while with more
+%   examples J tells hypotheses apart and the longer ones would only cost time.
+few_shot(Settings, Pos, Settings) :-
+    option(few_shot(K), Settings), length(Pos, NP), NP =< K, !.
+few_shot(Settings, _, [extra_literals(0)|Settings]).
 
 %   The coverage thresholds a program may take and the context to score with: with
 %   thresholds(Ts) \== [], best proofs are found down to the lowest of them and each program

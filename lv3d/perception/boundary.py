@@ -58,10 +58,10 @@ def grid_to_pixels(grid_mask: np.ndarray, stride: int, box: tuple[int, int, int,
     return out
 
 
-def grow_convex(poly: np.ndarray, d: float) -> np.ndarray:
+def grow_convex(poly: np.ndarray, d: float, miter: float = 2.0) -> np.ndarray:
     """Convex polygon (n, 2) pixels, clockwise in the image, with every side moved ``d`` pixels outward and the
     corners recomputed as the crossings of neighbouring sides (a corner stays put where its sides are nearly
-    parallel)."""
+    parallel, and moves at most ``miter`` * ``d``)."""
     p = np.asarray(poly, np.float64)
     e = np.roll(p, -1, axis=0) - p
     e /= np.maximum(np.linalg.norm(e, axis=1, keepdims=True), 1e-9)
@@ -72,4 +72,9 @@ def grow_convex(poly: np.ndarray, d: float) -> np.ndarray:
     safe = np.where(np.abs(cross) > 1e-3, cross, 1.0)
     t = ((q[:, 0] - a[:, 0]) * e[:, 1] - (q[:, 1] - a[:, 1]) * e[:, 0]) / safe
     res = np.where((np.abs(cross) > 1e-3)[:, None], a + t[:, None] * u, p)
-    return res
+    # miter limit: at a very sharp corner the crossing runs far out along the bisector (d / sin(angle / 2)); the
+    # corner moves at most ``miter`` * d
+    move = res - p
+    dist = np.linalg.norm(move, axis=1)
+    scale = np.minimum(1.0, miter * d / np.maximum(dist, 1e-9))
+    return p + move * scale[:, None]

@@ -78,15 +78,22 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
         height = float(np.percentile(h_above[m], 95)) if support is not None else np.inf
         if height < min_height_m:
             continue
-        # give back the free cells within ``regrow`` cells of this piece, through free cells only
-        grown = m.copy()
+        # give back the free cells within ``regrow`` cells of this piece, through free cells only (worked on
+        # the piece's bounding box grown by ``regrow``: dilating the whole grid per piece costs more)
+        x, y, bw, bh = stats[lab, :4]
+        i0, j0 = max(0, y - regrow), max(0, x - regrow)
+        i1, j1 = min(m.shape[0], y + bh + regrow), min(m.shape[1], x + bw + regrow)
+        grown = m[i0:i1, j0:j1].copy()
+        room = free[i0:i1, j0:j1]
         for _ in range(regrow):
-            ring = cv2.dilate(grown.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool) & free & ~grown
+            ring = cv2.dilate(grown.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool) & room & ~grown
             if not ring.any():
                 break
             grown |= ring
-        free &= ~grown
-        out.append(DepthObject(grown, height))
+        room &= ~grown  # a view into ``free``: these cells are taken
+        m = m.copy()
+        m[i0:i1, j0:j1] |= grown
+        out.append(DepthObject(m, height))
     out.sort(key=lambda o: (-o.size, int(np.argmax(o.mask))))
     return out
 

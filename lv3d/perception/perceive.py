@@ -106,7 +106,8 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
             timings[key] += v
         t0 = time.perf_counter()
         # colour faces of this object: mostly on its depth mask (the crop also holds table and neighbours)
-        grown = grid_to_pixels(_dilate(o.obj.mask), stride, box)
+        obj_grown = _dilate(o.obj.mask)
+        grown = grid_to_pixels(obj_grown, stride, box)
         plane_px = [grid_to_pixels(q.mask, stride, box) for q in o.planes]  # once per object, not per polygon
         off = np.array([box[0], box[1]], float)
         shape = (box[3] - box[1], box[2] - box[0])
@@ -137,7 +138,8 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
                             plane_rms_m=p.rms_m)
                 plane_face[match[a]] = len(faces)
             else:
-                own = _own_plane(f.polygon, o, dres, on_plane[a], plane_px, poly_px[i], claimed, seed=k)
+                own = _own_plane(f.polygon, o, dres, obj_grown, on_plane[a], plane_px, poly_px[i], claimed,
+                                 seed=k)
                 if own is None and on_plane[a] >= 0.5:
                     continue  # a patch of print or shadow on a plane that depth already has: not a face
                 if own is None:
@@ -212,13 +214,14 @@ _DISTINCT_PLANE_DEG = 15.0
 _SAME_PLANE_DEG = 12.0     # an unmatched depth plane this close to a colour face's own plane is that face
 
 
-def _own_plane(poly: np.ndarray, o: DepthObjectResult, dres: DepthResult, on_plane: float,
+def _own_plane(poly: np.ndarray, o: DepthObjectResult, dres: DepthResult, obj_grown: np.ndarray, on_plane: float,
                plane_px: list[np.ndarray], poly_px: np.ndarray, claimed: set[int], seed: int):
     """For a colour face that no depth plane matched: its own plane fitted to the depth points inside it, the
     unmatched depth planes that are that face badly segmented, and whether it lies on (and along) a plane that
     another colour face has already; None when the points do not make a plane or lie on the support plane."""
-    # the object's cells grown a little: a face seen edge-on loses cells to the depth-jump cuts of segmentation
-    fit = fit_face_plane(poly, dres.grid, seed=seed, on_mask=_dilate(o.obj.mask))
+    # on the object's cells grown a little (``obj_grown``): a face seen edge-on loses cells to the depth-jump
+    # cuts of segmentation
+    fit = fit_face_plane(poly, dres.grid, seed=seed, on_mask=obj_grown)
     if fit is None:
         return None
     plane, pts, _ = fit

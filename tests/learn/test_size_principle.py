@@ -37,20 +37,25 @@ def test_prefers_the_hypothesis_true_of_fewer_objects():
 
 
 def test_a_doubtful_fact_weighs_against_its_hypothesis():
-    # square believed 0.55 on the one positive: quadrilateral (true of 1 + 2 clutter + 3 clutter
-    # objects, 6 in all) has likelihood 1/6 = 0.167 < 0.55/0.55 = 1 for square, still square; at
-    # 0.55 with square also on every clutter quadrilateral it would lose (not built here), so
-    # check the confidence enters: the learned program's training score keeps the positive
-    scenes, labels = _one_shot(0.55)
-    prog = fit(scenes, labels, "box", settings={"metarules": ["part"], "disjunctions": 0})
-    assert "square(B)" in prog.clauses[0] and prog.score["tp"] == 1 and prog.score["fp"] == 0
+    # likelihood c / |h|: "a rectangle face" holds of the positive (1.0) and one clutter object,
+    # 1/2; "a square face" of the positive alone, believed c: c/1 wins for c = 0.6, loses for 0.4
+    def learn(c):
+        pos = _scene(0, [("rectangle", 1.0), ("square", c)], ["rectangle"])
+        negs = [_scene(k, [(p, 1.0)], ["triangle"]) for k, p in ((1, "triangle"), (2, "pentagon"))]
+        return fit([pos] + negs, ["box", "other", "other"], "box",
+                   settings={"metarules": ["part"], "disjunctions": 0, "threshold": 0.3}).clauses[0]
+    assert "square(B)" in learn(0.6)
+    assert "rectangle(B)" in learn(0.4)
 
 
 def test_extra_literals_offer_a_more_specific_clause():
-    # every object has a quadrilateral face; only the positive's is also a square: with one extra
-    # literal allowed, part2 "quadrilateral and square" competes, and "square" alone (shorter,
-    # the same extension) still wins, as the likelihood is equal and the proof more confident
-    scenes, labels = _one_shot(0.9)
-    prog = fit(scenes, labels, "box", settings={"metarules": ["part", "part2"], "disjunctions": 0,
-                                                "extra_literals": 1})
-    assert prog.clauses[0].count("(B)") == 1 and "square(B)" in prog.clauses[0]
+    # a quadrilateral face holds of 5 objects, a rectangle one of 2, a face that is both of the
+    # positive alone: with one literal more allowed, that clause is the most probable
+    pos = _scene(0, [("quadrilateral", 1.0), ("rectangle", 1.0)], ["quadrilateral", "rectangle"])
+    negs = [_scene(k, [(p, 1.0)], ["quadrilateral"]) for k, p in ((1, "triangle"), (2, "pentagon"), (3, "hexagon"))]
+    scenes, labels = [pos] + negs, ["box"] + ["other"] * 3
+    opts = {"metarules": ["part", "part2"], "disjunctions": 0}
+    short = fit(scenes, labels, "box", settings={**opts, "extra_literals": 0}).clauses[0]
+    assert "rectangle(B)" in short and "quadrilateral" not in short
+    both = fit(scenes, labels, "box", settings={**opts, "extra_literals": 1}).clauses[0]
+    assert "rectangle(B)" in both and "quadrilateral(B)" in both

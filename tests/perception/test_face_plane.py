@@ -93,3 +93,12 @@ def test_a_face_seen_edge_on_stays_with_its_object():
     assert len(without) == len(with_regrow) == 1
     assert np.count_nonzero(without[0].mask & strip) < 0.5 * strip.sum()
     assert np.count_nonzero(with_regrow[0].mask & strip) > 0.8 * strip.sum()
+
+
+def test_grow_convex_keeps_a_sharp_corner_near_its_place():
+    from lv3d.perception.polygons import clockwise
+
+    sliver = clockwise(np.array([[0, 0], [100, 2], [0, 4]], float))  # a 2-degree tip at (100, 2)
+    grown = grow_convex(sliver, 1.0)
+    assert area(grown) > area(sliver)  # grown outward, not inward
+    assert np.linalg.norm(grown - sliver, axis=1).max() <= 2.0 + 1e-9
