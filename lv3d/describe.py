@@ -54,6 +54,39 @@ def _simplify(poly: np.ndarray, max_sides: int) -> np.ndarray:
     return poly
 
 
+def _first(a, b):
+    return b if a is None else a
+
+
+def dense_face_points(face: Face, frame: RGBD, margin_px: int = 3, gate_m: float = 0.015) -> np.ndarray | None:
+    """Every depth reading of ``frame`` inside ``face.polygon`` shrunk by ``margin_px`` (away from flying
+    pixels and the neighbouring faces) and within ``gate_m`` of the face's plane: camera-frame points (m, 3)
+    in metres. Perception fits on a strided, thinned grid; refinement fits on the full resolution, which has
+    several times the readings and so a steadier plane (the noise is independent per pixel). None when the
+    face has no plane, the frame no depth, or fewer readings are found than perception's points."""
+    if face.plane is None or face.points is None or frame.depth is None:
+        return None
+    h, w = frame.depth.shape
+    poly = np.asarray(face.polygon, np.float64)
+    u0, v0 = np.maximum(np.floor(poly.min(0)).astype(int), 0)
+    u1, v1 = np.minimum(np.ceil(poly.max(0)).astype(int) + 1, (w, h))
+    if u1 - u0 < 3 or v1 - v0 < 3:
+        return None
+    m = np.zeros((v1 - v0, u1 - u0), np.uint8)
+    cv2.fillPoly(m, [np.round(poly - (u0, v0)).astype(np.int32)], 1)
+    if margin_px > 0:
+        m = cv2.erode(m, np.ones((2 * margin_px + 1, 2 * margin_px + 1), np.uint8))
+    z = frame.depth[v0:v1, u0:u1]
+    v, u = np.nonzero((m > 0) & (z > 0))
+    if len(v) < len(face.points):
+        return None
+    k = frame.intrinsics
+    zz = z[v, u].astype(np.float64)
+    pts = np.stack([(u + u0 - k.cx) / k.fx * zz, (v + v0 - k.cy) / k.fy * zz, zz], 1)
+    near = np.abs(pts @ np.asarray(face.plane.n, np.float64) + face.plane.offset) <= gate_m
+    return pts[near] if near.sum() >= len(face.points) else None
+
+
 def _boxes(scene: Scene, margin_px: float, only: SceneObject | None = None) -> list[tuple[float, float, float, float]]:
     """Boxes (u0, v0, u1, v1) around each object's polygons (or ``only``'s) plus ``margin_px``, overlapping
     ones merged: the field is needed only near the sides that are sampled, and one box around objects
@@ -130,7 +163,7 @@ def _chunks(faces: list[Face], max_faces: int, max_vertices: int, max_sides: int
 
 
 def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray | None = None,
-           refine_all: bool = False, calibrate: bool = True):
+           refine_all: bool = False, calibrate: bool = True, dense_points: bool = True):
     """Ground every object of ``scene``: (candidate facts with their probabilities, before any is dropped;
     per-object results). Candidates are ``(pred, args, probability, value)``.
 
@@ -139,7 +172,9 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     confidences from its Laplace covariance (the solver is three quarters of an object's cost).
 
     With ``calibrate``, each probability goes through the per-(modality, predicate) calibration map fitted on
-    dev scenes (:func:`grounding.calibrate`, docs/grounding.md); without it, the raw Gaussian probabilities."""
+    dev scenes (:func:`grounding.calibrate`, docs/grounding.md); without it, the raw Gaussian probabilities.
+    With ``dense_points``, a refined face's plane is fitted to every depth reading inside its outline
+    (:func:`dense_face_points`) rather than perception's strided points."""
     import grounding
     import jax
     import jax.numpy as jnp
@@ -163,13 +198,17 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
             pos = {f.id: i for i, f in enumerate(chunk)}
             polys = [_simplify(f.polygon, grounding.MAX_SIDES) for f in chunk]
             has_plane = [f.plane is not None and f.points is not None and len(f.points) >= 3 for f in chunk]
+            refined = refine and (refine_all or obj is target)
+            pts = [f.points if hp else None for f, hp in zip(chunk, has_plane)]
+            if refined and dense_points:  # only a refined plane moves, so only it needs the full-resolution points
+                pts = [p if p is None else _first(dense_face_points(f, frame), p) for f, p in zip(chunk, pts)]
             prob, index = grounding.pack_object(
                 polys, intrinsics=intr,
                 planes=[np.r_[f.plane.n, f.plane.offset] if hp else None for f, hp in zip(chunk, has_plane)],
-                points=[f.points if hp else None for f, hp in zip(chunk, has_plane)],
+                points=pts,
                 adjacency=[(pos[a], pos[b]) for a, b in obj.adjacency if a in pos and b in pos],
                 support_plane=support)
-            jobs.append((oi, chunk, polys, has_plane, index, prob, refine and (refine_all or obj is target)))
+            jobs.append((oi, chunk, polys, has_plane, index, prob, refined))
     field = jnp.asarray(field, jnp.float32)  # moved to the device once for every object
     grounded = [jax.tree.map(np.asarray, grounding.ground_object(j[5], field, j[6])) for j in jobs]
     for oi, obj in enumerate(scene.objects):

@@ -48,8 +48,8 @@ default(thresholds([])).        % learn_noisy: candidate coverage thresholds, on
 default(miss(0)).               % near misses: an absent fact counts as holding with this confidence (0: off)
 default(reference([])).         % learn_noisy: unlabelled atoms a hypothesis's extension is measured on ([]: the examples)
 default(extra_literals(0)).     % learn_noisy: also keep consistent hypotheses up to this many literals longer than the smallest
-default(few_shot(4)).          % learn_noisy: extra_literals apply to tasks of at most this many positives
-default(size_principle(true)). % learn_noisy: break ties of J by the size principle (false: by Soft, support, cost)
+default(few_shot(4)).          % learn_noisy: the size principle and extra_literals apply to tasks of at most this many positives
+default(size_principle(true)). % learn_noisy: in few-shot tasks break ties of J by the size principle (false: by Soft, support, cost)
 default(seed(0)).
 
 %!  metarule(?Name, ?Subs, ?Head, ?Body) is nondet.  The library of metarules; the first element
@@ -128,8 +128,12 @@ learn_noisy(Task, Settings0, Best, Score) :-
 %   hypotheses the few examples cannot tell apart, the one that covers the positives confidently
 %   (robust to a doubtful fact) and holds of few other objects (not over-general); with many
 %   examples J decides and this only breaks its ties.  Then the old key (Soft, support, cost, order).
-best_specific(_, Settings, _, All, Best, Score) :-
-    option(size_principle(false), Settings), !,
+%   Only for few-shot tasks (at most few_shot(K) positives): with many positives the n log |h|
+%   term favours the most specific of J's ties, which cost a multi-class scene on both dev seeds.
+best_specific(_, Settings, Pos, All, Best, Score) :-
+    (   option(size_principle(false), Settings) -> true
+    ;   option(few_shot(K), Settings), length(Pos, NP), NP > K
+    ), !,
     max_member(_-(Best-Score), All).
 best_specific(Ctx, Settings, Pos, All, Best, Score) :-
     aggregate_all(max(J), member(k(J, _, _, _, _)-_, All), JMax),

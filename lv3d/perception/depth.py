@@ -14,7 +14,8 @@ from .boundary import mask_polygon
 from .cloud import PointGrid, point_grid
 from .objects import DepthObject, segment_objects, support_band
 from .planes import DepthPlane, object_planes, plane_adjacency
-from .snap import snap_polygons
+from .plane_outline import simplify_on_plane
+from .snap import add_triple_corners, snap_polygons
 from .support import noise_threshold
 
 
@@ -63,6 +64,10 @@ def depth_scene(frame: RGBD, stride: int = 2, seed: int = 0, max_objects: int = 
             z = float(np.median(planes[0].points[:, 2]))
             polys = snap_polygons(polys, [p.plane for p in planes], adj, support, frame.intrinsics,
                                   2.5 * noise_threshold(z))
+            polys = add_triple_corners(polys, [p.plane for p in planes], adj, frame.intrinsics)
+            # corners judged on the face's plane, where an edge-on face is not squeezed
+            polys = [None if q is None else simplify_on_plane(q, p.plane, frame.intrinsics)
+                     for q, p in zip(polys, planes)]
         t_boundary += time.perf_counter() - tb
         t_planes += tb - ta
         ij = np.argwhere(o.mask)

@@ -10,6 +10,7 @@ crossings of consecutive side lines. A result that is not a convex polygon near 
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 from ..camera import Intrinsics
@@ -116,13 +117,15 @@ def snap_polygon(poly: np.ndarray, plane: Plane, others: list[Plane], k: Intrins
         else:
             snapped[s] = True
         lines.append(line)
-    # drop unsnapped sides much shorter than the rest: rounded-off corners, not edges of the face
-    keep = [s for s in range(n) if snapped[s] or length[s] >= short_frac * length.mean()]
+    # drop unsnapped sides much shorter than the rest: rounded-off corners, not edges of the face. Lengths on
+    # the plane: in the image a face seen edge-on has its true short sides squeezed to a few pixels
+    length3 = np.linalg.norm(np.vstack([ends3d[1:], ends3d[:1]]) - ends3d, axis=1)
+    keep = [s for s in range(n) if snapped[s] or length3[s] >= short_frac * length3.mean()]
     out = _corners(poly, [lines[s] for s in keep], max_move_px)
     if out is None:
         # a corner cut off further (a sharp apex whose tip went to the neighbour's mask): try without the
         # short unsnapped sides next to a snapped one
-        keep = [s for s in keep if snapped[s] or length[s] >= 0.35 * length.mean()
+        keep = [s for s in keep if snapped[s] or length3[s] >= 0.35 * length3.mean()
                 or not (snapped[s - 1] or snapped[(s + 1) % n])]
         out = _corners(poly, [lines[s] for s in keep], max_move_px)
     return poly if out is None else clockwise(out)
@@ -160,4 +163,52 @@ def snap_polygons(polys: list[np.ndarray | None], planes: list[Plane], adjacency
         if support is not None:
             others.append(support)
         out.append(snap_polygon(poly, planes[i], others, k, near_m))
+    return out
+
+
+def _triple_point(a: Plane, b: Plane, c: Plane, min_det: float = 0.15) -> np.ndarray | None:
+    """The point (3,) metres where three planes meet; None when two of them are nearly parallel or all three
+    nearly share a direction (the lateral faces of a prism meet along parallel lines, at no point)."""
+    n = np.stack([a.n, b.n, c.n])
+    if abs(np.linalg.det(n)) < min_det:
+        return None
+    return np.linalg.solve(n, -np.array([a.offset, b.offset, c.offset]))
+
+
+def add_triple_corners(polys: list[np.ndarray | None], planes: list[Plane], adjacency: list[tuple[int, int]],
+                       k: Intrinsics, max_px: float = 12.0, min_gap_px: float = 3.0) -> list[np.ndarray | None]:
+    """Each face's outline (n, 2) pixels with the corners it lost put back: where the face and two of its
+    neighbours that neighbour each other meet (their planes' common point, projected) there is a corner of the
+    face. A face seen edge-on is a few grid cells wide and its traced hull cuts such a corner off (3 sides for
+    4). A point is added, as a vertex of the outline's convex hull with it, only when it lies outside the
+    outline by at most ``max_px`` pixels and at least ``min_gap_px`` from every vertex."""
+    nb: dict[int, set[int]] = {}
+    for a, b in adjacency:
+        nb.setdefault(a, set()).add(b)
+        nb.setdefault(b, set()).add(a)
+    out = list(polys)
+    for i, poly in enumerate(polys):
+        if poly is None or i not in nb:
+            continue
+        p = np.asarray(poly, np.float64)
+        extra = []
+        ns = sorted(nb[i])
+        for x, a in enumerate(ns):
+            for b in ns[x + 1:]:
+                if b not in nb.get(a, ()):
+                    continue
+                X = _triple_point(planes[i], planes[a], planes[b])
+                if X is None or X[2] <= 0:
+                    continue
+                q = k.project(X[None])[0]
+                if np.min(np.linalg.norm(p - q, axis=1)) < min_gap_px:
+                    continue
+                dist = cv2.pointPolygonTest(p.astype(np.float32).reshape(-1, 1, 2), (float(q[0]), float(q[1])), True)
+                if -max_px <= dist < -1.0:  # outside, near: a cut-off corner
+                    extra.append(q)
+        if not extra:
+            continue
+        hull = cv2.convexHull(np.concatenate([p, np.array(extra)]).astype(np.float32)).reshape(-1, 2)
+        if len(hull) > len(p):
+            out[i] = clockwise(hull.astype(np.float64))
     return out
