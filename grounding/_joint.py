@@ -77,7 +77,7 @@ def residual_blocks(params: Params, prob: ObjectProblem, field: Float[Array, "H 
         return (x @ planes[b, :3] + planes[b, 3]) / (
             cfg.link_sigma_factor * depth_sigma(x[2], cfg.depth_sigma_a_m, cfg.depth_sigma_b_per_m))
 
-    links = jax.vmap(link)(u, fa, fb) * prob.link_mask
+    links = cauchy_residual(jax.vmap(link)(u, fa, fb), cfg.link_cauchy) * prob.link_mask
 
     vsig = jnp.where(prob.vertex_mask, prob.vertex_sigma_px, HELD)
     psig = jnp.where((prob.has_plane & prob.face_mask)[:, None], PLANE_PRIOR, HELD)

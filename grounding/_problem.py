@@ -39,7 +39,12 @@ class Settings(eqx.Module):
     edge_sigma_px: float = 0.7        # a priori spread of a well-localised edge around the edge field's zero
     edge_cauchy_px: float = 2.0       # Cauchy scale of edge residuals (pixels)
     depth_cauchy: float = 3.0         # Cauchy scale of depth residuals (in units of sigma(z))
-    link_sigma_factor: float = 2.0    # shared-vertex links are this many sigma(z) loose
+    # shared-vertex links are this many sigma(z) loose: tight, since refined planes fitted to a face's full-
+    # resolution depth are far surer than one reading (0.1 mm at the vertices on realsense dev scenes), and
+    # a true shared vertex lies on both planes exactly; a Cauchy loss (scale in units of this spread) keeps a
+    # wrongly merged vertex or a wrong adjacency from bending the faces
+    link_sigma_factor: float = 0.25
+    link_cauchy: float = 6.0
     support_px: float = 1.5           # an edge sample within this distance of an image edge counts as supported
 
 
