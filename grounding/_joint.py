@@ -92,7 +92,7 @@ def _flat_residuals(params: Params, args) -> Float[Array, " R"]:
 
 
 def solve(prob: ObjectProblem, field: Float[Array, "H W"], cfg: Settings, refine: Bool[Array, ""],
-          max_steps: int = 16) -> tuple[Params, Array]:
+          max_steps: int = 24) -> tuple[Params, Array]:
     """Refined updates (zero when ``refine`` is False) and a status: 0 converged or not asked, 1 step limit
     or failure (the last iterate is kept: it is never worse than the first guess by much)."""
     # imported here, not at the top: only tracing needs them, and a process that loads a saved program

@@ -58,7 +58,7 @@ def _first(a, b):
     return b if a is None else a
 
 
-def dense_face_points(face: Face, frame: RGBD, margin_px: int = 3, gate_m: float = 0.015) -> np.ndarray | None:
+def dense_face_points(face: Face, frame: RGBD, margin_px: int = 2, gate_m: float = 0.015) -> np.ndarray | None:
     """Every depth reading of ``frame`` inside ``face.polygon`` shrunk by ``margin_px`` (away from flying
     pixels and the neighbouring faces) and within ``gate_m`` of the face's plane: camera-frame points (m, 3)
     in metres. Perception fits on a strided, thinned grid; refinement fits on the full resolution, which has
@@ -68,14 +68,16 @@ def dense_face_points(face: Face, frame: RGBD, margin_px: int = 3, gate_m: float
         return None
     h, w = frame.depth.shape
     poly = np.asarray(face.polygon, np.float64)
-    u0, v0 = np.maximum(np.floor(poly.min(0)).astype(int), 0)
-    u1, v1 = np.minimum(np.ceil(poly.max(0)).astype(int) + 1, (w, h))
+    # the box is grown by the margin: erosion treats outside the box as inside, so a side on the box's edge
+    # would keep its pixels
+    u0, v0 = np.maximum(np.floor(poly.min(0)).astype(int) - margin_px - 1, 0)
+    u1, v1 = np.minimum(np.ceil(poly.max(0)).astype(int) + margin_px + 2, (w, h))
     if u1 - u0 < 3 or v1 - v0 < 3:
         return None
     m = np.zeros((v1 - v0, u1 - u0), np.uint8)
     cv2.fillPoly(m, [np.round(poly - (u0, v0)).astype(np.int32)], 1)
     if margin_px > 0:
-        m = cv2.erode(m, np.ones((2 * margin_px + 1, 2 * margin_px + 1), np.uint8))
+        m = cv2.erode(m, np.ones((2 * margin_px + 1, 2 * margin_px + 1), np.uint8), borderValue=0)
     z = frame.depth[v0:v1, u0:u1]
     v, u = np.nonzero((m > 0) & (z > 0))
     if len(v) < len(face.points):

@@ -138,3 +138,24 @@ def test_objects_with_many_vertices_are_split_into_problems_that_fit():
     assert [f for c in chunks for f in c] == faces
     for c in chunks:
         grounding.pack_object([f.polygon for f in c], intrinsics=(600.0, 600.0, 320.0, 240.0))
+
+
+def test_dense_face_points_take_every_reading_inside_the_shrunk_outline():
+    from lv3d.describe import dense_face_points
+
+    rng = np.random.default_rng(5)
+    frame, faces, _ = _frame_and_faces(rng)
+    poly, plane, pts = faces[0]
+    sparse = pts[::4]  # perception's points: a strided grid
+    face = Face("f", poly, "rgbd", plane=plane, points=sparse)
+    dense = dense_face_points(face, frame, margin_px=3)
+    assert dense is not None and len(dense) > 2 * len(sparse)
+    # on the face's plane, within the depth noise (0.2 % of 0.7 m)
+    assert np.abs(dense @ plane.n + plane.offset).max() < 0.01
+    # nothing within the margin of the outline: every point projects well inside the polygon
+    uv = _project(dense)
+    inside = np.array([cv2.pointPolygonTest(np.float32(poly), (float(u), float(v)), True) for u, v in uv])
+    assert inside.min() > 1.5
+    # a face without a plane, or whose outline holds fewer readings than perception found, keeps its points
+    assert dense_face_points(Face("f", poly, "rgb"), frame) is None
+    assert dense_face_points(Face("f", poly, "rgbd", plane=plane, points=np.zeros((10 ** 6, 3))), frame) is None
