@@ -38,7 +38,7 @@ def source_digest(parts: tuple[str, ...]) -> str:
         if not files:
             raise FileNotFoundError(f"no source files under {part} (looked in {_ROOT})")
         for p in files:
-            h.update(p.relative_to(p.parents[0].parent).as_posix().encode())  # name and folder: a rename counts
+            h.update(p.relative_to(p.parent.parent).as_posix().encode())  # folder and name: a rename counts
             h.update(p.read_bytes())
     return h.hexdigest()[:12]
 
