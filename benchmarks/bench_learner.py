@@ -63,9 +63,9 @@ class Data:
     """A dev set: items, and per id the pipeline facts and the truth facts (a scene without a
     pipeline answer has target None)."""
 
-    def __init__(self, folder: Path):
+    def __init__(self, folder: Path, modality: str = "rgbd"):
         self.folder = folder
-        raw = pickle.loads((folder / "facts_rgbd.pkl").read_bytes())
+        raw = pickle.loads((folder / f"facts_{modality}.pkl").read_bytes())
         man = json.loads((folder / "manifest.json").read_text())
         self.items = [Item(it["id"], it["class"], it["dir"]) for it in man["items"] if it["id"] in raw]
         self.label = {i: v[0] for i, v in raw.items()}
@@ -184,14 +184,16 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="clean and realsense rows only")
     ap.add_argument("--few-shot", action="store_true",
                     help="realsense class tasks of 1, 2, 4 positives (1.5 negatives each, one of each other class at least) only")
+    ap.add_argument("--modality", default="rgbd", choices=("rgbd", "depth"),
+                    help="--few-shot only: whose facts (depth: made with dev_facts.py --modalities rgbd,depth)")
     ap.add_argument("--settings", type=json.loads, default=None, help="learner settings (JSON) for every fit")
     a = ap.parse_args(argv)
     if a.seed == 0:
         raise SystemExit("seed 0 is the study's; use a dev seed")
     if a.few_shot:
-        rs = Data(dev_set(a.root, "realsense", a.seed, a.per_class))
+        rs = Data(dev_set(a.root, "realsense", a.seed, a.per_class), a.modality)
         for positives, draws in ((1, 4), (2, 4), (4, 2)):
-            show(f"{positives}-shot realsense", evaluate(rs, rs.pipeline, positives=positives, npp=1.5, seed=a.seed,
+            show(f"{positives}-shot realsense {a.modality}", evaluate(rs, rs.pipeline, positives=positives, npp=1.5, seed=a.seed,
                                                           multiclass=False, draws=draws, settings=a.settings))
         return 0
     clean, rs = (Data(dev_set(a.root, p, a.seed, a.per_class)) for p in ("clean", "realsense"))

@@ -128,6 +128,15 @@ def ece(p, y, bins=10):
     return float(sum(abs(p[idx == b].mean() - y[idx == b].mean()) * np.mean(idx == b) for b in range(bins) if np.any(idx == b)))
 
 
+def chance_ece(p, bins=10, draws=400, seed=0) -> float:
+    """The ECE a perfectly calibrated type with these confidences shows on average by sampling alone (labels
+    drawn from the confidences): an ECE near it cannot be told from perfect calibration on this many facts."""
+    if len(p) == 0:
+        return float("nan")
+    rng = np.random.default_rng(seed)
+    return float(np.mean([ece(p, rng.random(len(p)) < p, bins) for _ in range(draws)]))
+
+
 def report(rows: list[dict], table: dict, title: str) -> None:
     from grounding._calibration import calibrate_with
 
@@ -141,7 +150,7 @@ def report(rows: list[dict], table: dict, title: str) -> None:
         cal = np.array([(c, r["y"]) for r in rs if (c := calibrate_with(table, *key, r["p"], r)) >= MIN_CONF],
                        float).reshape(-1, 2)
         print(f"  {key[0]:5s} {key[1]:14s} raw {ece(*raw.T):.3f} (n={len(raw):4d})  calibrated {ece(*cal.T):.3f} "
-              f"(n={len(cal):4d})  mean conf {cal[:, 0].mean() if len(cal) else float('nan'):.2f} "
+              f"(n={len(cal):4d}, chance {chance_ece(cal[:, 0]):.3f})  mean conf {cal[:, 0].mean() if len(cal) else float('nan'):.2f} "
               f"true {cal[:, 1].mean() if len(cal) else float('nan'):.2f}")
 
 

@@ -38,6 +38,7 @@ def enable_cache(path: str | os.PathLike | None = None) -> Path:
 
 
 _programs: dict[str, object] = {}
+_keys: dict[tuple, str] = {}
 
 try:  # jax.export needs flatbuffers to serialise; without it programs are traced once per process
     import flatbuffers  # noqa: F401
@@ -83,8 +84,12 @@ def call_saved(name: str, fn, args: tuple) -> list:
     """
     leaves, treedef = jax.tree.flatten(args)
     leaves = [_leaf(x) for x in leaves]
-    spec = [(tuple(np.shape(x)), str(x.dtype)) for x in leaves]
-    key = hashlib.sha256(f"{name}|{_source_digest()}|{treedef}|{spec}".encode()).hexdigest()[:24]
+    # hashing the structure as text costs more than a small program's run: remember each key by its parts
+    parts = (name, treedef, tuple((x.shape, x.dtype) for x in leaves))
+    key = _keys.get(parts)
+    if key is None:
+        spec = [(tuple(np.shape(x)), str(x.dtype)) for x in leaves]
+        key = _keys[parts] = hashlib.sha256(f"{name}|{_source_digest()}|{treedef}|{spec}".encode()).hexdigest()[:24]
     call = _programs.get(key)
     if call is None and not (_CAN_SAVE and _enabled is not None):
         def flat_jit(*lv):

@@ -12,10 +12,11 @@ def _bilinear(img: np.ndarray, uv: np.ndarray) -> np.ndarray:
     h, w = img.shape
     u = np.clip(uv[:, 0], 0, w - 1.001)
     v = np.clip(uv[:, 1], 0, h - 1.001)
-    u0, v0 = u.astype(int), v.astype(int)
+    u0, v0 = u.astype(np.int32), v.astype(np.int32)
     fu, fv = u - u0, v - v0
-    top = img[v0, u0] * (1 - fu) + img[v0, u0 + 1] * fu
-    bottom = img[v0 + 1, u0] * (1 - fu) + img[v0 + 1, u0 + 1] * fu
+    flat, at = img.ravel(), v0 * w + u0
+    top = flat[at] * (1 - fu) + flat[at + 1] * fu
+    bottom = flat[at + w] * (1 - fu) + flat[at + w + 1] * fu
     return top * (1 - fv) + bottom * fv
 
 
@@ -46,36 +47,41 @@ def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 6
     if img.dtype != np.uint8:
         img = cv2.normalize(img, None, 0, 255, cv2.NORM_MINMAX).astype(np.uint8)
     h, w, nc = img.shape
-    edges = np.zeros((h, w), np.uint8)
-    gx = np.zeros((h, w), np.float32)
-    gy = np.zeros((h, w), np.float32)
-    mag = np.zeros((h, w), np.float32)
-    for c in range(nc):
-        ch = cv2.GaussianBlur(np.ascontiguousarray(img[..., c]), (5, 5), 1.0)
-        edges |= cv2.Canny(ch, low, high, L2gradient=True)
-        cx = cv2.Sobel(ch, cv2.CV_32F, 1, 0, ksize=3)
-        cy = cv2.Sobel(ch, cv2.CV_32F, 0, 1, ksize=3)
-        cm = cx * cx + cy * cy
-        take = cm > mag
-        gx[take], gy[take], mag[take] = cx[take], cy[take], cm[take]
-    if not edges.any():
-        return np.full((h, w), cap_px, np.float32)
-    _, labels = cv2.distanceTransformWithLabels(np.where(edges > 0, 0, 255).astype(np.uint8), cv2.DIST_L2, 5,
-                                                labelType=cv2.DIST_LABEL_PIXEL)
+    # one blur and one pair of Sobel derivatives per channel serve both Canny (which would otherwise take
+    # its own, with the same replicated border) and the gradient directions; derivatives of uint8 with
+    # ksize 3 are exact in int16
+    blur = cv2.GaussianBlur(np.ascontiguousarray(img), (5, 5), 1.0)
+    dxs = cv2.split(cv2.Sobel(blur, cv2.CV_16S, 1, 0, ksize=3, borderType=cv2.BORDER_REPLICATE))
+    dys = cv2.split(cv2.Sobel(blur, cv2.CV_16S, 0, 1, ksize=3, borderType=cv2.BORDER_REPLICATE))
+    edges = cv2.Canny(dxs[0], dys[0], low, high, L2gradient=True)
+    for c in range(1, nc):
+        edges |= cv2.Canny(dxs[c], dys[c], low, high, L2gradient=True)
     ev, eu = np.nonzero(edges)  # raster order: label k is the k-th edge pixel
-    g = np.stack([gx[ev, eu], gy[ev, eu]], 1)
+    if not len(ev):
+        return np.full((h, w), cap_px, np.float32)
+    _, labels = cv2.distanceTransformWithLabels(cv2.bitwise_not(edges), cv2.DIST_L2, 5,
+                                                labelType=cv2.DIST_LABEL_PIXEL)
+    mags = [cv2.magnitude(x.astype(np.float32), y.astype(np.float32)) for x, y in zip(dxs, dys)]
+    # each edge pixel's gradient is that of its strongest channel (the first on ties)
+    at = ev * w + eu
+    best = np.argmax(np.stack([mg.ravel()[at] for mg in mags]), axis=0)
+    g = np.stack([np.stack([x.ravel()[at] for x in dxs])[best, np.arange(len(at))],
+                  np.stack([y.ravel()[at] for y in dys])[best, np.arange(len(at))]], 1).astype(np.float32)
     n = g / np.maximum(np.linalg.norm(g, axis=1, keepdims=True), 1e-6)
+    m = np.maximum.reduce(mags)
     # sub-pixel peak of the gradient magnitude along the normal (parabola through three samples)
-    m = np.sqrt(mag)
     pts = np.stack([eu, ev], 1).astype(np.float32)
-    samples = [_bilinear(m, pts + k * n) for k in (-1.0, 0.0, 1.0)]
+    samples = _bilinear(m, np.concatenate([pts - n, pts, pts + n])).reshape(3, -1)
     curv = samples[0] - 2 * samples[1] + samples[2]
     offset = np.where(curv < -1e-6, 0.5 * (samples[0] - samples[2]) / np.where(curv < -1e-6, curv, -1.0), 0.0)
     sub = pts + np.clip(offset, -0.5, 0.5)[:, None] * n
-    k = labels.ravel() - 1
-    vv, uu = np.divmod(np.arange(h * w), w)
-    signed = (uu - sub[k, 0]) * n[k, 0] + (vv - sub[k, 1]) * n[k, 1]
-    return np.clip(signed, -cap_px, cap_px).reshape(h, w).astype(np.float32)
+    # each pixel's signed distance to the line through its nearest edge point: u n_u + v n_v - sub . n
+    n = n.astype(np.float32)
+    c = np.sum(sub * n, axis=1, dtype=np.float32)
+    k = labels - 1
+    signed = (np.arange(w, dtype=np.float32)[None, :] * n[k, 0] + np.arange(h, dtype=np.float32)[:, None] * n[k, 1]
+              - c[k])
+    return np.clip(signed, -cap_px, cap_px, out=signed)
 
 
 def normal_edge_field(depth: np.ndarray, intrinsics: tuple[float, float, float, float], *, smooth_px: float = 2.0,

@@ -11,6 +11,8 @@ Frames and units: pixels (u right, v down, pixel centres at integers) for vertic
 
 from __future__ import annotations
 
+import math
+
 import equinox as eqx
 import numpy as np
 from jaxtyping import Array, Bool, Float, Int
@@ -153,7 +155,7 @@ def _pack(polygons, *, intrinsics, planes, points, use_edges, edge_support, adja
     points = points or [None] * nf
     use_edges = [True] * nf if use_edges is None else list(use_edges)
     edge_support = edge_support or [None] * nf
-    verts: list[np.ndarray] = []
+    verts: list[list[float]] = []  # plain floats: a few dozen tiny vectors are far quicker without numpy
     guided: list[bool] = []
     face_index = np.zeros((MAX_FACES, MAX_SIDES), np.int32)
     face_vmask = np.zeros((MAX_FACES, MAX_SIDES), bool)
@@ -161,22 +163,28 @@ def _pack(polygons, *, intrinsics, planes, points, use_edges, edge_support, adja
         poly = np.asarray(poly, np.float64).reshape(-1, 2)
         if not 3 <= len(poly) <= MAX_SIDES:
             raise ValueError(f"face {f} has {len(poly)} vertices; need 3..{MAX_SIDES}")
-        for j, p in enumerate(poly):
-            d = [np.hypot(*(p - q)) for q in verts]
-            k = int(np.argmin(d)) if d else -1
-            if k < 0 or d[k] > merge_px or k in face_index[f, :j][face_vmask[f, :j]]:
+        ids: list[int] = []
+        for pu, pv in poly.tolist():
+            k, dk = -1, math.inf
+            for i, (qu, qv) in enumerate(verts):  # nearest vertex so far (the first of equals)
+                d = math.hypot(pu - qu, pv - qv)
+                if d < dk:
+                    k, dk = i, d
+            if k < 0 or dk > merge_px or k in ids:
                 if len(verts) >= MAX_VERTICES:
                     raise (_TooBig if strict else ValueError)(f"an object has more than {MAX_VERTICES} distinct vertices")
-                verts.append(p)
+                verts.append([pu, pv])
                 guided.append(False)
                 k = len(verts) - 1
             else:
-                verts[k] = (verts[k] + p) / 2  # merged vertices meet halfway
+                verts[k] = [(verts[k][0] + pu) / 2, (verts[k][1] + pv) / 2]  # merged vertices meet halfway
             guided[k] = guided[k] or bool(use_edges[f])
-            face_index[f, j] = k
-            face_vmask[f, j] = True
+            ids.append(k)
+        face_index[f, : len(ids)] = ids
+        face_vmask[f, : len(ids)] = True
     vertices = np.zeros((MAX_VERTICES, 2))
-    vertices[: len(verts)] = verts
+    if verts:
+        vertices[: len(verts)] = verts
     vmask = np.zeros(MAX_VERTICES, bool)
     vmask[: len(verts)] = True
     vsig = np.ones(MAX_VERTICES)

@@ -3,6 +3,8 @@ not closed (the last vertex joins the first)."""
 
 from __future__ import annotations
 
+import math
+
 import cv2
 import numpy as np
 
@@ -54,29 +56,35 @@ def simplify(poly: np.ndarray, rel_tol: float = 0.06, abs_tol: float = 2.0, min_
     """Drop nearly-collinear vertices until only the true corners remain: repeatedly remove the vertex that
     deviates least from the chord of its neighbours while that deviation is under
     ``max(abs_tol px, rel_tol * chord)`` or the direction turns there by less than ``min_turn_deg``."""
-    p = [np.asarray(v, dtype=np.float64) for v in poly]
+    p = [(float(u), float(v)) for u, v in np.asarray(poly, dtype=np.float64)]
+
+    def score(i: int) -> float:
+        """dev / chord of vertex i, or inf when it is a corner to keep (plain floats: numpy calls on 2-vectors
+        cost more than the arithmetic)."""
+        (ax, ay), (bx, by), (cx, cy) = p[i - 1], p[i], p[(i + 1) % len(p)]
+        chx, chy = cx - ax, cy - ay
+        L = math.hypot(chx, chy)
+        if L < 1e-9:
+            return 0.0  # a vertex between two that coincide: no deviation
+        dev = abs(chx * (by - ay) - chy * (bx - ax)) / L
+        d1x, d1y, d2x, d2y = bx - ax, by - ay, cx - bx, cy - by
+        n1, n2 = math.hypot(d1x, d1y), math.hypot(d2x, d2y)
+        turn = 0.0 if n1 < 1e-9 or n2 < 1e-9 else math.degrees(
+            math.acos(min(1.0, max(-1.0, (d1x * d2x + d1y * d2y) / (n1 * n2)))))
+        ok = dev < max(abs_tol, rel_tol * L) or turn < min_turn_deg
+        return dev / L if ok else math.inf
+
+    scores = [score(i) for i in range(len(p))]
     while len(p) > 3:
-        best, best_score = -1, np.inf
-        n = len(p)
-        for i in range(n):
-            a, b, c = p[i - 1], p[i], p[(i + 1) % n]
-            chord = c - a
-            L = float(np.hypot(*chord))
-            if L < 1e-9:
-                dev, turn = 0.0, 0.0
-            else:
-                dev = abs(chord[0] * (b[1] - a[1]) - chord[1] * (b[0] - a[0])) / L
-                d1, d2 = b - a, c - b
-                n1, n2 = np.hypot(*d1), np.hypot(*d2)
-                turn = 0.0 if n1 < 1e-9 or n2 < 1e-9 else float(
-                    np.degrees(np.arccos(np.clip(np.dot(d1, d2) / (n1 * n2), -1, 1))))
-            ok = dev < max(abs_tol, rel_tol * L) or turn < min_turn_deg
-            score = dev / max(L, 1e-9)
-            if ok and score < best_score:
-                best, best_score = i, score
-        if best < 0:
+        best = min(range(len(p)), key=scores.__getitem__)  # the first of equal scores, as before
+        if scores[best] == math.inf:
             break
         p.pop(best)
+        scores.pop(best)
+        # only the two neighbours of the removed vertex have new chords
+        n = len(p)
+        for i in ((best - 1) % n, best % n):
+            scores[i] = score(i)
     return np.array(p, dtype=np.float64)
 
 

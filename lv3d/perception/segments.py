@@ -27,33 +27,18 @@ def detect_color_segments(channels: list[np.ndarray], min_len_px: float = 8.0) -
     return merge_collinear(segs)
 
 
-class _UnionFind:
-    def __init__(self, n: int):
-        self.parent = np.arange(n)
-
-    def find(self, i: int) -> int:
-        root = i
-        while self.parent[root] != root:
-            root = self.parent[root]
-        while self.parent[i] != root:  # path compression
-            self.parent[i], i = root, self.parent[i]
-        return root
-
-    def union(self, i: int, j: int) -> None:
-        a, b = self.find(i), self.find(j)
-        if a != b:
-            self.parent[max(a, b)] = min(a, b)
-
-    def labels(self) -> np.ndarray:
-        return np.array([self.find(i) for i in range(len(self.parent))])
-
-
 def union_find_labels(n: int, pairs: np.ndarray) -> np.ndarray:
     """Connected-component label (smallest member index) of each of ``n`` items joined by ``pairs`` (m, 2)."""
-    uf = _UnionFind(n)
-    for i, j in pairs:
-        uf.union(int(i), int(j))
-    return uf.labels()
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    pairs = np.asarray(pairs, int).reshape(-1, 2)
+    graph = coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, comp = connected_components(graph, directed=False)
+    # name each component by its smallest member: components are numbered in order of first member already
+    first = np.full(comp.max(initial=-1) + 1, n, int)
+    np.minimum.at(first, comp, np.arange(n))
+    return first[comp]
 
 
 def merge_collinear(segs: np.ndarray, angle_deg: float = 4.0, dist_px: float = 2.0,

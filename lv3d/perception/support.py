@@ -31,29 +31,38 @@ def ransac_plane(points: np.ndarray, dist_m: float, rng: np.random.Generator, it
     Returns the plane and the boolean inlier mask (m,)."""
     m = len(points)
     tri = rng.integers(0, m, size=(iterations, 3))
-    a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
-    n = np.cross(b - a, c - a)
-    norm = np.linalg.norm(n, axis=1)
+    a = points[tri[:, 0]]
+    ab, ac = points[tri[:, 1]] - a, points[tri[:, 2]] - a
+    n = np.empty_like(ab)  # ab x ac written out: np.cross costs more than the product on these small arrays
+    n[:, 0] = ab[:, 1] * ac[:, 2] - ab[:, 2] * ac[:, 1]
+    n[:, 1] = ab[:, 2] * ac[:, 0] - ab[:, 0] * ac[:, 2]
+    n[:, 2] = ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0]
+    norm = np.sqrt(np.einsum("ij,ij->i", n, n))
     good = norm > 1e-12
     n = n[good] / norm[good, None]
     d = -np.einsum("ij,ij->i", n, a[good])
     if len(n) == 0:
         return refine(points), np.ones(m, bool)
+    cos_min = np.cos(np.radians(max_angle_deg))
     # score the hypotheses on a fixed subset of at most score_points points (preemptive RANSAC)
     sub = np.arange(m) if m <= score_points else np.sort(rng.choice(m, score_points, replace=False))
-    dist = np.abs(points[sub] @ n.T + d[None, :])                # (s, k)
-    inl = dist <= dist_m
+    dist = points[sub] @ n.T                                     # (s, k), made |distance| in place
+    dist += d[None, :]
+    inl = np.abs(dist, out=dist) <= dist_m
     if normals is not None:
-        cos_min = np.cos(np.radians(max_angle_deg))
-        inl &= np.abs(normals[sub] @ n.T) >= cos_min
-    best = int(np.argmax(inl.sum(axis=0)))
+        cos = normals[sub] @ n.T
+        inl &= np.abs(cos, out=cos) >= cos_min
+    best = int(np.argmax(np.count_nonzero(inl, axis=0)))
     plane = Plane.from_arrays(n[best], d[best])
     mask = np.zeros(m, bool)
     for _ in range(4):
-        new = np.abs(plane.distance(points)) <= dist_m
+        r = points @ plane.n
+        r += plane.offset
+        new = np.abs(r, out=r) <= dist_m
         if normals is not None:
-            new &= np.abs(normals @ plane.n) >= np.cos(np.radians(max_angle_deg))
-        if new.sum() < 3 or np.array_equal(new, mask):
+            c = normals @ plane.n
+            new &= np.abs(c, out=c) >= cos_min
+        if np.count_nonzero(new) < 3 or np.array_equal(new, mask):
             mask = new
             break  # a stable inlier set refits to the same plane
         mask = new
@@ -85,6 +94,8 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
     for _ in range(max_planes):
         if len(remaining) < min_frac * len(points):
             break
+        if any(-p.normal[1] >= min_up and min_share * c > len(remaining) for p, c in found):
+            break  # no plane left could hold min_share of an upward one found: none of them could win
         plane, mask = ransac_plane(remaining, dist_m, rng, iterations=200)
         if mask.sum() < min_frac * len(points):
             break
