@@ -10,9 +10,13 @@ probability accounts for their correlations. Tolerances are the constants below 
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jax.flatten_util import ravel_pytree
 from jax.scipy.special import ndtr
 from jaxtyping import Array, Float, Int
@@ -85,17 +89,41 @@ def floored(std: Quantities, floors: Floors) -> Quantities:
                       add(std.dihedral_deg, floors.dihedral_deg), add(std.parallel_deg, floors.dihedral_deg))
 
 
-def draws(q: Quantities, jq: Float[Array, "Q K"], cov: Float[Array, "K K"], floors: Floors) -> Quantities:
-    """``MC_DRAWS`` samples of the quantities from their linearised Gaussian plus independent floors."""
-    q_flat, unravel = ravel_pytree(q)
+@functools.cache
+def _normals(k: int, q: int, dtype) -> tuple[np.ndarray, np.ndarray]:
+    """The fixed standard-normal draws ((MC_DRAWS, k) for the unknowns, (MC_DRAWS, q) for the floors), made
+    once outside any trace: generated inside the program they cost more than the rest of the confidences."""
+    with jax.ensure_compile_time_eval():
+        key_a, key_b = jax.random.split(jax.random.key(0))
+        return (np.asarray(jax.random.normal(key_a, (MC_DRAWS, k), dtype)),
+                np.asarray(jax.random.normal(key_b, (MC_DRAWS, q), dtype)))
+
+
+class Drawn(eqx.Module):
+    """``MC_DRAWS`` samples of the quantities that the many-quantity predicates read."""
+
+    para_dev_deg: Float[Array, "M F 2"]
+    log_side_m: Float[Array, "M F S"]
+    corner3d_deg: Float[Array, "M F S"]
+
+
+def draws(q: Quantities, jq: Float[Array, "Q K"], cov: Float[Array, "K K"], floors: Floors) -> Drawn:
+    """``MC_DRAWS`` samples of the quantities from their linearised Gaussian plus independent floors; only
+    the quantities of :class:`Drawn` are sampled (the draws are those of the whole vector, so which are
+    kept does not change them)."""
+    q_flat, _ = ravel_pytree(q)
     k = cov.shape[0]
     chol = jnp.linalg.cholesky(cov + 1e-9 * jnp.eye(k, dtype=cov.dtype))
-    key_a, key_b = jax.random.split(jax.random.key(0))
-    z = jax.random.normal(key_a, (MC_DRAWS, k), cov.dtype)
-    zf = jax.random.normal(key_b, (MC_DRAWS, q_flat.shape[0]), cov.dtype)
+    z, zf = _normals(k, q_flat.shape[0], jnp.dtype(cov.dtype))
     floor_flat = ravel_pytree(floored(jax.tree.map(jnp.zeros_like, q), floors))[0]
-    samples = q_flat[None] + (z @ chol.T) @ jq.T + zf * floor_flat[None]
-    return jax.vmap(unravel)(samples)
+    # positions of the sampled quantities in the flat vector (fields flatten in their declared order)
+    sizes = {f.name: int(np.size(getattr(q, f.name))) for f in dataclasses.fields(Quantities)}
+    start = dict(zip(sizes, np.cumsum([0, *sizes.values()])))
+    drawn = [f.name for f in dataclasses.fields(Drawn)]
+    sel = np.concatenate([np.arange(start[name], start[name] + sizes[name]) for name in drawn])
+    samples = q_flat[sel][None] + (z @ chol.T) @ jq[sel].T + zf[:, sel] * floor_flat[sel][None]
+    parts = jnp.split(samples, np.cumsum([sizes[name] for name in drawn])[:-1], axis=1)
+    return Drawn(*(x.reshape((MC_DRAWS, *np.shape(getattr(q, name)))) for x, name in zip(parts, drawn)))
 
 
 def confidences(q: Quantities, std: Quantities, jq, cov, face_vmask, face_mask, has_plane, has_support,

@@ -61,14 +61,19 @@ def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 6
         return np.full((h, w), cap_px, np.float32)
     _, labels = cv2.distanceTransformWithLabels(cv2.bitwise_not(edges), cv2.DIST_L2, 5,
                                                 labelType=cv2.DIST_LABEL_PIXEL)
-    mags = [cv2.magnitude(x.astype(np.float32), y.astype(np.float32)) for x, y in zip(dxs, dys)]
+    # squared gradient magnitudes, exact in int32 (below 2^24, so float32 would rank them the same)
+    sq = [x.astype(np.int32) ** 2 + y.astype(np.int32) ** 2 for x, y in zip(dxs, dys)]
     # each edge pixel's gradient is that of its strongest channel (the first on ties)
     at = ev * w + eu
-    best = np.argmax(np.stack([mg.ravel()[at] for mg in mags]), axis=0)
-    g = np.stack([np.stack([x.ravel()[at] for x in dxs])[best, np.arange(len(at))],
-                  np.stack([y.ravel()[at] for y in dys])[best, np.arange(len(at))]], 1).astype(np.float32)
+    best = np.argmax(np.stack([m.ravel()[at] for m in sq]), axis=0)
+    pick = (best, np.arange(len(at)))
+    g = np.stack([np.stack([x.ravel()[at] for x in dxs])[pick], np.stack([y.ravel()[at] for y in dys])[pick]],
+                 1).astype(np.float32)
     n = g / np.maximum(np.linalg.norm(g, axis=1, keepdims=True), 1e-6)
-    m = np.maximum.reduce(mags)
+    top = sq[0]
+    for m in sq[1:]:
+        top = np.maximum(top, m)
+    m = np.sqrt(top.astype(np.float32))
     # sub-pixel peak of the gradient magnitude along the normal (parabola through three samples)
     pts = np.stack([eu, ev], 1).astype(np.float32)
     samples = _bilinear(m, np.concatenate([pts - n, pts, pts + n])).reshape(3, -1)

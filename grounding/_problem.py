@@ -11,9 +11,12 @@ Frames and units: pixels (u right, v down, pixel centres at integers) for vertic
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 
 import equinox as eqx
+import jax
 import numpy as np
 from jaxtyping import Array, Bool, Float, Int
 
@@ -75,6 +78,12 @@ class ObjectProblem(eqx.Module):
     intrinsics: Float[Array, " 4"]         # fx, fy, cx, cy in pixels
 
 
+@functools.cache
+def _problem_structure():
+    """The pytree structure of an :class:`ObjectProblem` (every field one array leaf)."""
+    return jax.tree.structure(ObjectProblem(*[0] * len(dataclasses.fields(ObjectProblem))))
+
+
 def _compress(points: np.ndarray, n: int, intrinsics) -> tuple[np.ndarray, np.ndarray]:
     """At most ``n`` points that stand for ``points`` ((m, 3) metres): the means of the points in the
     cells of an image-space grid, each weighted by its count (a cell mean's noise is sigma / sqrt(count)),
@@ -85,9 +94,10 @@ def _compress(points: np.ndarray, n: int, intrinsics) -> tuple[np.ndarray, np.nd
     z = np.where(np.abs(points[:, 2]) < 1e-9, 1e-9, points[:, 2])
     uv = np.stack([fx * points[:, 0] / z + cx, fy * points[:, 1] / z + cy], 1)
     lo, hi = uv.min(0), uv.max(0) + 1e-6
+    rel = uv - lo  # >= 0, so truncation is the floor
 
     def occupied(side):  # (cell of each point, number of occupied cells), by bincount over a dense grid
-        cells = np.floor((uv - lo) / side).astype(np.int64)
+        cells = (rel / side).astype(np.int64)
         key = cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]
         counts = np.bincount(key)
         return key, counts
@@ -102,7 +112,7 @@ def _compress(points: np.ndarray, n: int, intrinsics) -> tuple[np.ndarray, np.nd
             break
         side *= 1.1
     used = np.flatnonzero(counts)
-    sums = np.stack([np.bincount(key, points[:, c], minlength=len(counts))[used] for c in range(3)], 1)
+    sums = np.stack([np.bincount(key, col, minlength=len(counts))[used] for col in np.ascontiguousarray(points.T)], 1)
     return sums / counts[used, None], counts[used].astype(np.float64)
 
 
@@ -234,7 +244,7 @@ def _pack(polygons, *, intrinsics, planes, points, use_edges, edge_support, adja
     es = np.ones(MAX_FACES)
     es[:nf] = [1.0 if s is None else float(s) for s in edge_support]
     sp = np.array([0.0, -1.0, 0.0, 1.0]) if support_plane is None else np.asarray(support_plane, np.float64)
-    prob = ObjectProblem(
+    fields = dict(
         vertices=np.asarray(vertices, np.float32), vertex_mask=np.asarray(vmask), vertex_sigma_px=np.asarray(vsig, np.float32),
         face_index=np.asarray(face_index), face_vmask=np.asarray(face_vmask), face_mask=np.asarray(fmask),
         use_edges=np.asarray(ue), edge_support_prior=np.asarray(es, np.float32), has_plane=np.asarray(has_plane),
@@ -242,4 +252,6 @@ def _pack(polygons, *, intrinsics, planes, points, use_edges, edge_support, adja
         links=np.asarray(links), link_mask=np.asarray(lmask), adjacency=np.asarray(adj),
         support_plane=np.asarray(sp, np.float32), has_support=np.asarray(support_plane is not None),
         intrinsics=np.asarray(intrinsics, np.float32))
+    # unflattening skips equinox's checked __init__, which costs more than the rest of packing a small object
+    prob = jax.tree.unflatten(_problem_structure(), [fields[f.name] for f in dataclasses.fields(ObjectProblem)])
     return prob, face_index[:nf]

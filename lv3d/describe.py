@@ -14,6 +14,7 @@ import cv2
 import numpy as np
 
 from .facts import PREDICATES, Fact, SceneFacts
+from .perception.polygons import area
 from .rgbd import RGBD
 from .scene import Face, Scene, SceneObject
 
@@ -82,10 +83,8 @@ def dense_face_points(face: Face, frame: RGBD, margin_px: int = 2, gate_m: float
     v, u = np.nonzero((m > 0) & (z > 0))
     if len(v) < len(face.points):
         return None
-    k = frame.intrinsics
-    zz = z[v, u].astype(np.float64)
-    pts = np.stack([(u + u0 - k.cx) / k.fx * zz, (v + v0 - k.cy) / k.fy * zz, zz], 1)
-    near = np.abs(pts @ np.asarray(face.plane.n, np.float64) + face.plane.offset) <= gate_m
+    pts = frame.intrinsics.rays(np.stack([u + u0, v + v0], 1)) * z[v, u].astype(np.float64)[:, None]
+    near = np.abs(face.plane.distance(pts)) <= gate_m
     return pts[near] if near.sum() >= len(face.points) else None
 
 
@@ -178,7 +177,6 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     With ``dense_points``, a refined face's plane is fitted to every depth reading inside its outline
     (:func:`dense_face_points`) rather than perception's strided points."""
     import grounding
-    import jax
     import jax.numpy as jnp
 
     grounding.enable_cache()
@@ -212,7 +210,8 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 support_plane=support)
             jobs.append((oi, chunk, polys, has_plane, index, prob, refined))
     field = jnp.asarray(field, jnp.float32)  # moved to the device once for every object
-    grounded = [jax.tree.map(np.asarray, grounding.ground_object(j[5], field, j[6])) for j in jobs]
+    # every program is dispatched before any result is read, then each result is read once
+    grounded = [_to_numpy(g) for g in [grounding.ground_object(j[5], field, j[6]) for j in jobs]]
     for oi, obj in enumerate(scene.objects):
         face_conf: dict[str, float] = {}
         face_results: list[FaceResult] = []
@@ -222,14 +221,14 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         for (oj, chunk, polys, has_plane, index, _, _), g in zip(jobs, grounded):
             if oj != oi:
                 continue
-            g = _to_numpy(g)
             raw.append(([f.id for f in chunk], g))
             status = max(status, int(g["status"]))
             c = g["conf"]
+            vstd_all = _largest_std(g["vertex_cov"])
             for i, f in enumerate(chunk):
                 n = len(polys[i])
                 ids_i = index[i, :n]
-                vstd = np.sqrt(np.linalg.eigvalsh(g["vertex_cov"][ids_i]).max(-1).clip(0))
+                vstd = vstd_all[ids_i]
                 face_results.append(FaceResult(f, g["vertices"][ids_i], g["planes"][i] if has_plane[i] else None, vstd,
                                                _face_features(g, i, n, g["vertices"][ids_i], len(chunk))))
                 support_term = float(np.clip(c["edge_support"][i] / grounding.SUPPORT_FULL, 0.0, 1.0))
@@ -278,15 +277,21 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     return cands, results
 
 
+def _largest_std(cov: np.ndarray) -> np.ndarray:
+    """Square root of the larger eigenvalue of each symmetric 2x2 covariance (..., 2, 2), closed form
+    (quicker than a batched eigvalsh on a few dozen blocks); its lower triangle is read, as eigvalsh does."""
+    a, b, c = cov[..., 0, 0], cov[..., 1, 0], cov[..., 1, 1]
+    return np.sqrt(np.clip(0.5 * (a + c) + np.hypot(0.5 * (a - c), b), 0.0, None))
+
+
 def _face_features(g: dict, i: int, n: int, poly: np.ndarray, faces_in_problem: int) -> dict:
     """Measurements of face ``i`` of a grounding result that the calibration may read: the weakest corner's
     turn in units of its spread (how sure the side count is), edge support, image area and shortest side."""
     turn = 180.0 - g["quantities"]["corner_deg"][i, :n]
     sd = np.hypot(g["std"]["corner_deg"][i, :n], 1.2)
-    area = 0.5 * abs(float(np.dot(poly[:, 0], np.roll(poly[:, 1], -1)) - np.dot(poly[:, 1], np.roll(poly[:, 0], -1))))
     return {"sides": n, "min_turn_deg": float(turn.min()), "min_turn_z": float(((turn - 15.0) / sd).min()),
-            "support": float(g["conf"]["edge_support"][i]), "log_area_px": float(np.log(max(area, 1.0))),
-            "min_side_px": float(np.linalg.norm(np.roll(poly, -1, 0) - poly, axis=1).min()),
+            "support": float(g["conf"]["edge_support"][i]), "log_area_px": float(np.log(max(area(poly), 1.0))),
+            "min_side_px": float(np.linalg.norm(np.diff(poly, axis=0, append=poly[:1]), axis=1).min()),
             "faces": faces_in_problem}
 
 
@@ -295,15 +300,22 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
     about two faces, the weaker of each (smaller value), for ``object`` the object's best face."""
     by_face = {fr.face.id: fr.features for res in results for fr in res.faces}
     by_obj = {res.obj.id: [fr.features for fr in res.faces] for res in results}
+    weaker: dict[tuple[str, ...], dict] = {}  # by faces: a pair has up to six facts, each in both orders
+
+    def combined(args):
+        key = args if len(args) < 2 or args[0] <= args[1] else args[::-1]  # (a, b) and (b, a) share one
+        if key not in weaker:
+            fs = [by_face[a] for a in key if a in by_face]
+            weaker[key] = {k: min(f[k] for f in fs) for k in fs[0]} if fs else {}
+        return weaker[key]
+
     out = []
     for pred, args, _, _ in cands:
-        fs = by_obj.get(args[0], []) if pred == "object" else [by_face[a] for a in args if a in by_face]
-        if not fs:
-            out.append({})
-        elif pred == "object":
-            out.append(max(fs, key=lambda f: f["support"]))
+        if pred == "object":
+            fs = by_obj.get(args[0], [])
+            out.append(max(fs, key=lambda f: f["support"]) if fs else {})
         else:
-            out.append({k: min(f[k] for f in fs) for k in fs[0]})
+            out.append(combined(args))
     return out
 
 

@@ -50,6 +50,7 @@ default(reference([])).         % learn_noisy: unlabelled atoms a hypothesis's e
 default(extra_literals(0)).     % learn_noisy: also keep consistent hypotheses up to this many literals longer than the smallest
 default(few_shot(4)).          % learn_noisy: the size principle and extra_literals apply to tasks of at most this many positives
 default(size_principle(true)). % learn_noisy: in few-shot tasks break ties of J by the size principle (false: by Soft, support, cost)
+default(extension_miss(0)).    % size principle: an uncovered reference object counts its near proof, absent facts at this (0: counts 0)
 default(seed(0)).
 
 %!  metarule(?Name, ?Subs, ?Head, ?Body) is nondet.  The library of metarules; the first element
@@ -122,9 +123,12 @@ learn_noisy(Task, Settings0, Best, Score) :-
 
 %   Among the hypotheses of the best J, the most probable under the size principle (Tenenbaum
 %   1999; docs/learner.md): the positives are taken as drawn from the objects a hypothesis covers,
-%   so P(positives | h) = prod over covered positives of c(h, e) / |h|, with |h| the hypothesis's soft
-%   extension, the sum of its best-proof confidences over the reference objects (option
-%   reference: the unlabelled objects of the scenes; the examples too).  It prefers, of the
+%   so P(positives | h) = prod over covered positives of c(h, e) / |h|, with |h| the size of the
+%   hypothesis's extension over the reference objects (option reference: the unlabelled objects of
+%   the scenes; the examples too).  An object it covers counts 1; with extension_miss(Eps) > 0 an
+%   object it does not cover counts the chance that h holds of it all the same, its best near
+%   proof (a fact it lacks counts Eps, the chance perception missed it; see miss/1), so that a
+%   dozen reference objects still tell a conjunction from its parts.  It prefers, of the
 %   hypotheses the few examples cannot tell apart, the one that covers the positives confidently
 %   (robust to a doubtful fact) and holds of few other objects (not over-general); with many
 %   examples J decides and this only breaks its ties.  Then the old key (Soft, support, cost, order).
@@ -138,15 +142,30 @@ best_specific(_, Settings, Pos, All, Best, Score) :-
 best_specific(Ctx, Settings, Pos, All, Best, Score) :-
     aggregate_all(max(J), member(k(J, _, _, _, _)-_, All), JMax),
     option(reference(Ref0), Settings), append(Pos, Ref0, Ref1), sort(Ref1, Ref),
+    option(extension_miss(Eps), Settings), near_ctx(Ctx, Eps, NCtx),
     findall(k(B, Soft, W, C, O)-(Prog-S),
             ( member(k(J, Soft, W, C, O)-(Prog-S), All), J >= JMax - 1.0e-9,
-              size_likelihood(Ctx, Prog, Pos, Ref, B) ), Top),
+              size_likelihood(Ctx, NCtx, Prog, Pos, Ref, B) ), Top),
     max_member(_-(Best-Score), Top).
 
-size_likelihood(Ctx, Prog, Pos, Ref, B) :-
-    maplist(best_conf(Ctx, Prog), Pos, CP), maplist(best_conf(Ctx, Prog), Ref, CR),
-    include(<(0), CR, Covered), length(Covered, Ext),
+size_likelihood(Ctx, NCtx, Prog, Pos, Ref, B) :-
+    maplist(best_conf(Ctx, Prog), Pos, CP),
+    foldl(extension(Ctx, NCtx, Prog), Ref, 0.0, Ext),
     foldl(log_likelihood(Ext), CP, 0.0, B).
+
+%   An object's share of |h|: 1 when h covers it, else the confidence of its best near proof
+%   (none without extension_miss).
+extension(Ctx, NCtx, Prog, E, X0, X) :-
+    best_conf(Ctx, Prog, E, C),
+    (   C > 0 -> X is X0 + 1
+    ;   NCtx == none -> X = X0
+    ;   best_conf(NCtx, Prog, E, CN), X is X0 + CN
+    ).
+
+%   The context of near proofs: absent facts count Eps, and no threshold but a floor against
+%   underflow.
+near_ctx(_, Eps, none) :- Eps =< 0, !.
+near_ctx(ctx(A, B, C, D, E, _, G, H, I, J, _), Eps, ctx(A, B, C, D, E, 1.0e-12, G, H, I, J, Eps)).
 
 log_likelihood(Ext, C, B0, B) :- ( C > 0, Ext > 0 -> B is B0 + log(C / Ext) ; B = B0 ).
 

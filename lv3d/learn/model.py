@@ -16,12 +16,15 @@ from .program import Program
 # Metarules for shape concepts, in search order: a part with a property, a part with two, a
 # conjunction on the object, then a part in a relation with another part.
 SHAPE_METARULES = ("part", "part2", "part_pair")
-SHAPE_SETTINGS = {"max_clauses": 1, "max_inventions": 0, "time_limit": 20, "disjunctions": 20, "extra_literals": 1}
-FIT_MODULE, SCENE_MODULE = "lv3d_fit", "lv3d_scene"
 # When no program proves a scene, a model of several classes names the class whose program it
 # misses by least (docs/learner.md, "Classifying"): a fact the scene lacks counts as holding with
 # this confidence, the chance that perception missed a true fact.
 NEAR_MISS = 0.1
+# Learning from many examples (docs/learner.md, "Imperfect labels"): 16 samples of 2 positives and
+# 6 negatives; with 20 % wrong labels, 3 to 7 of them hold none, where 8 samples of 2 + 12 held 0.3 to 2.
+SHAPE_SETTINGS = {"max_clauses": 1, "max_inventions": 0, "time_limit": 20, "disjunctions": 20, "extra_literals": 1,
+                  "samples": 16, "sample_neg": 6}
+FIT_MODULE, SCENE_MODULE = "lv3d_fit", "lv3d_scene"
 
 
 # Search order of the body predicates, which decides among equally good hypotheses (the first

@@ -23,14 +23,14 @@ def match_faces(polygons: list[np.ndarray], plane_masks_grid: list[np.ndarray], 
     cands = []
     for i, poly in enumerate(polygons):
         pm = rasterize(poly - off, shape)
-        pa = pm.sum()
+        pa = np.count_nonzero(pm)
         if pa == 0:
             continue
         for j, qm in enumerate(plane_px):
             inter = np.count_nonzero(pm & qm)
             if inter == 0:
                 continue
-            iou = inter / (pa + qm.sum() - inter)
+            iou = inter / (pa + np.count_nonzero(qm) - inter)
             if inter / pa >= min_inside and iou >= min_iou:
                 cands.append((-iou, i, j))
     cands.sort()
@@ -49,5 +49,5 @@ def inside_fraction(poly: np.ndarray, grid_mask: np.ndarray, stride: int, box: t
     u0, v0, u1, v1 = box
     pm = rasterize(poly - np.array([u0, v0], float), (v1 - v0, u1 - u0))
     qm = grid_to_pixels(grid_mask, stride, box)
-    pa = pm.sum()
+    pa = np.count_nonzero(pm)
     return float(np.count_nonzero(pm & qm) / pa) if pa else 0.0

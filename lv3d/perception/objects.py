@@ -22,7 +22,7 @@ class DepthObject:
 
     @property
     def size(self) -> int:
-        return int(self.mask.sum())
+        return int(np.count_nonzero(self.mask))
 
 
 def border_contact(mask: np.ndarray) -> float:

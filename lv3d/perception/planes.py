@@ -39,12 +39,11 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     ``max(min_points, min_frac * object size)`` points in one connected piece."""
     rng = np.random.default_rng(seed)
     full_shape = obj_mask.shape
-    ij = np.argwhere(obj_mask)
-    if len(ij) == 0:
+    rows, cols = np.flatnonzero(obj_mask.any(axis=1)), np.flatnonzero(obj_mask.any(axis=0))
+    if len(rows) == 0:
         return []
     # work on the object's bounding box of the grid: connected components there are cheap
-    (i0, j0), (i1, j1) = ij.min(axis=0), ij.max(axis=0) + 1
-    ij = ij - np.array([i0, j0])
+    i0, j0, i1, j1 = rows[0], cols[0], rows[-1] + 1, cols[-1] + 1
     obj_mask = obj_mask[i0:i1, j0:j1]
     pts = grid.xyz[i0:i1, j0:j1][obj_mask].astype(np.float64)
     nrm_grid = grid.normals[i0:i1, j0:j1]
@@ -58,16 +57,17 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     free = np.ones(len(pts), bool)
     h, w = obj_mask.shape
     planes: list[Plane] = []
+    flat = np.flatnonzero(obj_mask)  # the object's cells as flat indices, in the order of ``pts``
     for _ in range(max_planes):
         idx = np.nonzero(free)[0]
         if len(idx) < need:
             break
         plane, inl = ransac_plane(pts[idx], dist_m, rng, iterations=96, normals=nrm[idx], max_angle_deg=max_angle_deg)
         m = np.zeros((h, w), bool)
-        m[ij[idx[inl], 0], ij[idx[inl], 1]] = True
+        m.flat[flat[idx[inl]]] = True
         piece = _largest_piece(m)
-        sel = piece[ij[:, 0], ij[:, 1]] & free
-        if sel.sum() < need:
+        sel = piece[obj_mask] & free
+        if np.count_nonzero(sel) < need:
             break
         plane = refine(pts[sel])
         planes.append(plane)
@@ -84,18 +84,17 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     out = []
     for k, plane in enumerate(planes):
         m = np.zeros((h, w), bool)
-        sel = ok & (best == k)
-        m[ij[sel, 0], ij[sel, 1]] = True
+        m.flat[flat[ok & (best == k)]] = True
         m = _largest_piece(m)
-        sel = m[ij[:, 0], ij[:, 1]]
-        if sel.sum() < need:
+        sel = m[obj_mask]
+        if np.count_nonzero(sel) < need:
             continue
         p = refine(pts[sel])
         rms = float(np.sqrt(np.mean(p.distance(pts[sel]) ** 2)))
         full = np.zeros(full_shape, bool)
         full[i0:i1, j0:j1] = m
         out.append(DepthPlane(p, full, pts[sel].astype(np.float32), rms))
-    out.sort(key=lambda d: -int(d.mask.sum()))
+    out.sort(key=lambda d: -np.count_nonzero(d.mask))
     return out
 
 
@@ -108,7 +107,7 @@ def plane_adjacency(planes: list[DepthPlane], min_contact: int = 4,
              for p in planes]
     for i in range(len(planes)):
         for j in range(i + 1, len(planes)):
-            contact = int((grown[i] & planes[j].mask).sum())
+            contact = np.count_nonzero(grown[i] & planes[j].mask)
             ang = np.degrees(np.arccos(np.clip(abs(planes[i].plane.n @ planes[j].plane.n), -1, 1)))
             if contact >= min_contact and ang >= min_angle_deg:
                 out.append((i, j))

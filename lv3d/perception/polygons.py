@@ -94,7 +94,7 @@ def clockwise(poly: np.ndarray) -> np.ndarray:
     if signed_area(p) < 0:
         p = p[::-1]
     start = int(np.lexsort((p[:, 0], p[:, 1]))[0])
-    return np.roll(p, -start, axis=0)
+    return np.concatenate([p[start:], p[:start]])
 
 
 def rasterize(poly: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
@@ -107,12 +107,12 @@ def rasterize(poly: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
 def sample_boundary(poly: np.ndarray, step: float = 1.0) -> np.ndarray:
     """Points (m, 2) every ``step`` pixels along the closed boundary."""
     p = np.asarray(poly, dtype=np.float64)
-    out = []
-    for a, b in zip(p, np.roll(p, -1, axis=0)):
-        k = max(1, int(np.ceil(np.hypot(*(b - a)) / step)))
-        t = np.arange(k)[:, None] / k
-        out.append(a + t * (b - a))
-    return np.concatenate(out, axis=0)
+    d = np.concatenate([p[1:], p[:1]]) - p
+    k = np.maximum(1, np.ceil(np.hypot(d[:, 0], d[:, 1]) / step).astype(int))
+    side = np.repeat(np.arange(len(p)), k)
+    # position along its side of each sample: 0, 1/k, ..., (k-1)/k
+    t = (np.arange(len(side)) - np.repeat(np.cumsum(k) - k, k)) / k[side]
+    return p[side] + t[:, None] * d[side]
 
 
 def drop_short_sides(poly: np.ndarray, rel_len: float = 0.15, reach: float = 1.5) -> np.ndarray:

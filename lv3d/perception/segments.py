@@ -29,16 +29,21 @@ def detect_color_segments(channels: list[np.ndarray], min_len_px: float = 8.0) -
 
 def union_find_labels(n: int, pairs: np.ndarray) -> np.ndarray:
     """Connected-component label (smallest member index) of each of ``n`` items joined by ``pairs`` (m, 2)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+    parent = list(range(n))  # plain lists: numpy scalar indexing costs more than the work here
 
-    pairs = np.asarray(pairs, int).reshape(-1, 2)
-    graph = coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-    _, comp = connected_components(graph, directed=False)
-    # name each component by its smallest member: components are numbered in order of first member already
-    first = np.full(comp.max(initial=-1) + 1, n, int)
-    np.minimum.at(first, comp, np.arange(n))
-    return first[comp]
+    def find(i: int) -> int:
+        root = i
+        while parent[root] != root:
+            root = parent[root]
+        while parent[i] != root:  # path compression
+            parent[i], i = root, parent[i]
+        return root
+
+    for i, j in np.asarray(pairs, int).reshape(-1, 2).tolist():
+        a, b = find(i), find(j)
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    return np.array([find(i) for i in range(n)], int)
 
 
 def merge_collinear(segs: np.ndarray, angle_deg: float = 4.0, dist_px: float = 2.0,
@@ -55,29 +60,26 @@ def merge_collinear(segs: np.ndarray, angle_deg: float = 4.0, dist_px: float = 2
     length = np.hypot(d[:, 0], d[:, 1])
     u = d / length[:, None]
     nrm = np.stack([-u[:, 1], u[:, 0]], axis=1)
-    cosang = np.abs(u @ u.T)
-    close_dir = cosang >= np.cos(np.radians(angle_deg))
-    # distance of j's ends to i's line, and their positions along it
-    def along(axis: np.ndarray, pts: np.ndarray) -> np.ndarray:
-        dx = pts[None, :, 0] - p0[:, None, 0]
-        dy = pts[None, :, 1] - p0[:, None, 1]
-        return axis[:, None, 0] * dx + axis[:, None, 1] * dy
+    # only pairs of nearly parallel segments can merge: the other tests run on those pairs alone, both ways
+    i, j = np.nonzero(np.triu(np.abs(u @ u.T) >= np.cos(np.radians(angle_deg)), 1))
 
-    on_line = (np.abs(along(nrm, p0)) <= dist_px) & (np.abs(along(nrm, p1)) <= dist_px)
-    t0, t1 = along(u, p0), along(u, p1)
-    lo, hi = np.minimum(t0, t1), np.maximum(t0, t1)
-    gap = np.maximum(lo - length[:, None], -hi)
-    near = gap <= gap_px
-    ok = close_dir & on_line & near
-    ok = ok & ok.T
-    i, j = np.nonzero(np.triu(ok, 1))
+    def ok(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """For pairs (a, b): b's ends within ``dist_px`` of a's line, and b overlapping a or near its ends."""
+        def along(axis: np.ndarray, pts: np.ndarray) -> np.ndarray:
+            return axis[a, 0] * (pts[b, 0] - p0[a, 0]) + axis[a, 1] * (pts[b, 1] - p0[a, 1])
+
+        on_line = (np.abs(along(nrm, p0)) <= dist_px) & (np.abs(along(nrm, p1)) <= dist_px)
+        t0, t1 = along(u, p0), along(u, p1)
+        gap = np.maximum(np.minimum(t0, t1) - length[a], -np.maximum(t0, t1))
+        return on_line & (gap <= gap_px)
+
+    both = ok(i, j) & ok(j, i)
+    i, j = i[both], j[both]
     labels = union_find_labels(n, np.stack([i, j], axis=1))
-    out = []
-    for lab in np.unique(labels):
+    alone = np.bincount(labels, minlength=n)[labels] == 1
+    out = list(segs[alone])
+    for lab in np.unique(labels[~alone]):
         idx = np.nonzero(labels == lab)[0]
-        if len(idx) == 1:
-            out.append(segs[idx[0]])
-            continue
         pts = np.concatenate([p0[idx], p1[idx]], axis=0)
         w = np.concatenate([length[idx], length[idx]])
         c = (pts * w[:, None]).sum(0) / w.sum()

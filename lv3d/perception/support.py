@@ -15,7 +15,7 @@ from ..plane import Plane
 
 def refine(points: np.ndarray) -> Plane:
     """Least-squares plane through points (m, 3): the smallest principal direction of their scatter."""
-    c = points.mean(axis=0)
+    c = points.sum(axis=0) / len(points)  # what mean() computes, without its wrapper's overhead
     q = points - c
     _, vecs = np.linalg.eigh(q.T @ q)  # 3x3 scatter: cheaper than an SVD of all the points
     n = vecs[:, 0]
@@ -97,9 +97,10 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
         if any(-p.normal[1] >= min_up and min_share * c > len(remaining) for p, c in found):
             break  # no plane left could hold min_share of an upward one found: none of them could win
         plane, mask = ransac_plane(remaining, dist_m, rng, iterations=200)
-        if mask.sum() < min_frac * len(points):
+        count = int(np.count_nonzero(mask))
+        if count < min_frac * len(points):
             break
-        found.append((plane, int(mask.sum())))
+        found.append((plane, count))
         remaining = remaining[~mask]
     up = [(p, c) for p, c in found if -p.normal[1] >= min_up]
     if up:

@@ -59,3 +59,18 @@ def test_extra_literals_offer_a_more_specific_clause():
     assert "rectangle(B)" in short and "quadrilateral" not in short
     both = fit(scenes, labels, "box", settings={**opts, "extra_literals": 1}).clauses[0]
     assert "rectangle(B)" in both and "quadrilateral(B)" in both
+
+
+def test_extension_miss_counts_near_proofs_of_uncovered_objects():
+    # "a square face" and "a square, regular face" both hold of the positive alone (|h| = 1 by
+    # count), so the caller's predicate order picks the shorter; measured with near proofs
+    # (extension_miss), a clutter triangle nearly holds "a square face" (0.1) but the conjunction
+    # only at 0.01, so the conjunction is the smaller hypothesis
+    pos = _scene(0, [("square", 1.0), ("regular", 1.0)], ["triangle", "triangle"])
+    negs = [_scene(k, [(p, 1.0)], ["triangle"]) for k, p in ((1, "pentagon"), (2, "hexagon"))]
+    scenes, labels = [pos] + negs, ["box", "other", "other"]
+    opts = {"metarules": ["part", "part2"], "disjunctions": 0, "extra_literals": 1}
+    count = fit(scenes, labels, "box", settings=opts).clauses[0]
+    assert "square(B)" in count and "regular" not in count
+    near = fit(scenes, labels, "box", settings={**opts, "extension_miss": 0.1}).clauses[0]
+    assert "square(B)" in near and "regular(B)" in near
