@@ -181,9 +181,13 @@ class Model:
         for r in ans[0]["Rs"] if ans else []:
             label, conf, trace = _result_parts(r)
             if near or conf >= thr[label]:
-                out.append({"label": label, "conf": conf, "trace": trace})
+                # a near proof ranks by its per-fact (geometric mean) confidence: a program of two
+                # facts missing one is half matched, one of four missing one three-quarters, where
+                # the product would rank them alike and favour the fewer present facts
+                n = sum(k in ("fact", "missing") for k, _, _ in trace) if near else 1
+                out.append({"label": label, "conf": conf, "trace": trace, "rank": conf ** (1 / max(n, 1))})
         j = {k: p.score.get("j", 0.0) for k, p in self.programs.items()}
-        out.sort(key=lambda r: (r["conf"], j.get(r["label"], 0.0)), reverse=True)
+        out.sort(key=lambda r: (r["rank"], j.get(r["label"], 0.0)), reverse=True)
         return out
 
     def _decide(self, scene: SceneFacts) -> list[dict]:

@@ -1,6 +1,6 @@
 import numpy as np
 
-from lv3d.perception.polygons import area, clockwise, is_simple, rasterize, signed_area, simplify
+from lv3d.perception.polygons import area, clockwise, is_simple, rasterize, sample_boundary, signed_area, simplify
 
 
 def test_simplify_keeps_only_true_corners():
@@ -30,3 +30,18 @@ def test_clockwise_in_the_image_has_positive_area():
 def test_rasterize_counts_the_inside():
     m = rasterize(np.array([[2, 2], [11, 2], [11, 11], [2, 11]], float), (20, 20))
     assert m.sum() == 100
+
+
+def test_sample_boundary_steps_along_every_side():
+    tri = np.array([[0, 0], [10, 0], [0, 4.5]], float)
+    pts = sample_boundary(tri, 1.0)
+    # ceil(side / step) samples per side, starting at each vertex: 10 + 11 + 5
+    assert len(pts) == 10 + int(np.ceil(np.hypot(10, 4.5))) + 5
+    np.testing.assert_allclose(pts[:10], np.stack([np.arange(10.0), np.zeros(10)], axis=1))
+    np.testing.assert_allclose(pts[-5:], np.stack([np.zeros(5), 4.5 - 0.9 * np.arange(5)], axis=1))
+
+
+def test_simplify_removes_the_least_deviating_vertex_first():
+    # two candidates: the near-collinear one goes, the true corner of the triangle-with-a-bump stays
+    poly = np.array([[0, 0], [50, 1], [100, 0], [50, 80]], float)
+    np.testing.assert_allclose(simplify(poly), [[0, 0], [100, 0], [50, 80]])

@@ -1,7 +1,7 @@
 import numpy as np
 
 from lv3d.perception.faces import bounded_faces, build_graph
-from lv3d.perception.segments import merge_collinear
+from lv3d.perception.segments import merge_collinear, union_find_labels
 
 
 def test_merge_collinear_joins_pieces_of_one_edge():
@@ -15,6 +15,12 @@ def test_merge_collinear_joins_pieces_of_one_edge():
 def test_merge_collinear_keeps_parallel_lines_apart():
     segs = np.array([[0, 0, 50, 0], [0, 8, 50, 8]], float)
     assert len(merge_collinear(segs)) == 2
+
+
+def test_union_find_labels_names_each_component_by_its_smallest_member():
+    labels = union_find_labels(7, np.array([[4, 2], [2, 6], [5, 1]]))
+    np.testing.assert_array_equal(labels, [0, 1, 2, 3, 2, 1, 2])
+    np.testing.assert_array_equal(union_find_labels(3, np.zeros((0, 2), int)), [0, 1, 2])
 
 
 def test_square_with_gaps_at_the_corners_is_one_face():

@@ -1,0 +1,70 @@
+"""The quick paths kept for speed give what the plain computations give: Monte Carlo draws of only the
+quantities that are read, vertex merging and point compression in pack_object, and the edge field's
+per-channel gradients."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax.flatten_util import ravel_pytree
+
+import grounding
+from grounding import _confidence, _problem
+from grounding._uncertainty import Quantities
+
+INTR = (600.0, 600.0, 320.0, 240.0)
+
+
+def test_draws_equal_the_columns_of_drawing_every_quantity():
+    rng = np.random.default_rng(3)
+    f, s, k = 4, 6, 9
+    shapes = dict(side_px=(f, s), corner_deg=(f, s), para_dev_deg=(f, 2), log_side_m=(f, s), corner3d_deg=(f, s),
+                  tilt_deg=(f,), dihedral_deg=(f, f), parallel_deg=(f, f))
+    q = Quantities(**{name: jnp.asarray(rng.normal(size=sh), jnp.float32) for name, sh in shapes.items()})
+    q_flat, unravel = ravel_pytree(q)
+    jq = jnp.asarray(rng.normal(size=(q_flat.shape[0], k)), jnp.float32)
+    a = rng.normal(size=(k, k))
+    cov = jnp.asarray(a @ a.T + k * np.eye(k), jnp.float32)
+    floors = grounding.Floors()
+    got = jax.jit(_confidence.draws)(q, jq, cov, floors)
+
+    # the plain computation: every quantity drawn inside the program from the same keys
+    chol = jnp.linalg.cholesky(cov + 1e-9 * jnp.eye(k, dtype=cov.dtype))
+    key_a, key_b = jax.random.split(jax.random.key(0))
+    z = jax.random.normal(key_a, (_confidence.MC_DRAWS, k), cov.dtype)
+    zf = jax.random.normal(key_b, (_confidence.MC_DRAWS, q_flat.shape[0]), cov.dtype)
+    floor_flat = ravel_pytree(_confidence.floored(jax.tree.map(jnp.zeros_like, q), floors))[0]
+    want = jax.vmap(unravel)(q_flat[None] + (z @ chol.T) @ jq.T + zf * floor_flat[None])
+    for name in ("para_dev_deg", "log_side_m", "corner3d_deg"):
+        np.testing.assert_allclose(getattr(got, name), getattr(want, name), rtol=1e-4, atol=1e-4)
+
+
+def test_close_vertices_of_two_faces_meet_halfway_once():
+    left = np.array([[100.0, 100.0], [150.0, 100.0], [150.0, 150.0], [100.0, 150.0]])
+    right = np.array([[151.0, 100.0], [200.0, 100.0], [200.0, 150.0], [151.0, 151.0]])
+    prob, index = grounding.pack_object([left, right], intrinsics=INTR)
+    assert int(np.sum(prob.vertex_mask)) == 6
+    shared = sorted(set(index[0, :4]) & set(index[1, :4]))  # slots past a face's sides are padding
+    assert len(shared) == 2
+    np.testing.assert_allclose(np.asarray(prob.vertices)[shared], [[150.5, 100.0], [150.5, 150.5]])
+    # a face never uses one vertex twice, even where two of its own corners are within the merge distance
+    tiny = np.array([[300.0, 300.0], [303.0, 300.0], [301.0, 303.0]])
+    _, index = grounding.pack_object([tiny], intrinsics=INTR)
+    assert len(set(index[0, :3])) == 3
+
+
+def test_compressed_points_keep_the_count_and_the_mean():
+    rng = np.random.default_rng(1)
+    pts = np.c_[rng.uniform(-0.1, 0.1, (3000, 2)), rng.uniform(0.9, 1.1, 3000)]
+    means, weights = _problem._compress(pts, 64, INTR)
+    assert len(means) <= 64 and weights.sum() == len(pts)
+    np.testing.assert_allclose((means * weights[:, None]).sum(0) / weights.sum(), pts.mean(0), atol=1e-9)
+
+
+def test_edge_field_takes_each_edge_from_its_strongest_channel():
+    img = np.zeros((120, 160, 3), np.uint8)
+    img[:, 80:, 1] = 200  # a step in green only, at u = 79.5
+    img[60:, :, 2] = 90   # a weaker step in blue only, at v = 59.5
+    field = grounding.edge_distance_field(img)
+    assert abs(field[20, 79] + 0.5) < 0.15 and abs(field[20, 80] - 0.5) < 0.15
+    assert abs(field[59, 20] + 0.5) < 0.15 and abs(field[60, 20] - 0.5) < 0.15
+    assert abs(field[20, 70] + 9.5) < 0.2
