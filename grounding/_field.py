@@ -12,9 +12,10 @@ def _bilinear(img: np.ndarray, uv: np.ndarray) -> np.ndarray:
     h, w = img.shape
     u = np.clip(uv[:, 0], 0, w - 1.001)
     v = np.clip(uv[:, 1], 0, h - 1.001)
-    u0, v0 = u.astype(np.int32), v.astype(np.int32)
+    # floor in the positions' own dtype: mixing in int32 would promote float32 positions to float64
+    u0, v0 = np.floor(u), np.floor(v)
     fu, fv = u - u0, v - v0
-    flat, at = img.ravel(), v0 * w + u0
+    flat, at = img.ravel(), v0.astype(np.int32) * w + u0.astype(np.int32)
     top = flat[at] * (1 - fu) + flat[at + 1] * fu
     bottom = flat[at + w] * (1 - fu) + flat[at + w + 1] * fu
     return top * (1 - fv) + bottom * fv
@@ -81,11 +82,11 @@ def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 6
     offset = np.where(curv < -1e-6, 0.5 * (samples[0] - samples[2]) / np.where(curv < -1e-6, curv, -1.0), 0.0)
     sub = pts + np.clip(offset, -0.5, 0.5)[:, None] * n
     # each pixel's signed distance to the line through its nearest edge point: u n_u + v n_v - sub . n
-    n = n.astype(np.float32)
     c = np.sum(sub * n, axis=1, dtype=np.float32)
     k = labels - 1
-    signed = (np.arange(w, dtype=np.float32)[None, :] * n[k, 0] + np.arange(h, dtype=np.float32)[:, None] * n[k, 1]
-              - c[k])
+    nu, nv = np.ascontiguousarray(n.T)
+    signed = (np.arange(w, dtype=np.float32)[None, :] * nu.take(k)
+              + np.arange(h, dtype=np.float32)[:, None] * nv.take(k) - c.take(k))
     return np.clip(signed, -cap_px, cap_px, out=signed)
 
 

@@ -124,7 +124,8 @@ class Explanation:
             return f"{self.target}: unknown (no class's program proves it)"
         if self.missing:
             lines = [f"{self.target} is most likely a {self.label} (confidence {self.confidence:.3f}): no program "
-                     f"proves it, and this one misses by {len(self.missing)} fact(s) the fewest"]
+                     f"proves it, and this one misses by {len(self.missing)} of its {len(self.facts) + len(self.missing)} "
+                     f"fact(s), the least"]
         else:
             lines = [f"{self.target} is a {self.label} (confidence {self.confidence:.3f}) because"]
         lines += ["  " + c.replace("\n", "\n  ") for c in self.clauses]
@@ -140,8 +141,8 @@ class Model:
     """One program per class. ``predict`` names the class whose program proves the scene's target
     with the highest confidence (ties: the program with the higher training J). When none proves
     it: with one program, "unknown" (the negative answer of a class task); with several, the class
-    whose program it misses by least (fewest absent facts, then most confident), with that near
-    proof's confidence, which is below the coverage threshold."""
+    whose program it misses by least (the highest per-fact confidence, absent facts at NEAR_MISS),
+    with that near proof's confidence, which is below the coverage threshold."""
 
     def __init__(self, programs: dict[str, Program], settings: dict | None = None,
                  failures: dict[str, str] | None = None):

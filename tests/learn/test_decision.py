@@ -50,6 +50,16 @@ def test_near_miss_never_for_one_program_or_structure():
     assert _model().predict(bare) == ("unknown", 0.0)
 
 
+def test_near_miss_ranks_by_the_share_of_facts_missed():
+    # tri misses one of its four facts (face_of, triangle 0.9, perpendicular, square 0.9): product
+    # 0.081; pent misses one of three (face_of, pentagon, regular 1.0): product 0.1. The product
+    # would name pent, which matches the scene by one square face; per fact tri matches better
+    scene = _scene(5, [[("triangle", 0.9)], [("square", 0.9), ("regular", 1.0)]])
+    assert _model()._proofs(scene) == []
+    label, conf = _model().predict(scene)
+    assert label == "tri" and abs(conf - 0.081) < 1e-6
+
+
 def test_proved_class_wins_over_near_misses():
     scene = _scene(4, [[("pentagon", 0.9), ("regular", 0.9)], [("triangle", 1.0)]])
     label, conf = _model().predict(scene)
