@@ -29,6 +29,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.calibration_error import chance_ece, ece  # noqa: E402
 from benchmarks.grounding_truth import match_faces, truth_labels, truth_quantities, truth_scene  # noqa: E402
 from lv3d.describe import MIN_CONF, ground  # noqa: E402
 from lv3d.perception import perceive  # noqa: E402
@@ -45,14 +46,6 @@ DEBUG = bool(os.environ.get("BENCH_DEBUG"))
 
 def _med(xs):
     return float(np.median(xs)) if len(xs) else float("nan")
-
-
-def ece(p: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
-    """Expected calibration error: sum over confidence bins of |mean confidence - accuracy| * share."""
-    if len(p) == 0:
-        return float("nan")
-    idx = np.minimum((p * bins).astype(int), bins - 1)
-    return float(sum(abs(p[idx == b].mean() - y[idx == b].mean()) * np.mean(idx == b) for b in range(bins) if np.any(idx == b)))
 
 
 def run_preset(preset: str, per_class: int, seed0: int, source: str = "perceived") -> dict:
@@ -217,7 +210,7 @@ def main(argv=None) -> int:
             p, y = np.array(rows).T
             e = ece(p, y)
             tgt = f"  (target <= {ECE_TARGET}: {'met' if e <= ECE_TARGET else 'NOT met'})" if preset == "realsense" else ""
-            print(f"  ECE {pred:14s} {e:.3f}  n={len(p):4d}  mean conf {p.mean():.2f}  true {y.mean():.2f}{tgt}")
+            print(f"  ECE {pred:14s} {e:.3f}  n={len(p):4d}  chance {chance_ece(p):.3f}  mean conf {p.mean():.2f}  true {y.mean():.2f}{tgt}")
         if allp:
             p, y = np.array(allp).T
             print(f"  ECE all facts      {ece(p, y):.3f}  n={len(p)}")

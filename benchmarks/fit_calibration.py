@@ -27,6 +27,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.calibration_error import chance_ece, ece  # noqa: E402
 from grounding._calibration import design  # noqa: E402
 
 MODALITIES = ("rgbd", "depth")  # rgb is left raw: see docs/grounding.md (its labels need a look first)
@@ -119,22 +120,6 @@ def fit_one(rows: list[dict], seed: int = 0):
     b, c, f = _fit_monotone(rows, cands[name])
     return {"features": f, "bias": round(b, 5), "coef": [round(float(v), 5) for v in c], "n": len(rows),
             "map": name, "cv_logloss": round(losses[name], 4)}, losses
-
-
-def ece(p, y, bins=10):
-    if len(p) == 0:
-        return float("nan")
-    idx = np.minimum((p * bins).astype(int), bins - 1)
-    return float(sum(abs(p[idx == b].mean() - y[idx == b].mean()) * np.mean(idx == b) for b in range(bins) if np.any(idx == b)))
-
-
-def chance_ece(p, bins=10, draws=400, seed=0) -> float:
-    """The ECE a perfectly calibrated type with these confidences shows on average by sampling alone (labels
-    drawn from the confidences): an ECE near it cannot be told from perfect calibration on this many facts."""
-    if len(p) == 0:
-        return float("nan")
-    rng = np.random.default_rng(seed)
-    return float(np.mean([ece(p, rng.random(len(p)) < p, bins) for _ in range(draws)]))
 
 
 def report(rows: list[dict], table: dict, title: str) -> None:

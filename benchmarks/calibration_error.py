@@ -1,0 +1,27 @@
+"""Expected calibration error of fact confidences, and the level sampling alone produces (used by
+bench_grounding.py and fit_calibration.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def ece(p: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
+    """Expected calibration error: sum over equal-width confidence bins of |mean confidence - share true| *
+    share of facts in the bin. ``p`` (n,) confidences in [0, 1]; ``y`` (n,) truth as 0/1 or bool."""
+    p, y = np.asarray(p, float), np.asarray(y, float)
+    if len(p) == 0:
+        return float("nan")
+    idx = np.minimum((p * bins).astype(int), bins - 1)
+    return float(sum(abs(p[idx == b].mean() - y[idx == b].mean()) * np.mean(idx == b) for b in range(bins) if np.any(idx == b)))
+
+
+def chance_ece(p: np.ndarray, bins: int = 10, draws: int = 400, seed: int = 0) -> float:
+    """The ECE a perfectly calibrated fact type with these confidences shows on average by sampling alone
+    (labels drawn from the confidences): an ECE near it cannot be told from perfect calibration on this
+    many facts."""
+    p = np.asarray(p, float)
+    if len(p) == 0:
+        return float("nan")
+    rng = np.random.default_rng(seed)
+    return float(np.mean([ece(p, rng.random(len(p)) < p, bins) for _ in range(draws)]))
