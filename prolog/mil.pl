@@ -51,6 +51,7 @@ default(extra_literals(0)).     % learn_noisy: also keep consistent hypotheses u
 default(few_shot(4)).          % learn_noisy: the size principle and extra_literals apply to tasks of at most this many positives
 default(size_principle(true)). % learn_noisy: in few-shot tasks break ties of J by the size principle (false: by Soft, support, cost)
 default(extension_miss(0)).    % size principle: an uncovered reference object counts its near proof, absent facts at this (0: counts 0)
+default(literal_prior(0)).     % size principle: log prior of a hypothesis, -this per body literal (Occam; 0: flat prior)
 default(seed(0)).
 
 %!  metarule(?Name, ?Subs, ?Head, ?Body) is nondet.  The library of metarules; the first element
@@ -143,15 +144,20 @@ best_specific(Ctx, Settings, Pos, All, Best, Score) :-
     aggregate_all(max(J), member(k(J, _, _, _, _)-_, All), JMax),
     option(reference(Ref0), Settings), append(Pos, Ref0, Ref1), sort(Ref1, Ref),
     option(extension_miss(Eps), Settings), near_ctx(Ctx, Eps, NCtx),
+    option(literal_prior(LP), Settings),
     findall(k(B, Soft, W, C, O)-(Prog-S),
             ( member(k(J, Soft, W, C, O)-(Prog-S), All), J >= JMax - 1.0e-9,
-              size_likelihood(Ctx, NCtx, Prog, Pos, Ref, B) ), Top),
+              size_likelihood(Ctx, NCtx, Prog, Pos, Ref, L),
+              literals(Prog, NL), B is L - LP * NL ), Top),
     max_member(_-(Best-Score), Top).
 
 size_likelihood(Ctx, NCtx, Prog, Pos, Ref, B) :-
     maplist(best_conf(Ctx, Prog), Pos, CP),
     foldl(extension(Ctx, NCtx, Prog), Ref, 0.0, Ext),
     foldl(log_likelihood(Ext), CP, 0.0, B).
+
+%   The number of body literals of a program (its clauses' together).
+literals(Prog, N) :- aggregate_all(sum(K), (member(sub(_, [_|Syms], _), Prog), length(Syms, K)), N).
 
 %   An object's share of |h|: 1 when h covers it, else the confidence of its best near proof
 %   (none without extension_miss).

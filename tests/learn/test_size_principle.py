@@ -74,3 +74,17 @@ def test_extension_miss_counts_near_proofs_of_uncovered_objects():
     assert "square(B)" in count and "regular" not in count
     near = fit(scenes, labels, "box", settings={**opts, "extension_miss": 0.1}).clauses[0]
     assert "square(B)" in near and "regular(B)" in near
+
+
+def test_literal_prior_charges_each_literal_against_the_extension_it_saves():
+    # the scene of the test above: with near proofs, |"a square face"| = 1 + 6 x 0.1 = 1.6 and
+    # |"a square, regular face"| = 1 + 6 x 0.01 = 1.06, a gain of log(1.6 / 1.06) = 0.41 nats for
+    # one more literal; a prior of exp(-0.2) a literal lets it pay, exp(-1) does not
+    pos = _scene(0, [("square", 1.0), ("regular", 1.0)], ["triangle", "triangle"])
+    negs = [_scene(k, [(p, 1.0)], ["triangle"]) for k, p in ((1, "pentagon"), (2, "hexagon"))]
+    scenes, labels = [pos] + negs, ["box", "other", "other"]
+    opts = {"metarules": ["part", "part2"], "disjunctions": 0, "extra_literals": 1, "extension_miss": 0.1}
+    cheap = fit(scenes, labels, "box", settings={**opts, "literal_prior": 0.2}).clauses[0]
+    assert "square(B)" in cheap and "regular(B)" in cheap
+    dear = fit(scenes, labels, "box", settings={**opts, "literal_prior": 1.0}).clauses[0]
+    assert "square(B)" in dear and "regular" not in dear
