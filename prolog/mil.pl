@@ -132,7 +132,9 @@ learn_noisy(Task, Settings0, Best, Score) :-
 %   dozen reference objects still tell a conjunction from its parts.  It prefers, of the
 %   hypotheses the few examples cannot tell apart, the one that covers the positives confidently
 %   (robust to a doubtful fact) and holds of few other objects (not over-general); with many
-%   examples J decides and this only breaks its ties.  Then the old key (Soft, support, cost, order).
+%   examples J decides and this only breaks its ties.  With literal_prior(L) > 0 the prior
+%   exp(-L * literals) multiplies it (Occam): a literal must shrink |h| by more than e^L.
+%   Then the old key (Soft, support, cost, order).
 %   Only for few-shot tasks (at most few_shot(K) positives): with many positives the n log |h|
 %   term favours the most specific of J's ties, which cost a multi-class scene on both dev seeds.
 best_specific(_, Settings, Pos, All, Best, Score) :-
