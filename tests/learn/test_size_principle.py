@@ -61,14 +61,19 @@ def test_extra_literals_offer_a_more_specific_clause():
     assert "rectangle(B)" in both and "quadrilateral(B)" in both
 
 
+def _square_regular_task():
+    """One positive with a square, regular face among clutter triangles, two negatives: (scenes, labels)."""
+    pos = _scene(0, [("square", 1.0), ("regular", 1.0)], ["triangle", "triangle"])
+    negs = [_scene(k, [(p, 1.0)], ["triangle"]) for k, p in ((1, "pentagon"), (2, "hexagon"))]
+    return [pos] + negs, ["box", "other", "other"]
+
+
 def test_extension_miss_counts_near_proofs_of_uncovered_objects():
     # "a square face" and "a square, regular face" both hold of the positive alone (|h| = 1 by
     # count), so the caller's predicate order picks the shorter; measured with near proofs
     # (extension_miss), a clutter triangle nearly holds "a square face" (0.1) but the conjunction
     # only at 0.01, so the conjunction is the smaller hypothesis
-    pos = _scene(0, [("square", 1.0), ("regular", 1.0)], ["triangle", "triangle"])
-    negs = [_scene(k, [(p, 1.0)], ["triangle"]) for k, p in ((1, "pentagon"), (2, "hexagon"))]
-    scenes, labels = [pos] + negs, ["box", "other", "other"]
+    scenes, labels = _square_regular_task()
     opts = {"metarules": ["part", "part2"], "disjunctions": 0, "extra_literals": 1}
     count = fit(scenes, labels, "box", settings=opts).clauses[0]
     assert "square(B)" in count and "regular" not in count
@@ -80,9 +85,7 @@ def test_literal_prior_charges_each_literal_against_the_extension_it_saves():
     # the scene of the test above: with near proofs, |"a square face"| = 1 + 6 x 0.1 = 1.6 and
     # |"a square, regular face"| = 1 + 6 x 0.01 = 1.06, a gain of log(1.6 / 1.06) = 0.41 nats for
     # one more literal; a prior of exp(-0.2) a literal lets it pay, exp(-1) does not
-    pos = _scene(0, [("square", 1.0), ("regular", 1.0)], ["triangle", "triangle"])
-    negs = [_scene(k, [(p, 1.0)], ["triangle"]) for k, p in ((1, "pentagon"), (2, "hexagon"))]
-    scenes, labels = [pos] + negs, ["box", "other", "other"]
+    scenes, labels = _square_regular_task()
     opts = {"metarules": ["part", "part2"], "disjunctions": 0, "extra_literals": 1, "extension_miss": 0.1}
     cheap = fit(scenes, labels, "box", settings={**opts, "literal_prior": 0.2}).clauses[0]
     assert "square(B)" in cheap and "regular(B)" in cheap
