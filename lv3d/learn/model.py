@@ -118,6 +118,8 @@ class Explanation:
     derived: list[str] = field(default_factory=list)
     others: dict[str, float] = field(default_factory=dict)
     missing: list[str] = field(default_factory=list)  # facts the scene lacks (a near miss)
+    near: bool = False  # no program proves the scene at its threshold: this is the nearest one
+
 
     def __str__(self) -> str:
         if self.label == "unknown":
@@ -126,6 +128,9 @@ class Explanation:
             lines = [f"{self.target} is most likely a {self.label} (confidence {self.confidence:.3f}): no program "
                      f"proves it, and this one misses by {len(self.missing)} of its {len(self.facts) + len(self.missing)} "
                      f"fact(s), the least"]
+        elif self.near:
+            lines = [f"{self.target} is most likely a {self.label} (confidence {self.confidence:.3f}): no program "
+                     f"proves it above its threshold, and this one comes nearest"]
         else:
             lines = [f"{self.target} is a {self.label} (confidence {self.confidence:.3f}) because"]
         lines += ["  " + c.replace("\n", "\n  ") for c in self.clauses]
@@ -194,7 +199,7 @@ class Model:
     def _decide(self, scene: SceneFacts) -> list[dict]:
         proofs = self._proofs(scene)
         if not proofs and len(self.programs) > 1:
-            proofs = self._proofs(scene, near=True)
+            proofs = [{**p, "near": True} for p in self._proofs(scene, near=True)]
         return proofs
 
     def _thresholds(self, opts: dict) -> dict[str, float]:
@@ -219,7 +224,7 @@ class Model:
             facts=[(a, c) for k, a, c in best["trace"] if k == "fact"],
             derived=[a for k, a, _ in best["trace"] if k == "derived"],
             others={p["label"]: p["conf"] for p in proofs[1:]},
-            missing=[a for k, a, _ in best["trace"] if k == "missing"])
+            missing=[a for k, a, _ in best["trace"] if k == "missing"], near=best.get("near", False))
 
     def save(self, out_dir: Path) -> Path:
         out_dir = Path(out_dir)

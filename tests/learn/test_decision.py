@@ -60,6 +60,16 @@ def test_near_miss_ranks_by_the_share_of_facts_missed():
     assert label == "tri" and abs(conf - 0.081) < 1e-6
 
 
+def test_near_answer_with_every_fact_says_it_is_below_threshold():
+    # every fact of tri's clause is there, but the right angle is too doubtful for the threshold
+    scene = _scene(6, [[("triangle", 1.0)], [("square", 1.0)]], pairs=[("perpendicular", 1, 2, 0.3)])
+    model = _model()
+    assert model._proofs(scene) == []
+    e = model.explain(scene)
+    assert e.label == "tri" and e.near and not e.missing and abs(e.confidence - 0.3) < 1e-6
+    assert "is most likely a tri" in str(e) and "above its threshold" in str(e)
+
+
 def test_proved_class_wins_over_near_misses():
     scene = _scene(4, [[("pentagon", 0.9), ("regular", 0.9)], [("triangle", 1.0)]])
     label, conf = _model().predict(scene)
