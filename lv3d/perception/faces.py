@@ -34,10 +34,15 @@ class GraphFace:
 
 
 def build_graph(segs: np.ndarray, reach_px: float = 10.0, rel_reach: float = 0.35, merge_px: float = 5.0,
-                min_angle_deg: float = 12.0) -> PlanarGraph:
+                min_angle_deg: float = 12.0, edge_dist: np.ndarray | None = None, far_reach_px: float = 40.0,
+                far_rel_reach: float = 0.35) -> PlanarGraph:
     """Planar graph of segments (n, 4). Two segments meet where their lines cross, if that point lies within
     ``min(reach_px, rel_reach * length)`` of each segment (extending ends a little, never far) and they are at
-    least ``min_angle_deg`` apart. Junctions within ``merge_px`` become one vertex."""
+    least ``min_angle_deg`` apart. With ``edge_dist`` (H, W) float, the distance in pixels from each pixel to the
+    nearest edge pixel (:func:`lv3d.perception.edges.edge_distance`), one of the two may also reach up to
+    ``min(far_reach_px, far_rel_reach * length)`` where the whole extension runs along edge pixels: LSD stops
+    well short of a corner where a thin face's edge converges on a neighbour's, though the image edge goes on.
+    Junctions within ``merge_px`` become one vertex."""
     n = len(segs)
     if n < 3:
         return PlanarGraph(np.zeros((0, 2)), np.zeros((0, 2), int))
@@ -57,6 +62,9 @@ def build_graph(segs: np.ndarray, reach_px: float = 10.0, rel_reach: float = 0.3
     ok_i = (s >= -reach[:, None]) & (s <= length[:, None] + reach[:, None])
     ok_j = (t >= -reach[None, :]) & (t <= length[None, :] + reach[None, :])
     meet = apart & ok_i & ok_j
+    if edge_dist is not None:
+        far = np.minimum(far_reach_px, far_rel_reach * length)
+        meet |= _far_meetings(p0, u, length, s, t, apart & ~meet, reach, far, edge_dist)
     np.fill_diagonal(meet, False)
     ii, jj = np.nonzero(np.triu(meet, 1))
     if len(ii) == 0:
@@ -89,6 +97,41 @@ def build_graph(segs: np.ndarray, reach_px: float = 10.0, rel_reach: float = 0.3
             edges.add((min(va, vb), max(va, vb)))
     e = np.array(sorted(edges), dtype=int).reshape(-1, 2)
     return prune(PlanarGraph(vertices, e))
+
+
+def _far_meetings(p0: np.ndarray, u: np.ndarray, length: np.ndarray, s: np.ndarray, t: np.ndarray,
+                  cand: np.ndarray, reach: np.ndarray, far: np.ndarray, edge_dist: np.ndarray,
+                  tol_px: float = 1.0, min_on: float = 1.0, samples: int = 12) -> np.ndarray:
+    """(n, n) bool: pairs among ``cand`` whose crossing (at ``s`` along i, ``t`` along j) lies within ``far``
+    (n,) px of one segment and within ``reach`` (n,) px of the other, where each extension past its segment's
+    end longer than ``reach`` has at least ``min_on`` of its points within ``tol_px`` of an edge pixel (texture
+    edges rarely run straight on for long; a hole in the edge stops the extension)."""
+    gap_i = np.maximum(np.maximum(-s, s - length[:, None]), 0.0)
+    gap_j = np.maximum(np.maximum(-t, t - length[None, :]), 0.0)
+    with np.errstate(invalid="ignore"):
+        cand = cand & (((gap_i <= far[:, None]) & (gap_j <= reach[None, :])) |
+                       ((gap_j <= far[None, :]) & (gap_i <= reach[:, None])))
+    ii, jj = np.nonzero(np.triu(cand, 1))
+    out = np.zeros_like(cand)
+    if len(ii) == 0:
+        return out
+    ok = np.ones(len(ii), bool)
+    h, w = edge_dist.shape
+    frac = np.linspace(0.0, 1.0, samples)
+    for seg, along in ((ii, s[ii, jj]), (jj, t[ii, jj])):
+        beyond = np.maximum(np.maximum(-along, along - length[seg]), 0.0) > reach[seg]
+        end = np.clip(along, 0.0, length[seg])
+        a = p0[seg] + end[:, None] * u[seg]           # the segment's end nearest the crossing
+        b = p0[seg] + along[:, None] * u[seg]         # the crossing
+        pts = a[:, None, :] + frac[None, :, None] * (b - a)[:, None, :]
+        uu = np.round(pts[..., 0]).astype(int)
+        vv = np.round(pts[..., 1]).astype(int)
+        inside = (uu >= 0) & (uu < w) & (vv >= 0) & (vv < h)
+        d = edge_dist[np.clip(vv, 0, h - 1), np.clip(uu, 0, w - 1)]
+        on = np.mean((d <= tol_px) & inside, axis=1) >= min_on
+        ok &= ~beyond | on
+    out[ii[ok], jj[ok]] = True
+    return out | out.T
 
 
 def _bridges(nv: int, edges: np.ndarray) -> set[tuple[int, int]]:

@@ -68,7 +68,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     t1 = time.perf_counter()
     segs = detect_color_segments(chans)
     t2 = time.perf_counter()
-    g = build_graph(segs)
+    g = build_graph(segs, edge_dist=dist)
     cw, ch = u1 - u0, v1 - v0
     frame = (0, 0, cw - 1, ch - 1)
     cands = []

@@ -47,3 +47,35 @@ def test_graph_is_deterministic():
     segs = rng.uniform(0, 200, (40, 4))
     a, b = build_graph(segs), build_graph(segs.copy())
     assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.edges, b.edges)
+
+
+def _square_edge_distance(size: int = 120) -> np.ndarray:
+    """Distance to the outline of the square (10, 10)-(100, 100), as edge_distance gives it."""
+    import cv2
+
+    from lv3d.perception.edges import edge_distance
+
+    edges = np.zeros((size, size), np.uint8)
+    cv2.rectangle(edges, (10, 10), (100, 100), 255, 1)
+    return edge_distance(edges)
+
+
+def test_segment_stopping_far_short_of_a_corner_reaches_it_along_the_edge_map():
+    # the left side stops 20 px short of the bottom-left corner: beyond the plain reach (10 px)
+    segs = np.array([[13, 10, 97, 10], [100, 13, 100, 97], [97, 100, 13, 100], [10, 80, 10, 13]], float)
+    assert bounded_faces(build_graph(segs)) == []
+    faces = bounded_faces(build_graph(segs, edge_dist=_square_edge_distance()))
+    assert len(faces) == 1 and len(faces[0].cycle) == 4
+    assert np.allclose(sorted(faces[0].polygon[:, 1]), [10, 10, 100, 100], atol=1)
+
+
+def test_far_reach_needs_edge_pixels_all_along_the_extension():
+    segs = np.array([[13, 10, 97, 10], [100, 13, 100, 97], [97, 100, 13, 100], [10, 80, 10, 13]], float)
+    dist = _square_edge_distance()
+    import cv2
+
+    from lv3d.perception.edges import edge_distance
+
+    edges = (dist == 0).astype(np.uint8) * 255
+    cv2.line(edges, (10, 85), (10, 95), 0, 1)  # a 10 px hole in the edge along the gap
+    assert bounded_faces(build_graph(segs, edge_dist=edge_distance(edges))) == []
