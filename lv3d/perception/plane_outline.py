@@ -12,7 +12,7 @@ import numpy as np
 from ..camera import Intrinsics
 from ..plane import Plane
 from .polygons import clockwise, drop_short_sides, simplify
-from .snap import _cross
+from .snap import cross3
 
 # a ray this close to lying in the plane (|cos| of its angle to the normal) lifts to a point whose place is
 # dominated by the plane's error: the face is seen too edge-on to be measured on its plane
@@ -23,9 +23,9 @@ def plane_basis(plane: Plane) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(origin (3,), e1 (3,), e2 (3,)): the plane's point nearest the camera and two orthonormal in-plane axes."""
     n = plane.n
     a = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    e1 = _cross(n, a)
+    e1 = cross3(n, a)
     e1 /= np.linalg.norm(e1)
-    return -plane.offset * n, e1, _cross(n, e1)
+    return -plane.offset * n, e1, cross3(n, e1)
 
 
 def lift(poly: np.ndarray, plane: Plane, k: Intrinsics) -> np.ndarray | None:

@@ -31,7 +31,7 @@ def _meet(a: _Line, b: _Line) -> np.ndarray | None:
     return p + s * u
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Cross product of two 3-vectors (np.cross costs ten times more on single vectors)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
@@ -40,7 +40,7 @@ def _intersection_line(pi: Plane, pj: Plane, near: np.ndarray, k: Intrinsics) ->
     """Image of the 3D line where planes ``pi`` and ``pj`` meet, around the camera-frame point ``near`` (m).
     Written with 3-vectors in plain numpy (no solve/project calls): it runs for every side of every face."""
     ni, nj = pi.n, pj.n
-    d = _cross(ni, nj)
+    d = cross3(ni, nj)
     nd = float(np.sqrt(d @ d))
     if nd < np.sin(np.radians(10.0)):
         return None
@@ -48,7 +48,7 @@ def _intersection_line(pi: Plane, pj: Plane, near: np.ndarray, k: Intrinsics) ->
     # the point of the line nearest ``near``: n_i.x = -o_i, n_j.x = -o_j, d.x = d.near, by Cramer's rule
     # with rows (n_i, n_j, d), whose determinant is d . (n_i x n_j) = nd
     rhs = (-pi.offset, -pj.offset, float(d @ near))
-    x0 = (rhs[0] * _cross(nj, d) + rhs[1] * _cross(d, ni) + rhs[2] * _cross(ni, nj)) / nd
+    x0 = (rhs[0] * cross3(nj, d) + rhs[1] * cross3(d, ni) + rhs[2] * cross3(ni, nj)) / nd
     a, b = x0 - 0.03 * d, x0 + 0.03 * d
     if a[2] <= 0.05 or b[2] <= 0.05:
         return None
