@@ -11,6 +11,7 @@ import jax
 import numpy as np
 
 _enabled: Path | None = None
+_asked: tuple | None = None  # the request that gave _enabled
 
 
 def enable_cache(path: str | os.PathLike | None = None) -> Path:
@@ -22,18 +23,23 @@ def enable_cache(path: str | os.PathLike | None = None) -> Path:
     all of them costs seconds at the first frame of every new process.
     Calling it again with the same folder does nothing; a different folder switches to it.
     """
-    global _enabled
+    global _enabled, _asked
+    # describe() calls this every frame: resolving the path takes system calls, so the same request
+    # (argument and the environment it depends on) returns the folder it found last time
+    asked = (None if path is None else os.fspath(path), os.environ.get("LV3D_CACHE"), os.environ.get("HOME"))
+    if _enabled is not None and asked == _asked:
+        return _enabled
     if path is None:
         root = os.environ.get("LV3D_CACHE")
         path = Path(root) / "jax" if root else Path.home() / ".cache" / "lv3d" / "jax"
     path = Path(path).expanduser().resolve()
-    if _enabled == path:
-        return path
-    path.mkdir(parents=True, exist_ok=True)
-    jax.config.update("jax_compilation_cache_dir", str(path))
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
-    jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
-    _enabled = path
+    if _enabled != path:
+        path.mkdir(parents=True, exist_ok=True)
+        jax.config.update("jax_compilation_cache_dir", str(path))
+        jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
+        jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
+        _enabled = path
+    _asked = asked
     return path
 
 
@@ -61,15 +67,27 @@ def _source_digest() -> str:
     return h.hexdigest()
 
 
+_scalars: dict[tuple, jax.Array] = {}
+
+
 def _leaf(x):
-    """A pytree leaf as an array of a fixed dtype (Python scalars become float32 / int32 / bool)."""
+    """A pytree leaf as an array of a fixed dtype (Python scalars become float32 / int32 / bool).
+
+    Scalars (the settings, floors and flags) become device arrays kept per value: a program call moves
+    every host argument to the device, ~10 us each, and there are a dozen and a half of them per call."""
     if isinstance(x, bool):
-        return np.asarray(x, np.bool_)
-    if isinstance(x, int):
-        return np.asarray(x, np.int32)
-    if isinstance(x, float):
-        return np.asarray(x, np.float32)
-    return x
+        dtype = np.bool_
+    elif isinstance(x, int):
+        dtype = np.int32
+    elif isinstance(x, float):
+        dtype = np.float32
+    else:
+        return x
+    key = (dtype, x)
+    arr = _scalars.get(key)
+    if arr is None:
+        arr = _scalars[key] = jax.device_put(np.asarray(x, dtype))
+    return arr
 
 
 def call_saved(name: str, fn, args: tuple) -> list:

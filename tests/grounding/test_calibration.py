@@ -34,6 +34,15 @@ def test_a_map_reads_the_named_measurements():
     assert low == 0.5 and abs(high - 1 / (1 + np.exp(-2.0))) < 1e-12
 
 
+def test_calibrate_is_calibrate_with_the_shipped_table():
+    # calibrate keeps each map's inputs looked up; the numbers must be those of the general function
+    for modality, maps in TABLE.items():
+        for pred in maps:
+            for p in (1e-6, 0.3, 0.97, 1.0):
+                assert grounding.calibrate(modality, pred, p, MEASURES) == calibrate_with(TABLE, modality, pred, p, MEASURES)
+                assert grounding.calibrate(modality, pred, p) == calibrate_with(TABLE, modality, pred, p)
+
+
 def _square(x0, y0, s=40.0):
     return np.array([[x0, y0], [x0 + s, y0], [x0 + s, y0 + s], [x0, y0 + s]], float)
 
