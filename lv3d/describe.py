@@ -96,12 +96,12 @@ def dense_face_points(face: Face, frame: RGBD, margin_px: int = 2, gate_m: float
     return np.compress(near, pts, axis=0) if np.count_nonzero(near) >= len(face.points) else None
 
 
-def _boxes(scene: Scene, margin_px: float, only: SceneObject | None = None) -> list[tuple[float, float, float, float]]:
-    """Boxes (u0, v0, u1, v1) around each object's polygons (or ``only``'s) plus ``margin_px``, overlapping
+def _boxes(scene: Scene, margin_px: float) -> list[tuple[float, float, float, float]]:
+    """Boxes (u0, v0, u1, v1) around each object's polygons plus ``margin_px``, overlapping
     ones merged: the field is needed only near the sides that are sampled, and one box around objects
     spread over the frame would cover most of it."""
     boxes = []
-    for o in scene.objects if only is None else [only]:
+    for o in scene.objects:
         polys = [np.asarray(f.polygon, float).reshape(-1, 2) for f in o.faces if len(f.polygon)]
         if polys:
             p = np.concatenate(polys)
