@@ -41,6 +41,13 @@ def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 
         scene.objects = [_depth_object(scene_id, k + 1, o, dres) for k, o in enumerate(dres.objects)]
         return scene
     scene.objects = _fused_objects(frame, scene_id, dres, scene.timings_ms)
+    if not scene.objects:
+        # depth found no object (too noisy, or nothing above the support): the colour path runs only inside
+        # depth objects' boxes, so without this a face seen by colour alone would be lost with the object
+        res = rgb_faces(frame.color)
+        for key, v in res.timings_ms.items():
+            scene.timings_ms[key] = scene.timings_ms.get(key, 0.0) + v
+        scene.objects = _rgb_objects(scene_id, res.faces, res.groups, res.adjacency)
     return scene
 
 

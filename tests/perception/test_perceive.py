@@ -38,6 +38,16 @@ def test_each_modality_finds_the_three_faces_of_the_box(box_frame, modality):
         assert scene.support_plane is None and all(f.plane is None for f in target.faces)
 
 
+def test_rgbd_keeps_colour_faces_where_depth_finds_no_object(box_frame):
+    # a flat wall of depth: no object stands on a support, but colour still sees the box's three faces
+    frame = box_frame[0]
+    wall = RGBD(frame.color, np.full_like(frame.depth, 1.0), frame.intrinsics)
+    assert perceive(wall, "depth").objects == []
+    target = perceive(wall, "rgbd", scene_id="s000007").target()
+    assert target is not None and sorted(f.sides for f in target.faces) == [4, 4, 4]
+    assert all(f.provenance == "rgb" and f.plane is None for f in target.faces)
+
+
 def test_perceive_is_deterministic(box_frame):
     a = perceive(box_frame[0], "rgbd")
     b = perceive(box_frame[0], "rgbd")
