@@ -10,7 +10,8 @@ expected calibration error (ECE, 10 bins) of every emitted fact type against the
 the ground truth (a fact on a face that matches no true face is false), and a reliability diagram
 (PNG under --out); the model-error floor each quantity would need (docs/grounding.md). Then speed:
 refinement + facts per 640x480 frame on one core after warm-up (median over --speed-runs processes, each
-timing 15 frames twice), and the first call in each new process with a warm compilation cache. Targets from the issue are printed beside the figures.
+timing --speed-frames - 1 frames twice), and the first call in each new process with a warm compilation
+cache. Targets from the issue are printed beside the figures.
 """
 
 from __future__ import annotations
