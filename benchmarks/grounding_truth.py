@@ -187,8 +187,7 @@ def truth_scene(frame, faces_mask: np.ndarray, scene_id: str, rng: np.random.Gen
         if np.count_nonzero(m) < min_pixels:
             continue
         v, u = np.nonzero(m)
-        z = frame.depth[v, u].astype(np.float64)
-        pts = np.stack([(u - k.cx) * z / k.fx, (v - k.cy) * z / k.fy, z], 1)
+        pts = k.back_project(u, v, frame.depth[v, u])
         c = pts.mean(0)
         n = np.linalg.svd(pts - c, full_matrices=False)[2][-1]
         poly = np.asarray(g["polygon"], float) + rng.normal(0, vertex_noise_px, (len(g["polygon"]), 2))

@@ -21,8 +21,11 @@ def _bilinear(img: np.ndarray, uv: np.ndarray) -> np.ndarray:
     return top * (1 - fv) + bottom * fv
 
 
+Box = tuple[float, float, float, float]
+
+
 def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 60.0, cap_px: float = 30.0,
-                        roi: tuple[int, int, int, int] | None = None) -> np.ndarray:
+                        roi: Box | list[Box] | None = None) -> np.ndarray:
     """Signed distance (float32 pixels, (H, W)) from each pixel to the tangent line of its nearest image edge.
 
     Edges are Canny edges of every channel of ``image`` ((H, W) or (H, W, C) uint8), so faces that differ
@@ -31,17 +34,19 @@ def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 6
     across the gradient. The sign says which side of the edge a pixel is on (towards the brighter side
     of the edge's strongest channel is positive); an edge's zero crossing is sub-pixel accurate and the
     field is linear across it, so bilinear sampling keeps both. Values are clipped to ``+-cap_px``.
-    ``roi`` = (u0, v0, u1, v1) computes the field only inside that box (the rest is ``cap_px``): the
-    polygons to refine usually cover a small part of the frame.
+    ``roi`` = (u0, v0, u1, v1), or a list of such boxes that do not overlap, computes the field only inside
+    them, each box on its own (the rest is ``cap_px``): the polygons to refine usually cover a small part of
+    the frame.
     """
     img = np.asarray(image)
     if roi is not None:
         h, w = img.shape[:2]
-        u0, v0 = max(0, int(roi[0])), max(0, int(roi[1]))
-        u1, v1 = min(w, int(np.ceil(roi[2]))), min(h, int(np.ceil(roi[3])))
         out = np.full((h, w), cap_px, np.float32)
-        if u1 - u0 >= 8 and v1 - v0 >= 8:
-            out[v0:v1, u0:u1] = edge_distance_field(img[v0:v1, u0:u1], low=low, high=high, cap_px=cap_px)
+        for box in (roi if isinstance(roi, list) else [roi]):
+            u0, v0 = max(0, int(box[0])), max(0, int(box[1]))
+            u1, v1 = min(w, int(np.ceil(box[2]))), min(h, int(np.ceil(box[3])))
+            if u1 - u0 >= 8 and v1 - v0 >= 8:
+                out[v0:v1, u0:u1] = edge_distance_field(img[v0:v1, u0:u1], low=low, high=high, cap_px=cap_px)
         return out
     if img.ndim == 2:
         img = img[..., None]
@@ -93,7 +98,7 @@ def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 6
 
 def normal_edge_field(depth: np.ndarray, intrinsics: tuple[float, float, float, float], *, smooth_px: float = 2.0,
                       low: float = 40.0, high: float = 100.0, cap_px: float = 30.0,
-                      roi: tuple[int, int, int, int] | None = None) -> np.ndarray:
+                      roi: Box | list[Box] | None = None) -> np.ndarray:
     """Edge-distance field (float32 pixels, (H, W)) of a depth image: its edges are where the surface
     normal turns (a solid's edges, convex or concave) or the depth jumps (an outline).
 

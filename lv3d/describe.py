@@ -88,9 +88,7 @@ def dense_face_points(face: Face, frame: RGBD, margin_px: int = 2, gate_m: float
     if nz is None or len(nz) < len(face.points):
         return None
     u, v = nz.reshape(-1, 2).T
-    # ``frame.intrinsics.rays(uv) * z`` with the same arithmetic, column by column (a third of its time)
-    k, zf = frame.intrinsics, z[v, u].astype(np.float64)
-    pts = np.stack([((u + u0) - k.cx) / k.fx * zf, ((v + v0) - k.cy) / k.fy * zf, zf], 1)
+    pts = frame.intrinsics.back_project(u + u0, v + v0, z[v, u])
     near = np.abs(face.plane.distance(pts)) <= gate_m
     # np.compress: the rows pts[near] picks, several times quicker for (m, 3) arrays
     return np.compress(near, pts, axis=0) if np.count_nonzero(near) >= len(face.points) else None
@@ -128,30 +126,13 @@ def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px
     only the boxes around its objects' polygons (plus ``margin_px``) are computed; the rest is the cap."""
     import grounding
 
-    k = frame.intrinsics
-
-    def one(roi):
-        if modality == "depth":
-            return grounding.normal_edge_field(frame.depth, (k.fx, k.fy, k.cx, k.cy), roi=roi, cap_px=CAP_PX)
-        return grounding.edge_distance_field(frame.color, roi=roi, cap_px=CAP_PX)
-
     boxes = _boxes(scene, margin_px) if scene is not None else []
-    if modality == "depth" or len(boxes) <= 1:
-        # the depth field smooths the whole image anyway; one box needs no stitching
-        if scene is None or not boxes:
-            return one(None)
-        if len(boxes) == 1 or modality == "depth":
-            b = np.array(boxes)
-            return one((*b[:, :2].min(0), *b[:, 2:].max(0)))
-    # each box straight into one frame-sized field (what edge_distance_field's roi does for one box)
-    h, w = frame.color.shape[:2]
-    out = np.full((h, w), CAP_PX, np.float32)
-    for b in boxes:
-        u0, v0 = max(0, int(b[0])), max(0, int(b[1]))
-        u1, v1 = min(w, int(np.ceil(b[2]))), min(h, int(np.ceil(b[3])))
-        if u1 - u0 >= 8 and v1 - v0 >= 8:
-            out[v0:v1, u0:u1] = grounding.edge_distance_field(frame.color[v0:v1, u0:u1], cap_px=CAP_PX)
-    return out
+    if modality == "depth":
+        k = frame.intrinsics
+        # the depth field smooths the whole image anyway: one box around all objects
+        roi = (*np.min([b[:2] for b in boxes], 0), *np.max([b[2:] for b in boxes], 0)) if boxes else None
+        return grounding.normal_edge_field(frame.depth, (k.fx, k.fy, k.cx, k.cy), roi=roi, cap_px=CAP_PX)
+    return grounding.edge_distance_field(frame.color, roi=boxes or None, cap_px=CAP_PX)
 
 
 def _chunks(faces: list[Face], max_faces: int, max_vertices: int, max_sides: int) -> list[list[Face]]:

@@ -31,10 +31,7 @@ class RGBD:
     def points(self) -> tuple[np.ndarray, np.ndarray]:
         """Back-projected valid depth: camera-frame points (m, 3) in metres and their pixels (m, 2) as (u, v)."""
         v, u = np.nonzero(self.depth > 0)
-        z = self.depth[v, u].astype(np.float64)
-        k = self.intrinsics
-        pts = np.stack([(u - k.cx) * z / k.fx, (v - k.cy) * z / k.fy, z], axis=1)
-        return pts, np.stack([u, v], axis=1)
+        return self.intrinsics.back_project(u, v, self.depth[v, u]), np.stack([u, v], axis=1)
 
 
 def read_color(path: Path) -> np.ndarray:

@@ -120,7 +120,6 @@ class Explanation:
     missing: list[str] = field(default_factory=list)  # facts the scene lacks (a near miss)
     near: bool = False  # no program proves the scene at its threshold: this is the nearest one
 
-
     def __str__(self) -> str:
         if self.label == "unknown":
             return f"{self.target}: unknown (no class's program proves it)"

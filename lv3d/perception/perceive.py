@@ -31,9 +31,8 @@ def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 
         raise InputError("--modality", f"unknown modality {modality!r}; choose one of {', '.join(MODALITIES)}")
     _check_frame(frame, modality)
     if modality == "rgb":
-        res = rgb_faces(frame.color)
-        scene = Scene(scene_id, modality, frame.intrinsics, timings_ms=dict(res.timings_ms))
-        scene.objects = _rgb_objects(scene_id, res.faces, res.groups, res.adjacency)
+        scene = Scene(scene_id, modality, frame.intrinsics, timings_ms={})
+        scene.objects = _colour_objects(frame, scene_id, scene.timings_ms)
         return scene
     dres = depth_scene(frame, seed=seed)
     scene = Scene(scene_id, modality, frame.intrinsics, support_plane=dres.support, timings_ms=dict(dres.timings_ms))
@@ -44,10 +43,7 @@ def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 
     if not scene.objects:
         # depth found no object (too noisy, or nothing above the support): the colour path runs only inside
         # depth objects' boxes, so without this a face seen by colour alone would be lost with the object
-        res = rgb_faces(frame.color)
-        for key, v in res.timings_ms.items():
-            scene.timings_ms[key] = scene.timings_ms.get(key, 0.0) + v
-        scene.objects = _rgb_objects(scene_id, res.faces, res.groups, res.adjacency)
+        scene.objects = _colour_objects(frame, scene_id, scene.timings_ms)
     return scene
 
 
@@ -65,6 +61,14 @@ def _centroid(polys: list[np.ndarray]) -> tuple[float, float]:
     w = np.array([area(p) for p in polys])
     c = np.array([p.mean(axis=0) for p in polys])
     return tuple(float(x) for x in (c * w[:, None]).sum(0) / max(w.sum(), 1e-9))
+
+
+def _colour_objects(frame: RGBD, scene_id: str, timings: dict[str, float]) -> list[SceneObject]:
+    """The colour path on the whole frame: its faces grouped into objects; its stage times added to ``timings``."""
+    res = rgb_faces(frame.color)
+    for key, v in res.timings_ms.items():
+        timings[key] = timings.get(key, 0.0) + v
+    return _rgb_objects(scene_id, res.faces, res.groups, res.adjacency)
 
 
 def _rgb_objects(scene_id: str, faces: list[RGBFace], groups: list[list[int]],
