@@ -12,6 +12,7 @@ from ..rgbd import RGBD
 from ..scene import Face, Scene, SceneObject
 from .depth import DepthObjectResult, DepthResult, depth_scene
 from .boundary import grid_to_pixels
+from .confirm import replace_unconfirmed, unconfirmed
 from .face_plane import angle_deg, fit_face_plane
 from .fuse import match_faces
 from .plane_outline import simplify_on_plane
@@ -44,6 +45,11 @@ def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 
         # depth found no object (too noisy, or nothing above the support): the colour path runs only inside
         # depth objects' boxes, so without this a face seen by colour alone would be lost with the object
         scene.objects = _colour_objects(frame, scene_id, scene.timings_ms)
+    elif unconfirmed(scene.objects):
+        # objects of depth faces alone: fragments of a noisy solid that colour may see whole (confirm.py)
+        colour = _colour_objects(frame, scene_id, scene.timings_ms, _box(scene.objects, unconfirmed(scene.objects),
+                                                                          frame.shape))
+        scene.objects = replace_unconfirmed(scene.objects, colour, frame.shape, scene_id)
     return scene
 
 
@@ -63,12 +69,24 @@ def _centroid(polys: list[np.ndarray]) -> tuple[float, float]:
     return tuple(float(x) for x in (c * w[:, None]).sum(0) / max(w.sum(), 1e-9))
 
 
-def _colour_objects(frame: RGBD, scene_id: str, timings: dict[str, float]) -> list[SceneObject]:
-    """The colour path on the whole frame: its faces grouped into objects; its stage times added to ``timings``."""
-    res = rgb_faces(frame.color)
+def _colour_objects(frame: RGBD, scene_id: str, timings: dict[str, float],
+                    box: tuple[int, int, int, int] | None = None) -> list[SceneObject]:
+    """The colour path on the whole frame (or in ``box`` = (u0, v0, u1, v1) pixels): its faces grouped into
+    objects; its stage times added to ``timings``."""
+    res = rgb_faces(frame.color, box=box)
     for key, v in res.timings_ms.items():
         timings[key] = timings.get(key, 0.0) + v
     return _rgb_objects(scene_id, res.faces, res.groups, res.adjacency)
+
+
+def _box(objects: list[SceneObject], which: list[int], shape: tuple[int, int]) -> tuple[int, int, int, int]:
+    """The box around the faces of ``objects[i]`` for i in ``which``, grown by a margin that lets a solid seen
+    in fragments be seen whole: a third of the box's larger side, at least the crop margin."""
+    p = np.concatenate([np.asarray(f.polygon, float) for i in which for f in objects[i].faces])
+    (u0, v0), (u1, v1) = p.min(0), p.max(0)
+    m = max(_CROP_MARGIN_PX, (max(u1 - u0, v1 - v0)) / 3)
+    h, w = shape
+    return (max(0, int(u0 - m)), max(0, int(v0 - m)), min(w, int(np.ceil(u1 + m))), min(h, int(np.ceil(v1 + m))))
 
 
 def _rgb_objects(scene_id: str, faces: list[RGBFace], groups: list[list[int]],
