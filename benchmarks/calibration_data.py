@@ -1,13 +1,14 @@
 """Candidate facts of perceived dev scenes with their ground-truth labels and the measurements behind them:
 the data the confidence calibration (grounding/_calibration.py) is fitted on and checked against.
 
-    .venv/bin/python benchmarks/calibration_data.py --seed 30000 --per-class 20 --out out/calib/dev30000.pkl
+    .venv/bin/python benchmarks/calibration_data.py --fresh --seed 30000 --per-class 50 --modalities rgbd,depth --out out/calib/s5_a50.pkl
 
 Scenes are ``render_scene(cls, seed + 1000 * class_index + i, preset)`` for the 7 bench classes: dev seeds
 only (never the study's seed-0 data set). Each row: modality, predicate, raw probability (before any
 calibration), truth label (True/False; candidates the truth says nothing about are left out) and the
-face measurements ``lv3d.describe.calibration_features`` gives. Rows are appended per scene, so an
-interrupted run resumes.
+face measurements ``lv3d.describe.calibration_features`` gives (with the candidate's measured ``value``).
+Rows are appended per scene, so an interrupted run resumes; ``--fresh`` starts the file over (after
+perception or grounding changed, old rows are stale).
 """
 
 from __future__ import annotations
@@ -53,8 +54,9 @@ def main(argv=None) -> int:
     ap.add_argument("--preset", default="realsense")
     ap.add_argument("--modalities", default="rgbd,depth,rgb")
     ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--fresh", action="store_true", help="start --out over instead of resuming it")
     a = ap.parse_args(argv)
-    done = pickle.loads(a.out.read_bytes()) if a.out.exists() else {"rows": [], "scenes": []}
+    done = pickle.loads(a.out.read_bytes()) if a.out.exists() and not a.fresh else {"rows": [], "scenes": []}
     a.out.parent.mkdir(parents=True, exist_ok=True)
     t0 = time.time()
     for s in range(a.per_class):

@@ -1,16 +1,21 @@
 """Fit the per-(modality, predicate) confidence calibration maps and write grounding/_calibration_table.py.
 
-    .venv/bin/python benchmarks/calibration_data.py --seed 30000 --per-class 25 --out out/calib/dev30000.pkl
-    .venv/bin/python benchmarks/fit_calibration.py out/calib/dev30000.pkl            # fit, print, write
-    .venv/bin/python benchmarks/fit_calibration.py out/calib/dev30000.pkl --check out/calib/dev40000.pkl
+The refit (docs/grounding.md, "Calibration on perceived scenes"; ~15 min on 2 busy cores):
 
-For each (modality, predicate) three maps compete by 5-fold cross-validated log loss on the dev rows:
-the raw probability unchanged, Platt scaling (bias + slope on logit p), and Platt plus a few face
-measurements (``FEATURES``). The winner is refitted on all rows (L2-regularised logistic regression,
+    for a in "30000 50 a50" "31000 50 b50" "32000 30 c30"; do set -- $a; .venv/bin/python benchmarks/calibration_data.py \
+        --fresh --seed $1 --per-class $2 --modalities rgbd,depth --out out/calib/s5_$3.pkl & done; wait
+    .venv/bin/python benchmarks/fit_calibration.py out/calib/s5_a50.pkl out/calib/s5_b50.pkl --check out/calib/s5_c30.pkl
+
+For each (modality, predicate) four maps compete by 5-fold cross-validated log loss on the dev rows:
+the raw probability unchanged, a shift in logit space, Platt scaling (bias + slope on logit p), and Platt
+plus a few face measurements (``FEATURES``) and, for predicates with a tolerance, the measured value in
+tolerances (``tol_frac``). The winner is refitted on all rows (L2-regularised logistic regression,
 measurements standardised, the standardisation folded into the coefficients). A map whose slope on
-logit p comes out negative is not used (confidence must grow with the measured probability).
-``--check`` prints per-type ECE before and after on another dev set (rows with confidence >= 0.05,
-as facts are emitted). Rows come from dev seeds only, never the study's data.
+logit p comes out negative is not used (confidence must grow with the measured probability). Then per
+modality one isotonic map of the pooled out-of-fold confidences of every type (``FINAL``).
+``--check`` prints per-type ECE on another dev set (rows with confidence >= 0.05, as facts are emitted)
+for the raw probabilities, the table in the tree and the new one, and each modality's ECE and log loss
+over all facts. Rows come from dev seeds only, never the study's data.
 """
 
 from __future__ import annotations
@@ -28,7 +33,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.calibration_error import chance_ece, ece  # noqa: E402
-from grounding._calibration import design  # noqa: E402
+from grounding._calibration import TOL_FRAC_PREDS, inputs  # noqa: E402
 
 MODALITIES = ("rgbd", "depth")  # rgb is left raw: see docs/grounding.md (its labels need a look first)
 FEATURES = ["support", "log_area_px", "min_turn_z", "min_side_px"]
@@ -67,7 +72,7 @@ def _fit_shift(rows: list[dict]):
     one smoothed constant (types whose dev candidates were all true or all false keep p's order)."""
     from scipy.optimize import minimize_scalar
 
-    z = np.array([design(r["p"], r, ["logit_p"])[0] for r in rows])
+    z = np.array([inputs(r["pred"], r["p"], r, ["logit_p"])[0] for r in rows])
     y = np.array([r["y"] for r in rows], float)
 
     def loss(b):  # log loss plus the two half pseudo-observations at logit 0
@@ -84,7 +89,7 @@ def _fit_monotone(rows: list[dict], feats: list[str] | None):
     y = np.array([r["y"] for r in rows], float)
     if not feats:  # a constant: the smoothed rate
         return float(np.log((y.sum() + .5) / ((1 - y).sum() + .5))), np.zeros(0), []
-    x = np.array([design(r["p"], r, feats) for r in rows])
+    x = np.array([inputs(r["pred"], r["p"], r, feats) for r in rows])
     b, c = _fit(x, y)
     if feats and feats[0] == "logit_p" and c[0] < 0:
         return _fit_monotone(rows, feats[1:])
@@ -92,16 +97,18 @@ def _fit_monotone(rows: list[dict], feats: list[str] | None):
 
 
 def fit_one(rows: list[dict], seed: int = 0):
-    """The best map for one (modality, predicate) by 5-fold CV log loss: None (raw) or a table entry."""
+    """The best map for one (modality, predicate) by 5-fold CV log loss: (None (raw) or a table entry,
+    {map: CV log loss}, the winner's out-of-fold confidences (n,))."""
     y = np.array([r["y"] for r in rows], float)
     p = np.array([r["p"] for r in rows])
     if len(rows) < MIN_ROWS:
-        return None, {}
+        return None, {}, np.clip(p, 0, 1)
     folds = np.random.default_rng(seed).permutation(len(rows)) % 5
-    cands = {"raw": "raw", "shift": None, "platt": ["logit_p"], "platt+measures": ["logit_p"] + FEATURES}
+    tol = ["tol_frac"] if rows[0]["pred"] in TOL_FRAC_PREDS else []  # the measured value in tolerances
+    cands = {"raw": "raw", "shift": None, "platt": ["logit_p"], "platt+measures": ["logit_p"] + FEATURES + tol}
     if rows[0]["pred"] in SUPPORT_PREDS:  # p is edge support, not a geometric probability: may be ignored
         cands["const"] = []
-    losses = {}
+    losses, oof = {}, {}
     for name, feats in cands.items():
         pred = np.empty(len(rows))
         for k in range(5):
@@ -111,32 +118,62 @@ def fit_one(rows: list[dict], seed: int = 0):
                 continue
             trows = [r for r, t in zip(rows, tr) if t]
             b, c, f = _fit_monotone(trows, feats)
-            x = np.array([design(r["p"], r, f) for r, t in zip(rows, te) if t]).reshape(int(te.sum()), len(f))
+            x = np.array([inputs(r["pred"], r["p"], r, f) for r, t in zip(rows, te) if t]).reshape(int(te.sum()), len(f))
             pred[te] = _predict(b, c, x)
-        losses[name] = _logloss(pred, y)
+        losses[name], oof[name] = _logloss(pred, y), pred
     name = min(losses, key=losses.get)
     if cands[name] == "raw":
-        return None, losses
+        return None, losses, oof[name]
     b, c, f = _fit_monotone(rows, cands[name])
     return {"features": f, "bias": round(b, 5), "coef": [round(float(v), 5) for v in c], "n": len(rows),
-            "map": name, "cv_logloss": round(losses[name], 4)}, losses
+            "map": name, "cv_logloss": round(losses[name], 4)}, losses, oof[name]
 
 
-def report(rows: list[dict], table: dict, title: str) -> None:
+def fit_final(conf: np.ndarray, y: np.ndarray) -> dict:
+    """The final map of one modality: isotonic regression of the truth on the pooled out-of-fold confidences
+    of every type (n,), kept within [0.001, 0.999], as knots {"x": [...], "y": [...]} (ascending x)."""
+    from sklearn.isotonic import IsotonicRegression
+
+    iso = IsotonicRegression(y_min=1e-3, y_max=1 - 1e-3, out_of_bounds="clip").fit(conf, y)
+    return {"x": [round(float(v), 5) for v in iso.X_thresholds_], "y": [round(float(v), 5) for v in iso.y_thresholds_]}
+
+
+def report(rows: list[dict], table: tuple, title: str, shipped: tuple | None = None) -> None:
+    """Per (modality, predicate): ECE of the raw probabilities, of ``shipped`` (the (TABLE, FINAL) in the
+    tree when the fit began) if given, and of ``table`` (TABLE, FINAL), with the chance level of its
+    confidences."""
     from grounding._calibration import calibrate_with
 
-    print(f"== {title}: per-type ECE of emitted facts (conf >= {MIN_CONF}), raw -> calibrated")
+    print(f"== {title}: per-type ECE of emitted facts (conf >= {MIN_CONF}), raw -> "
+          + ("shipped table -> " if shipped is not None else "") + "calibrated")
     by = defaultdict(list)
     for r in rows:
         by[(r["modality"], r["pred"])].append(r)
+
+    def emitted(tab):
+        return np.array([(c, r["y"]) for r in rs if (c := calibrate_with(tab[0], *key, r["p"], r, tab[1])) >= MIN_CONF],
+                        float).reshape(-1, 2)
+
     for key in sorted(by):
+        if key[0] not in MODALITIES:
+            continue
         rs = by[key]
         raw = np.array([(min(r["p"], 1.0), r["y"]) for r in rs if r["p"] >= MIN_CONF], float).reshape(-1, 2)
-        cal = np.array([(c, r["y"]) for r in rs if (c := calibrate_with(table, *key, r["p"], r)) >= MIN_CONF],
-                       float).reshape(-1, 2)
-        print(f"  {key[0]:5s} {key[1]:14s} raw {ece(*raw.T):.3f} (n={len(raw):4d})  calibrated {ece(*cal.T):.3f} "
+        cal = emitted(table)
+        old = f"  shipped {ece(*emitted(shipped).T):.3f}" if shipped is not None else ""
+        print(f"  {key[0]:5s} {key[1]:14s} raw {ece(*raw.T):.3f} (n={len(raw):4d}){old}  calibrated {ece(*cal.T):.3f} "
               f"(n={len(cal):4d}, chance {chance_ece(cal[:, 0]):.3f})  mean conf {cal[:, 0].mean() if len(cal) else float('nan'):.2f} "
               f"true {cal[:, 1].mean() if len(cal) else float('nan'):.2f}")
+    for mod in MODALITIES:  # every emitted fact, and the log loss of every candidate (p > 0): a proper score
+        rs = [r for r in rows if r["modality"] == mod and r["p"] > 0]
+        y = np.array([r["y"] for r in rs], float)
+        line = f"  {mod:5s} all facts     "
+        for name, tab in (("shipped", shipped), ("calibrated", table)):
+            if tab is None:
+                continue
+            c = np.array([calibrate_with(tab[0], mod, r["pred"], r["p"], r, tab[1]) for r in rs])
+            line += f"  {name} ECE {ece(c[c >= MIN_CONF], y[c >= MIN_CONF]):.3f} (n={int((c >= MIN_CONF).sum())}) log loss {_logloss(c, y):.4f}"
+        print(line)
 
 
 def main(argv=None) -> int:
@@ -152,19 +189,25 @@ def main(argv=None) -> int:
         if r["modality"] in MODALITIES and r["p"] > 0:
             by[(r["modality"], r["pred"])].append(r)
     table: dict = {}
+    oof = defaultdict(list)  # per modality: (out-of-fold confidence, truth) of every row
     for key in sorted(by):
-        entry, losses = fit_one(by[key])
+        entry, losses, conf = fit_one(by[key])
+        oof[key[0]] += zip(conf, (r["y"] for r in by[key]))
         print(f"  {key[0]:5s} {key[1]:14s} n={len(by[key]):5d}  cv log loss "
               + "  ".join(f"{k} {v:.4f}" for k, v in losses.items()) + f"  -> {'raw' if entry is None else entry['map'] + ' ' + ','.join(entry['features'])}")
         if entry is not None:
             table.setdefault(key[0], {})[key[1]] = entry
-    report(rows, table, f"fit rows ({', '.join(map(str, a.data))})")
+    final = {mod: fit_final(*np.array(oof[mod], float).T) for mod in sorted(oof)}
+    report(rows, (table, final), f"fit rows ({', '.join(map(str, a.data))})")
     if a.check:
-        report(pickle.loads(a.check.read_bytes())["rows"], table, f"check rows ({a.check})")
+        from grounding._calibration_table import FINAL, TABLE
+
+        report(pickle.loads(a.check.read_bytes())["rows"], (table, final), f"check rows ({a.check})", (TABLE, FINAL))
     if not a.dry_run:
         a.out.write_text('"""Calibration maps (see _calibration.py), written by benchmarks/fit_calibration.py from\n'
                          f'{", ".join(p.name for p in a.data)} (perceived realsense dev scenes). Do not edit by hand."""\n\n'
-                         f"TABLE: dict = {pprint.pformat(table, width=110, sort_dicts=True)}\n")
+                         f"TABLE: dict = {pprint.pformat(table, width=110, sort_dicts=True)}\n\n"
+                         f"FINAL: dict = {pprint.pformat(final, width=110, compact=True)}\n")
         print(f"wrote {a.out}")
     return 0
 

@@ -8,19 +8,25 @@ of the faces behind it into a calibrated one:
 
     conf = sigmoid(bias + sum_k coef_k x_k),  x = (logit p, measurements named in the table)
 
+then one final non-decreasing piecewise-linear map per modality (isotonic regression of the pooled
+out-of-fold confidences of every type, ``FINAL``) corrects what the logistic form leaves over: per type
+calibrated on average, the pooled middle bins (0.4-0.85) came out over-confident.
 The maps are fitted (L2-regularised logistic regression, ``benchmarks/fit_calibration.py``) on perceived
 dev scenes (realsense preset, seeds 30000+; never the study's data) and live in
-``_calibration_table.py``; a (modality, predicate) pair without a map keeps its raw probability.
-The map is monotone increasing in ``p`` (its ``logit_p`` coefficient is kept positive), so a more
-certain measurement never gets a lower confidence, other things equal.
+``_calibration_table.py``; a (modality, predicate) pair without a map keeps its raw probability (then the
+final map). Both stages are monotone increasing in ``p`` (the ``logit_p`` coefficient is kept positive), so a
+more certain measurement never gets a lower confidence, other things equal.
 """
 
 from __future__ import annotations
 
+import bisect
 import functools
 import math
 
-from ._calibration_table import TABLE
+from ._calibration_table import FINAL, TABLE
+from ._confidence import (ACUTE_BELOW_DEG, EQUAL_SIDES_RATIO, OBTUSE_ABOVE_DEG, PARALLEL_SIDES_DEG, PLANE_ANGLE_DEG,
+                          RIGHT_ANGLE_DEG)
 
 P_CLIP = 1e-4  # logit(p) is taken of p clipped to [P_CLIP, 1 - P_CLIP]: saturated probabilities stay finite
 
@@ -34,10 +40,33 @@ def logit(p: float) -> float:
 # 20-spread one), the shortest side as a log; absent measurements (e.g. of `object`) read as 0
 _SCALE = {"min_turn_z": lambda v: min(max(v, -5.0), 20.0), "min_side_px": lambda v: math.log(max(v, 1.0))}
 
+# "tol_frac": the fact's measured value (describe's candidate value) as a fraction of its predicate's
+# tolerance, 1 at the boundary, below 1 inside it. The Gaussian probability reads the same value in units of
+# its spread; where perception's errors are heavy-tailed the distance in tolerances tells more (a near-square
+# face 3 spreads past the ratio limit is often square; one 2 tolerances past it, never).
+_TOL_FRACTION = {
+    "square": lambda v: math.log(max(v, 1.0)) / math.log(EQUAL_SIDES_RATIO),  # v: longest / shortest side
+    "regular": lambda v: math.log(max(v, 1.0)) / math.log(EQUAL_SIDES_RATIO),
+    "rectangle": lambda v: v / RIGHT_ANGLE_DEG,                               # v: largest |corner - 90| deg
+    "parallelogram": lambda v: v / PARALLEL_SIDES_DEG,                        # v: opposite sides' angle deg
+    "perpendicular": lambda v: abs(v - 90.0) / RIGHT_ANGLE_DEG,               # v: interior dihedral deg
+    "acute": lambda v: 1.0 + (v - ACUTE_BELOW_DEG) / RIGHT_ANGLE_DEG,
+    "obtuse": lambda v: 1.0 + (OBTUSE_ABOVE_DEG - v) / RIGHT_ANGLE_DEG,
+    "parallel": lambda v: v / PLANE_ANGLE_DEG,                                # v: angle between the planes deg
+    "horizontal": lambda v: v / PLANE_ANGLE_DEG,                              # v: tilt to the support deg
+    "vertical": lambda v: abs(90.0 - v) / PLANE_ANGLE_DEG,
+}
+TOL_FRAC_PREDS = tuple(_TOL_FRACTION)
 
-def design(p: float, x: dict, names: list[str]) -> list[float]:
-    """The inputs of a calibration map: ``logit(p)`` then the named measurements of ``x``."""
-    return [logit(p) if n == "logit_p" else _SCALE.get(n, float)(float(x.get(n, 0.0))) for n in names]
+
+def _tol_fraction(pred: str):
+    frac = _TOL_FRACTION[pred]
+    return lambda v: min(max(frac(v), -3.0), 3.0)  # 3 tolerances out is as false as it gets
+
+
+def inputs(pred: str, p: float, x: dict, names: list[str]) -> list[float]:
+    """The inputs of ``pred``'s calibration map: ``logit(p)`` then the named measurements of ``x``."""
+    return [logit(p) if k is None else scale(float(x.get(k, 0.0))) for k, scale in _inputs(pred, names)]
 
 
 def measures_used(modality: str, pred: str) -> list[str]:
@@ -48,32 +77,59 @@ def measures_used(modality: str, pred: str) -> list[str]:
 
 def calibrate(modality: str, pred: str, p: float, x: dict | None = None) -> float:
     """Calibrated probability of one candidate fact with raw probability ``p`` and face measurements ``x``
-    (keys as ``lv3d.describe.calibration_features`` gives them). ``p`` itself where no map was fitted;
-    0 stays 0 (a predicate the geometry rules out is not revived). The same arithmetic as
-    :func:`calibrate_with` on ``TABLE``, with each map's inputs looked up once (a frame has ~150 candidates)."""
-    entry = _compiled(modality, pred)
-    if entry is None or not p > 0.0 or not math.isfinite(p):
-        return p
-    bias, terms = entry
-    x = x or {}
-    z = bias + sum(c * (logit(p) if n is None else scale(float(x.get(n, 0.0)))) for c, n, scale in terms)
-    return 1.0 / (1.0 + math.exp(-max(min(z, 50.0), -50.0)))
+    (keys as ``lv3d.describe.calibration_features`` gives them). ``p`` itself where nothing was fitted;
+    0 stays 0 (a predicate the geometry rules out is not revived). :func:`calibrate_with` on ``TABLE`` and
+    ``FINAL``, with each map's inputs looked up once (a frame has ~150 candidates)."""
+    return _apply(_compiled(modality, pred), p, x)
+
+
+def calibrate_with(table: dict, modality: str, pred: str, p: float, x: dict | None = None,
+                   final: dict | None = None) -> float:
+    """:func:`calibrate` with the maps of ``table`` (same layout as ``TABLE``) and the final per-modality
+    maps of ``final`` (layout of ``FINAL``; None: no final stage)."""
+    return _apply(_compile(pred, table.get(modality, {}).get(pred), (final or {}).get(modality)), p, x)
+
+
+def _inputs(pred: str, names: list[str]) -> list:
+    """[(key of the measurement in x, or None for logit p; its scale)] of ``pred``'s map's named inputs."""
+    return [(None, None) if n == "logit_p" else ("value", _tol_fraction(pred)) if n == "tol_frac"
+            else (n, _SCALE.get(n, float)) for n in names]
+
+
+def _compile(pred: str, entry: dict | None, final: dict | None):
+    """(bias, [(coefficient, key in x or None for logit p, scale)], final knots (xs, ys)) of ``pred``'s table
+    entry (bias and terms None without one) and its modality's final map (None without one); None if neither."""
+    if entry is None and final is None:
+        return None
+    terms = None if entry is None else [(c, k, s) for c, (k, s) in zip(entry["coef"], _inputs(pred, entry["features"]))]
+    return (None if entry is None else entry["bias"]), terms, (None if final is None else (final["x"], final["y"]))
 
 
 @functools.cache
 def _compiled(modality: str, pred: str):
-    """(bias, [(coefficient, measurement name or None for logit p, its scale)]) of TABLE's map, or None."""
-    entry = TABLE.get(modality, {}).get(pred)
-    if entry is None:
-        return None
-    return entry["bias"], [(c, None if n == "logit_p" else n, _SCALE.get(n, float))
-                           for c, n in zip(entry["coef"], entry["features"])]
+    """:func:`_compile` of TABLE's and FINAL's maps of (modality, pred)."""
+    return _compile(pred, TABLE.get(modality, {}).get(pred), FINAL.get(modality))
 
 
-def calibrate_with(table: dict, modality: str, pred: str, p: float, x: dict | None = None) -> float:
-    """:func:`calibrate` with the maps of ``table`` (same layout as ``TABLE``)."""
-    entry = table.get(modality, {}).get(pred)
-    if entry is None or not p > 0.0 or not math.isfinite(p):
+def _apply(compiled, p: float, x: dict | None) -> float:
+    """The maps ``compiled`` (:func:`_compile`; None: none) applied to raw probability ``p`` and measurements ``x``."""
+    if compiled is None or not p > 0.0 or not math.isfinite(p):
         return p
-    z = entry["bias"] + sum(c * v for c, v in zip(entry["coef"], design(p, x or {}, entry["features"])))
-    return 1.0 / (1.0 + math.exp(-max(min(z, 50.0), -50.0)))
+    bias, terms, knots = compiled
+    if terms is not None:
+        x = x or {}
+        z = bias + sum(c * (logit(p) if n is None else scale(float(x.get(n, 0.0)))) for c, n, scale in terms)
+        p = 1.0 / (1.0 + math.exp(-max(min(z, 50.0), -50.0)))
+    return p if knots is None else _interp(knots, p)
+
+
+def _interp(knots: tuple, c: float) -> float:
+    """Piecewise-linear non-decreasing map through the knots (xs non-decreasing: a repeated x is a step,
+    taken from the right; ys non-decreasing), constant beyond the ends."""
+    xs, ys = knots
+    i = bisect.bisect_right(xs, c)  # xs[i - 1] <= c < xs[i]
+    if i == 0:
+        return ys[0]
+    if i == len(xs):
+        return ys[i - 1]
+    return ys[i - 1] + (ys[i] - ys[i - 1]) * (c - xs[i - 1]) / (xs[i] - xs[i - 1])

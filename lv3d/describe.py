@@ -284,7 +284,8 @@ def _face_features(g: dict, i: int, n: int, poly: np.ndarray, faces_in_problem: 
 
 def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]:
     """Per candidate the face measurements its calibration may read (:func:`_face_features`); for a fact
-    about two faces, the weaker of each (smaller value), for ``object`` the object's best face."""
+    about two faces, the weaker of each (smaller value), for ``object`` the object's best face; and, for a
+    candidate with a measured value, that value as ``value``."""
     by_face = {fr.face.id: fr.features for res in results for fr in res.faces}
     by_obj = {res.obj.id: [fr.features for fr in res.faces] for res in results}
     weaker: dict[tuple[str, ...], dict] = {}  # by faces: a pair has up to six facts, each in both orders
@@ -297,12 +298,12 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
         return weaker[key]
 
     out = []
-    for pred, args, _, _ in cands:
+    for pred, args, _, value in cands:
         if pred == "object":
             fs = by_obj.get(args[0], [])
             out.append(max(fs, key=lambda f: f["support"]) if fs else {})
         else:
-            out.append(combined(args))
+            out.append(combined(args) if value is None else {**combined(args), "value": value})
     return out
 
 

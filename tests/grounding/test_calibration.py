@@ -1,14 +1,19 @@
 """grounding.calibrate: the shipped per-(modality, predicate) maps are monotone in the raw probability,
-stay in (0, 1), leave unmapped predicates and impossible facts alone; pack_object picks the small padded
-shape for small objects."""
+stay in (0, 1), leave unmapped predicates and impossible facts alone, read a fact's value in tolerances;
+pack_object picks the small padded shape for small objects."""
+
+import math
 
 import numpy as np
 
 import grounding
-from grounding._calibration import TABLE, calibrate_with
+from grounding._calibration import FINAL, TABLE, calibrate_with
+from grounding._confidence import EQUAL_SIDES_RATIO, RIGHT_ANGLE_DEG
 from grounding._problem import SIZES
+from lv3d.describe import calibration_features
 
-MEASURES = {"support": 0.9, "log_area_px": 8.0, "min_turn_z": 6.0, "min_side_px": 40.0, "sides": 4, "faces": 3}
+MEASURES = {"support": 0.9, "log_area_px": 8.0, "min_turn_z": 6.0, "min_side_px": 40.0, "sides": 4, "faces": 3,
+            "value": 1.05}
 
 
 def test_every_shipped_map_grows_with_the_raw_probability():
@@ -34,13 +39,39 @@ def test_a_map_reads_the_named_measurements():
     assert low == 0.5 and abs(high - 1 / (1 + np.exp(-2.0))) < 1e-12
 
 
+def test_tol_frac_is_the_value_in_units_of_the_tolerance_clipped():
+    def conf(pred, value):  # sigmoid of the tolerance fraction alone
+        table = {"rgbd": {pred: {"features": ["logit_p", "tol_frac"], "bias": 0.0, "coef": [0.0, 1.0]}}}
+        return -math.log(1 / calibrate_with(table, "rgbd", pred, 0.5, {"value": value}) - 1)
+
+    assert abs(conf("square", EQUAL_SIDES_RATIO) - 1.0) < 1e-9        # at the boundary: 1
+    assert abs(conf("square", EQUAL_SIDES_RATIO ** 2) - 2.0) < 1e-9
+    assert abs(conf("perpendicular", 90.0 + RIGHT_ANGLE_DEG / 2) - 0.5) < 1e-9
+    assert abs(conf("acute", 60.0) - -1.0) < 1e-9                     # 20 deg inside the 80 deg limit
+    assert abs(conf("square", 50.0) - 3.0) < 1e-9                     # clipped: 3 tolerances out at most
+
+
+def test_calibration_features_carry_each_candidates_value():
+    cands = [("square", ("f1",), 0.9, 1.05), ("rectangle", ("f1",), 0.8, 3.0), ("face_of", ("o1", "f1"), 1.0, None)]
+    feats = calibration_features(cands, [])
+    assert [f.get("value") for f in feats] == [1.05, 3.0, None]
+
+
 def test_calibrate_is_calibrate_with_the_shipped_table():
     # calibrate keeps each map's inputs looked up; the numbers must be those of the general function
     for modality, maps in TABLE.items():
         for pred in maps:
             for p in (1e-6, 0.3, 0.97, 1.0):
-                assert grounding.calibrate(modality, pred, p, MEASURES) == calibrate_with(TABLE, modality, pred, p, MEASURES)
-                assert grounding.calibrate(modality, pred, p) == calibrate_with(TABLE, modality, pred, p)
+                assert grounding.calibrate(modality, pred, p, MEASURES) == calibrate_with(TABLE, modality, pred, p, MEASURES, FINAL)
+                assert grounding.calibrate(modality, pred, p) == calibrate_with(TABLE, modality, pred, p, None, FINAL)
+
+
+def test_final_map_interpolates_its_knots_and_keeps_zero():
+    final = {"rgbd": {"x": [0.2, 0.6, 0.6, 0.8], "y": [0.1, 0.3, 0.5, 0.7]}}  # a step at 0.6
+    got = [calibrate_with({}, "rgbd", "triangle", p, None, final) for p in (0.0, 0.1, 0.4, 0.6, 0.7, 0.9)]
+    assert np.allclose(got, [0.0, 0.1, 0.2, 0.5, 0.6, 0.7])
+    for knots in FINAL.values():
+        assert np.all(np.diff(knots["x"]) >= 0) and np.all(np.diff(knots["y"]) >= 0)
 
 
 def _square(x0, y0, s=40.0):
