@@ -1,5 +1,5 @@
 """Faces from colour alone: edges -> segments -> planar graph -> bounded minimal cycles -> validated polygons,
-grouped into objects by shared edges."""
+plus the thin faces beside them that the graph cannot trace (thin.py), grouped into objects by shared edges."""
 
 from __future__ import annotations
 
@@ -10,20 +10,23 @@ import numpy as np
 
 from .edges import channels, edge_distance, edge_support, edges_and_gradient
 from .faces import bounded_faces, build_graph
-from .polygons import area, clockwise, drop_short_sides, is_simple, simplify
+from .polygons import area, clockwise, drop_short_sides, is_simple, sample_boundary, simplify
 from .segments import detect_color_segments, union_find_labels
 from .split import split_by_diagonal, split_concave
+from .thin import thin_faces
 
 
 @dataclass(frozen=True)
 class RGBFace:
     """A validated colour face: ``polygon`` (n, 2) pixels, clockwise, simplified to its corners;
-    ``edges``: the planar-graph edges it is bounded by (for adjacency); ``edge_support`` in [0, 1]."""
+    ``edges``: the planar-graph edges it is bounded by (for adjacency); ``edge_support`` in [0, 1]; ``thin``: a
+    sliver a few pixels wide beside faces found in the graph (thin.py)."""
 
     polygon: np.ndarray
     edges: frozenset[tuple[int, int]]
     edge_support: float
     area_px: float
+    thin: bool = False  # closed by the thin-face pass (thin.py), not traced in the graph
 
 
 @dataclass(frozen=True)
@@ -101,7 +104,11 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     # a face that contains another kept face is a region around it (table, wall), not an object face
     keep = [not any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
                     for j in range(len(cands))) for i in range(len(cands))]
-    faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for (p, e, s, a), k in zip(cands, keep) if k]
+    cands = [c for c, k in zip(cands, keep) if k]
+    n_traced = len(cands)
+    cands += _thin_cands(cands, segs, dist, min_area_px)
+    faces = [RGBFace(p + np.array([u0, v0], float), e, s, a, thin=k >= n_traced)
+             for k, (p, e, s, a) in enumerate(cands)]
     faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
                  if faces[i].edges & faces[j].edges]
@@ -113,3 +120,20 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     t3 = time.perf_counter()
     timings = {"edges": (t1 - t0) * 1e3, "segments": (t2 - t1) * 1e3, "faces": (t3 - t2) * 1e3}
     return RGBResult(faces, ordered, adjacency, timings)
+
+
+def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: float,
+                touch_px: float = 2.5) -> list:
+    """Thin faces (thin.py) beside the kept candidates, as candidates: each shares a made-up edge key with every
+    candidate whose outline runs within ``touch_px`` of its own, so that they group and count as neighbours."""
+    out = []
+    for k, q in enumerate(thin_faces(segs, dist, [c[0] for c in cands], min_area_px)):
+        key = (-10_000 - k, -10_000 - k)
+        pts = sample_boundary(q, 1.0)
+        for n, c in enumerate(cands):
+            outline = c[0].astype(np.float32).reshape(-1, 1, 2)
+            d = np.abs([cv2.pointPolygonTest(outline, (float(x), float(y)), True) for x, y in pts])
+            if np.mean(d <= touch_px) >= 0.15:
+                cands[n] = (c[0], c[1] | {key}, c[2], c[3])
+        out.append((q, frozenset({key}), edge_support(q, dist), area(q)))
+    return out
