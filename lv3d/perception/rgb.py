@@ -19,14 +19,12 @@ from .thin import thin_faces
 @dataclass(frozen=True)
 class RGBFace:
     """A validated colour face: ``polygon`` (n, 2) pixels, clockwise, simplified to its corners;
-    ``edges``: the planar-graph edges it is bounded by (for adjacency); ``edge_support`` in [0, 1]; ``thin``: a
-    sliver a few pixels wide beside faces found in the graph (thin.py)."""
+    ``edges``: the planar-graph edges it is bounded by (for adjacency); ``edge_support`` in [0, 1]."""
 
     polygon: np.ndarray
     edges: frozenset[tuple[int, int]]
     edge_support: float
     area_px: float
-    thin: bool = False  # closed by the thin-face pass (thin.py), not traced in the graph
 
 
 @dataclass(frozen=True)
@@ -105,10 +103,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     keep = [not any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
                     for j in range(len(cands))) for i in range(len(cands))]
     cands = [c for c, k in zip(cands, keep) if k]
-    n_traced = len(cands)
     cands += _thin_cands(cands, segs, dist, min_area_px)
-    faces = [RGBFace(p + np.array([u0, v0], float), e, s, a, thin=k >= n_traced)
-             for k, (p, e, s, a) in enumerate(cands)]
+    faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for p, e, s, a in cands]
     faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
                  if faces[i].edges & faces[j].edges]
