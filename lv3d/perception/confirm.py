@@ -12,6 +12,8 @@ colour misses (a face of low contrast) than a noisy fragment.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..facts import face_id, object_id
@@ -48,15 +50,16 @@ def _mask(o: SceneObject, shape: tuple[int, int]) -> np.ndarray:
     return m
 
 
-def replace_unconfirmed(objects: list[SceneObject], colour: list[SceneObject], shape: tuple[int, int],
-                        scene_id: str) -> list[SceneObject]:
-    """``objects`` (fused rgbd objects) with each colour object that covers unconfirmed ones in their place.
+def replace_unconfirmed(objects: list[SceneObject], unconfirmed_idx: list[int], colour: list[SceneObject],
+                        shape: tuple[int, int], scene_id: str) -> list[SceneObject]:
+    """``objects`` (fused rgbd objects) with each colour object that covers unconfirmed ones (``unconfirmed_idx``,
+    as :func:`unconfirmed` gives them) in their place.
 
     A colour object that could be one solid's view (``_MAX_FACES``, ``_MAX_SIDES``) takes the place of every
     unconfirmed object it overlaps by more than half of the smaller of the two, unless it lies as much on
     another object (there colour and depth already agree, or the depth is trusted). Objects
     are then renumbered largest first; ``shape`` is the image's (H, W)."""
-    weak = set(unconfirmed(objects))
+    weak = set(unconfirmed_idx)
     if not weak or not colour:
         return objects
     masks = [_mask(o, shape) for o in objects]
@@ -82,8 +85,7 @@ def renumber(objects: list[SceneObject], scene_id: str) -> list[SceneObject]:
     out = []
     for k, o in enumerate(sorted(objects, key=lambda o: -o.pixel_count), start=1):
         ids = {f.id: face_id(scene_id, k, j) for j, f in enumerate(o.faces, start=1)}
-        faces = [Face(ids[f.id], f.polygon, f.provenance, plane=f.plane, points=f.points,
-                      edge_support=f.edge_support, plane_rms_m=f.plane_rms_m) for f in o.faces]
+        faces = [dataclasses.replace(f, id=ids[f.id]) for f in o.faces]
         adj = sorted(tuple(sorted((ids[a], ids[b]))) for a, b in o.adjacency)
         out.append(SceneObject(object_id(scene_id, k), faces, adj, o.pixel_count, o.centroid_px))
     return out

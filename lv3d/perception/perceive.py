@@ -45,11 +45,12 @@ def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 
         # depth found no object (too noisy, or nothing above the support): the colour path runs only inside
         # depth objects' boxes, so without this a face seen by colour alone would be lost with the object
         scene.objects = _colour_objects(frame, scene_id, scene.timings_ms)
-    elif unconfirmed(scene.objects):
+    else:
         # objects of depth faces alone: fragments of a noisy solid that colour may see whole (confirm.py)
-        colour = _colour_objects(frame, scene_id, scene.timings_ms, _box(scene.objects, unconfirmed(scene.objects),
-                                                                          frame.shape))
-        scene.objects = replace_unconfirmed(scene.objects, colour, frame.shape, scene_id)
+        weak = unconfirmed(scene.objects)
+        if weak:
+            colour = _colour_objects(frame, scene_id, scene.timings_ms, _box(scene.objects, weak, frame.shape))
+            scene.objects = replace_unconfirmed(scene.objects, weak, colour, frame.shape, scene_id)
     return scene
 
 

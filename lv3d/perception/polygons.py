@@ -104,6 +104,14 @@ def rasterize(poly: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
     return m.astype(bool)
 
 
+def distance_to_segments(points: np.ndarray, starts: np.ndarray, steps: np.ndarray) -> np.ndarray:
+    """Distance (m,) in pixels from each of ``points`` (m, 2) to the nearest of the segments from ``starts``
+    (k, 2) to ``starts + steps`` (k, 2)."""
+    rel = points[:, None, :] - starts[None]
+    t = np.clip((rel * steps[None]).sum(-1) / np.maximum((steps * steps).sum(-1), 1e-12), 0.0, 1.0)
+    return np.sqrt(((rel - t[..., None] * steps[None]) ** 2).sum(-1)).min(axis=1)
+
+
 def sample_boundary(poly: np.ndarray, step: float = 1.0) -> np.ndarray:
     """Points (m, 2) every ``step`` pixels along the closed boundary."""
     p = np.asarray(poly, dtype=np.float64)

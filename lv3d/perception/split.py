@@ -11,7 +11,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .polygons import area, signed_area
+from .polygons import area, distance_to_segments, signed_area
 
 
 def gradient_magnitude(channels: list[np.ndarray]) -> np.ndarray:
@@ -66,10 +66,7 @@ def _diagonal_strengths(p: np.ndarray, pairs: list[tuple[int, int]], grad: np.nd
     if not pts:
         return out
     pts, owner = np.concatenate(pts), np.concatenate(owner)
-    side = np.roll(p, -1, axis=0) - p
-    rel = pts[:, None, :] - p[None]
-    s = np.clip((rel * side[None]).sum(-1) / np.maximum((side * side).sum(-1), 1e-12), 0.0, 1.0)
-    clear = np.sqrt(((rel - s[..., None] * side[None]) ** 2).sum(-1)).min(axis=1) >= clear_px
+    clear = distance_to_segments(pts, p, np.roll(p, -1, axis=0) - p) >= clear_px
     h, w = grad.shape
     u = np.clip(np.round(pts[clear, 0]).astype(int), 0, w - 1)
     v = np.clip(np.round(pts[clear, 1]).astype(int), 0, h - 1)

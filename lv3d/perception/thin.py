@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 from .edges import edge_support
-from .polygons import area, clockwise, is_simple, perimeter, rasterize, sample_boundary
+from .polygons import area, clockwise, distance_to_segments, is_simple, perimeter, rasterize, sample_boundary
 
 
 def _outline_distance(polys: list[np.ndarray], shape: tuple[int, int]) -> np.ndarray:
@@ -179,12 +179,7 @@ def _sides_seen(poly: np.ndarray, line: np.ndarray, segs: np.ndarray, to_found: 
     outer = np.abs(off) <= tol_px
     if not outer.any() or outer.all():
         return False
-    p0, p1 = segs[:, :2], segs[:, 2:]
-    d = p1 - p0
-    ll = np.maximum((d * d).sum(1), 1e-9)
-    rel = pts[outer][:, None, :] - p0[None]
-    t = np.clip((rel * d[None]).sum(-1) / ll, 0.0, 1.0)
-    to_seg = np.sqrt(((rel - t[..., None] * d[None]) ** 2).sum(-1)).min(axis=1)
+    to_seg = distance_to_segments(pts[outer], segs[:, :2], segs[:, 2:] - segs[:, :2])
     if np.mean(to_seg <= tol_px) < min_on_edge:
         return False
     return bool(np.mean(_lookup(to_found, pts[~outer]) <= tol_px) >= min_inner)

@@ -31,7 +31,7 @@ def test_noisy_fragments_give_way_to_the_colour_view():
     frags = [_depth_object("s_o1", [_square(40, 30, 80, 90)], 0.8), _depth_object("s_o2", [_square(80, 30, 120, 90)], 0.7)]
     colour = [_colour_object("s_o1", [_square(40, 30, 82, 90), _square(82, 30, 120, 90)])]
     assert unconfirmed(frags) == [0, 1]
-    out = replace_unconfirmed(frags, colour, SHAPE, "s")
+    out = replace_unconfirmed(frags, unconfirmed(frags), colour, SHAPE, "s")
     assert len(out) == 1
     assert [f.provenance for f in out[0].faces] == ["rgb", "rgb"]
     assert [f.id for f in out[0].faces] == ["s_o1_f1", "s_o1_f2"] and out[0].adjacency == [("s_o1_f1", "s_o1_f2")]
@@ -41,17 +41,17 @@ def test_depth_that_fits_its_noise_model_is_kept():
     frags = [_depth_object("s_o1", [_square(40, 30, 80, 90)], 0.2), _depth_object("s_o2", [_square(80, 30, 120, 90)], 0.25)]
     colour = [_colour_object("s_o1", [_square(40, 30, 82, 90), _square(82, 30, 120, 90)])]
     assert unconfirmed(frags) == []
-    assert replace_unconfirmed(frags, colour, SHAPE, "s") is frags
+    assert replace_unconfirmed(frags, unconfirmed(frags), colour, SHAPE, "s") is frags
 
 
 def test_implausible_colour_objects_and_confirmed_objects_are_not_replaced():
     frags = [_depth_object("s_o1", [_square(40, 30, 80, 90)], 0.8)]
     many = [_colour_object("s_o1", [_square(40 + 6 * k, 30, 46 + 6 * k, 90) for k in range(6)])]  # six faces
-    assert replace_unconfirmed(frags, many, SHAPE, "s") is frags
+    assert replace_unconfirmed(frags, unconfirmed(frags), many, SHAPE, "s") is frags
     fused = SceneObject("s_o2", [Face("s_o2_f1", _square(80, 30, 120, 90), "rgbd")], [], 2400, (100.0, 60.0))
     over_both = [_colour_object("s_o1", [_square(40, 30, 82, 90), _square(82, 30, 120, 90)])]
     # colour lies on a fragment and on an object colour and depth agree on: both stay as they are
-    assert replace_unconfirmed(frags + [fused], over_both, SHAPE, "s") == frags + [fused]
+    assert replace_unconfirmed(frags + [fused], unconfirmed(frags + [fused]), over_both, SHAPE, "s") == frags + [fused]
 
 
 def test_renumber_orders_largest_first():
