@@ -11,8 +11,10 @@ the raw probability unchanged, a shift in logit space, Platt scaling (bias + slo
 plus a few face measurements (``FEATURES``) and, for predicates with a tolerance, the measured value in
 tolerances (``tol_frac``). The winner is refitted on all rows (L2-regularised logistic regression,
 measurements standardised, the standardisation folded into the coefficients). A map whose slope on
-logit p comes out negative is not used (confidence must grow with the measured probability). Then per
-modality one isotonic map of the pooled out-of-fold confidences of every type (``FINAL``).
+logit p comes out negative is not used (confidence must grow with the measured probability). Then the
+final map (``FINAL``) of out-of-fold confidences: per modality one isotonic map of every type pooled, and
+per type the best by scene-grouped 5-fold CV log loss of none, the pooled map and the type's own isotonic
+map (``fit_final``).
 ``--check`` prints per-type ECE on another dev set (rows with confidence >= 0.05, as facts are emitted)
 for the raw probabilities, the table in the tree and the new one, and each modality's ECE and log loss
 over all facts. Rows come from dev seeds only, never the study's data.
@@ -40,6 +42,7 @@ FEATURES = ["support", "log_area_px", "min_turn_z", "min_side_px"]
 MIN_ROWS = 12        # fewer rows (or one class of label only): keep the raw probability
 C_REG = 0.5          # inverse L2 strength of the logistic fits (standardised inputs)
 MIN_CONF = 0.05
+MIN_OWN_FINAL = 50   # fewer rows of either label: a type's own isotonic map would be steps of a few facts
 SUPPORT_PREDS = ("face_of", "adjacent", "object")
 
 
@@ -129,13 +132,49 @@ def fit_one(rows: list[dict], seed: int = 0):
             "map": name, "cv_logloss": round(losses[name], 4)}, losses, oof[name]
 
 
-def fit_final(conf: np.ndarray, y: np.ndarray) -> dict:
-    """The final map of one modality: isotonic regression of the truth on the pooled out-of-fold confidences
-    of every type (n,), kept within [0.001, 0.999], as knots {"x": [...], "y": [...]} (ascending x)."""
+def _isotonic(conf: np.ndarray, y: np.ndarray):
     from sklearn.isotonic import IsotonicRegression
 
-    iso = IsotonicRegression(y_min=1e-3, y_max=1 - 1e-3, out_of_bounds="clip").fit(conf, y)
+    return IsotonicRegression(y_min=1e-3, y_max=1 - 1e-3, out_of_bounds="clip").fit(conf, y)
+
+
+def _knots(iso) -> dict:
+    """An isotonic fit as knots {"x": [...], "y": [...]} (ascending x), values within [0.001, 0.999]."""
     return {"x": [round(float(v), 5) for v in iso.X_thresholds_], "y": [round(float(v), 5) for v in iso.y_thresholds_]}
+
+
+def fit_final(oof: dict, seed: int = 0) -> tuple[dict, dict]:
+    """The final maps of one modality from ``oof`` {pred: (out-of-fold stage-1 confidences (n,), truth (n,),
+    scene seeds (n,))}: the pooled isotonic map of every type together, and per type the final map with the
+    best 5-fold cross-validated log loss among none, the pooled map and the type's own isotonic map (only
+    with ``MIN_OWN_FINAL`` rows of each label). Folds are whole scenes: a scene's facts share its view and
+    perception errors. Returns (the ``FINAL`` entry: pooled knots with "by_pred" {pred: own knots, or None
+    for no final stage} for types that do not take the pooled map, {pred: {choice: CV log loss}})."""
+    preds = sorted(oof)
+    conf, y, seeds = (np.concatenate([oof[p][i] for p in preds]) for i in range(3))
+    owner = np.concatenate([[p] * len(oof[p][0]) for p in preds])
+    scenes = np.unique(seeds)
+    fold = dict(zip(scenes, np.random.default_rng(seed).permutation(len(scenes)) % 5))
+    folds = np.array([fold[s] for s in seeds])
+    pooled = [_isotonic(conf[folds != k], y[folds != k]) for k in range(5)]
+    final, losses = _knots(_isotonic(conf, y)), {}
+    by_pred = {}
+    for pred in preds:
+        mine = owner == pred
+        c, t, f = conf[mine], y[mine], folds[mine]
+        cands = {"none": c, "pooled": np.empty(len(c))}
+        if min(t.sum(), len(t) - t.sum()) >= MIN_OWN_FINAL:
+            cands["own"] = np.empty(len(c))
+        for k in range(5):
+            te = f == k
+            cands["pooled"][te] = pooled[k].predict(c[te])
+            if "own" in cands and te.any():
+                cands["own"][te] = _isotonic(c[~te], t[~te]).predict(c[te])
+        losses[pred] = {name: _logloss(v, t) for name, v in cands.items()}
+        best = min(losses[pred], key=losses[pred].get)
+        if best != "pooled":
+            by_pred[pred] = None if best == "none" else _knots(_isotonic(c, t))
+    return {**final, "by_pred": by_pred}, losses
 
 
 def report(rows: list[dict], table: tuple, title: str, shipped: tuple | None = None) -> None:
@@ -189,15 +228,20 @@ def main(argv=None) -> int:
         if r["modality"] in MODALITIES and r["p"] > 0:
             by[(r["modality"], r["pred"])].append(r)
     table: dict = {}
-    oof = defaultdict(list)  # per modality: (out-of-fold confidence, truth) of every row
+    oof = defaultdict(dict)  # per modality, per predicate: out-of-fold confidences, truth, scene seeds
     for key in sorted(by):
         entry, losses, conf = fit_one(by[key])
-        oof[key[0]] += zip(conf, (r["y"] for r in by[key]))
+        oof[key[0]][key[1]] = (conf, np.array([r["y"] for r in by[key]], float), np.array([r["seed"] for r in by[key]]))
         print(f"  {key[0]:5s} {key[1]:14s} n={len(by[key]):5d}  cv log loss "
               + "  ".join(f"{k} {v:.4f}" for k, v in losses.items()) + f"  -> {'raw' if entry is None else entry['map'] + ' ' + ','.join(entry['features'])}")
         if entry is not None:
             table.setdefault(key[0], {})[key[1]] = entry
-    final = {mod: fit_final(*np.array(oof[mod], float).T) for mod in sorted(oof)}
+    final = {}
+    print("final map per type, scene-grouped 5-fold CV log loss:")
+    for mod in sorted(oof):
+        final[mod], losses = fit_final(oof[mod])
+        for pred, ls in losses.items():
+            print(f"  {mod:5s} {pred:14s} " + "  ".join(f"{k} {v:.4f}" for k, v in ls.items()) + f"  -> {min(ls, key=ls.get)}")
     report(rows, (table, final), f"fit rows ({', '.join(map(str, a.data))})")
     if a.check:
         from grounding._calibration_table import FINAL, TABLE

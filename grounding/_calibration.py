@@ -8,9 +8,12 @@ of the faces behind it into a calibrated one:
 
     conf = sigmoid(bias + sum_k coef_k x_k),  x = (logit p, measurements named in the table)
 
-then one final non-decreasing piecewise-linear map per modality (isotonic regression of the pooled
-out-of-fold confidences of every type, ``FINAL``) corrects what the logistic form leaves over: per type
-calibrated on average, the pooled middle bins (0.4-0.85) came out over-confident.
+then a final non-decreasing piecewise-linear map (isotonic regression of out-of-fold confidences,
+``FINAL``) corrects what the logistic form leaves over: per type calibrated on average, the pooled middle
+bins (0.4-0.85) came out over-confident. Per (modality, predicate) the final map is the type's own (fitted
+on its rows alone), the modality's pooled one (every type together), or none, whichever had the best
+scene-grouped cross-validated log loss: one pooled map helped some types far less than their own map
+(perpendicular) and hurt others (triangle, acute, parallel).
 The maps are fitted (L2-regularised logistic regression, ``benchmarks/fit_calibration.py``) on perceived
 dev scenes (realsense preset, seeds 30000+; never the study's data) and live in
 ``_calibration_table.py``; a (modality, predicate) pair without a map keeps its raw probability (then the
@@ -85,8 +88,9 @@ def calibrate(modality: str, pred: str, p: float, x: dict | None = None) -> floa
 
 def calibrate_with(table: dict, modality: str, pred: str, p: float, x: dict | None = None,
                    final: dict | None = None) -> float:
-    """:func:`calibrate` with the maps of ``table`` (same layout as ``TABLE``) and the final per-modality
-    maps of ``final`` (layout of ``FINAL``; None: no final stage)."""
+    """:func:`calibrate` with the maps of ``table`` (same layout as ``TABLE``) and the final maps of ``final``
+    (layout of ``FINAL``: per modality pooled knots {"x", "y"} and optionally "by_pred", {pred: knots of the
+    type's own map, or None for no final stage}; None: no final stage)."""
     return _apply(_compile(pred, table.get(modality, {}).get(pred), (final or {}).get(modality)), p, x)
 
 
@@ -96,13 +100,24 @@ def _inputs(pred: str, names: list[str]) -> list:
             else (n, _SCALE.get(n, float)) for n in names]
 
 
+def _final_knots(pred: str, final: dict | None) -> dict | None:
+    """The final map of ``pred`` in one modality's ``final`` (layout of a ``FINAL`` value): the type's own
+    (or None, no final stage) where "by_pred" names it, else the pooled one."""
+    if final is None:
+        return None
+    by_pred = final.get("by_pred", {})
+    return by_pred[pred] if pred in by_pred else final
+
+
 def _compile(pred: str, entry: dict | None, final: dict | None):
     """(bias, [(coefficient, key in x or None for logit p, scale)], final knots (xs, ys)) of ``pred``'s table
-    entry (bias and terms None without one) and its modality's final map (None without one); None if neither."""
-    if entry is None and final is None:
+    entry (bias and terms None without one) and its final map in its modality's ``final`` (None without
+    one); None if neither."""
+    knots = _final_knots(pred, final)
+    if entry is None and knots is None:
         return None
     terms = None if entry is None else [(c, k, s) for c, (k, s) in zip(entry["coef"], _inputs(pred, entry["features"]))]
-    return (None if entry is None else entry["bias"]), terms, (None if final is None else (final["x"], final["y"]))
+    return (None if entry is None else entry["bias"]), terms, (None if knots is None else (knots["x"], knots["y"]))
 
 
 @functools.cache

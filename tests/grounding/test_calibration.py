@@ -1,5 +1,6 @@
 """grounding.calibrate: the shipped per-(modality, predicate) maps are monotone in the raw probability,
-stay in (0, 1), leave unmapped predicates and impossible facts alone, read a fact's value in tolerances;
+stay in (0, 1), leave unmapped predicates and impossible facts alone, read a fact's value in tolerances,
+take a type's own final map (or none) over the pooled one;
 pack_object picks the small padded shape for small objects."""
 
 import math
@@ -70,8 +71,17 @@ def test_final_map_interpolates_its_knots_and_keeps_zero():
     final = {"rgbd": {"x": [0.2, 0.6, 0.6, 0.8], "y": [0.1, 0.3, 0.5, 0.7]}}  # a step at 0.6
     got = [calibrate_with({}, "rgbd", "triangle", p, None, final) for p in (0.0, 0.1, 0.4, 0.6, 0.7, 0.9)]
     assert np.allclose(got, [0.0, 0.1, 0.2, 0.5, 0.6, 0.7])
-    for knots in FINAL.values():
-        assert np.all(np.diff(knots["x"]) >= 0) and np.all(np.diff(knots["y"]) >= 0)
+    for final in FINAL.values():
+        for knots in [final, *(k for k in final.get("by_pred", {}).values() if k is not None)]:
+            assert np.all(np.diff(knots["x"]) >= 0) and np.all(np.diff(knots["y"]) >= 0)
+
+
+def test_a_type_takes_its_own_final_map_or_none_before_the_pooled_one():
+    final = {"rgbd": {"x": [0.0, 1.0], "y": [0.2, 0.2],                 # pooled: everything to 0.2
+                      "by_pred": {"square": {"x": [0.0, 1.0], "y": [0.5, 0.5]}, "parallel": None}}}
+    got = {pred: calibrate_with({}, "rgbd", pred, 0.7, None, final) for pred in ("square", "parallel", "triangle")}
+    assert got == {"square": 0.5, "parallel": 0.7, "triangle": 0.2}
+    assert calibrate_with({}, "rgbd", "square", 0.0, None, final) == 0.0  # impossible stays impossible
 
 
 def _square(x0, y0, s=40.0):

@@ -1,0 +1,22 @@
+"""benchmarks/fit_calibration.fit_final: per type, the final map with the best scene-grouped CV log loss
+among none, the pooled isotonic map and the type's own."""
+
+import numpy as np
+
+from benchmarks.fit_calibration import fit_final
+
+
+def test_fit_final_gives_a_miscalibrated_type_its_own_map_and_leaves_a_calibrated_one():
+    rng = np.random.default_rng(0)
+    n = 3000
+    seeds = np.repeat(np.arange(n // 10), 10)               # 10 facts per scene
+    c_ok, c_bad = rng.uniform(0.05, 0.95, n), rng.uniform(0.05, 0.95, n)
+    oof = {"calibrated": (c_ok, (rng.random(n) < c_ok).astype(float), seeds),
+           "overconfident": (c_bad, (rng.random(n) < c_bad ** 3).astype(float), seeds)}
+    final, losses = fit_final(oof)
+    assert set(losses["overconfident"]) == {"none", "pooled", "own"}
+    assert final["by_pred"]["overconfident"] is not None    # its own map, which lowers its confidences
+    own = final["by_pred"]["overconfident"]
+    assert np.interp(0.5, own["x"], own["y"]) < 0.25
+    assert "calibrated" not in final["by_pred"] or final["by_pred"]["calibrated"] is None  # pooled would pull it down
+    assert np.all(np.diff(final["x"]) >= 0) and np.all(np.diff(final["y"]) >= 0)
