@@ -15,6 +15,7 @@ from .boundary import grid_to_pixels
 from .confirm import replace_unconfirmed, unconfirmed
 from .face_plane import angle_deg, fit_face_plane
 from .fuse import match_faces
+from .holes import add_hole_faces
 from .plane_outline import simplify_on_plane
 from .polygons import area, rasterize
 from .rgb import RGBFace, rgb_faces
@@ -208,6 +209,8 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         merged = set(alias) | set(alias.values())
         keep = [i for i in _reliable(faces) if i not in alias and (i not in piece or i in merged)]
         keep = _drop_covered(faces, keep, shape, off)
+        keep += add_hole_faces(faces, pairs, keep, frame, box, grid_to_pixels(o.obj.mask, stride, box),
+                                res.edge_dist)
         pairs = {(a, b) for a, b in pairs if a in keep and b in keep}
         _refine_outlines(faces, keep, frame.intrinsics)
         # stable ids: faces largest first

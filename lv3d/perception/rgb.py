@@ -33,6 +33,7 @@ class RGBResult:
     groups: list[list[int]]           # indices into faces, one list per object, largest first
     adjacency: list[tuple[int, int]]  # pairs of face indices sharing a graph edge, i < j
     timings_ms: dict[str, float]
+    edge_dist: np.ndarray | None = None  # (h, w) px from each pixel of the searched box to the nearest edge
 
 
 def _touches_frame(poly: np.ndarray, box: tuple[int, int, int, int], tol: float = 3.0) -> float:
@@ -115,7 +116,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     ordered = sorted(groups.values(), key=lambda idx: (-sum(faces[i].area_px for i in idx), idx[0]))
     t3 = time.perf_counter()
     timings = {"edges": (t1 - t0) * 1e3, "segments": (t2 - t1) * 1e3, "faces": (t3 - t2) * 1e3}
-    return RGBResult(faces, ordered, adjacency, timings)
+    return RGBResult(faces, ordered, adjacency, timings, dist)
 
 
 def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: float,
