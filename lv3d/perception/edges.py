@@ -6,7 +6,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .polygons import sample_boundary
+from .polygons import pixel_values, sample_boundary
 
 
 def to_gray(color: np.ndarray) -> np.ndarray:
@@ -58,7 +58,4 @@ def edge_distance(edges: np.ndarray) -> np.ndarray:
 def edge_support(poly: np.ndarray, dist: np.ndarray, tol_px: float = 2.0) -> float:
     """Fraction in [0, 1] of the polygon's perimeter within ``tol_px`` of an edge pixel."""
     pts = sample_boundary(poly, 1.0)
-    h, w = dist.shape
-    u = np.clip(np.round(pts[:, 0]).astype(int), 0, w - 1)
-    v = np.clip(np.round(pts[:, 1]).astype(int), 0, h - 1)
-    return float(np.mean(dist[v, u] <= tol_px)) if len(pts) else 0.0
+    return float(np.mean(pixel_values(dist, pts) <= tol_px)) if len(pts) else 0.0

@@ -112,6 +112,14 @@ def distance_to_segments(points: np.ndarray, starts: np.ndarray, steps: np.ndarr
     return np.sqrt(((rel - t[..., None] * steps[None]) ** 2).sum(-1)).min(axis=1)
 
 
+def pixel_values(img: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """Values of ``img`` (H, W) at the pixels nearest the points (m, 2) (u, v pixels), clipped to the image."""
+    h, w = img.shape[:2]
+    u = np.clip(np.round(pts[:, 0]).astype(int), 0, w - 1)
+    v = np.clip(np.round(pts[:, 1]).astype(int), 0, h - 1)
+    return img[v, u]
+
+
 def sample_boundary(poly: np.ndarray, step: float = 1.0) -> np.ndarray:
     """Points (m, 2) every ``step`` pixels along the closed boundary."""
     p = np.asarray(poly, dtype=np.float64)

@@ -33,7 +33,7 @@ class RGBResult:
     groups: list[list[int]]           # indices into faces, one list per object, largest first
     adjacency: list[tuple[int, int]]  # pairs of face indices sharing a graph edge, i < j
     timings_ms: dict[str, float]
-    edge_dist: np.ndarray | None = None  # (h, w) px from each pixel of the searched box to the nearest edge
+    edge_dist: np.ndarray             # (h, w) px from each pixel of the searched box to the nearest edge
 
 
 def _touches_frame(poly: np.ndarray, box: tuple[int, int, int, int], tol: float = 3.0) -> float:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .polygons import area, distance_to_segments, signed_area
+from .polygons import area, distance_to_segments, pixel_values, signed_area
 
 
 def gradient_magnitude(channels: list[np.ndarray]) -> np.ndarray:
@@ -42,10 +42,7 @@ def _line_strength(a: np.ndarray, b: np.ndarray, grad: np.ndarray, trim_px: floa
         return 0.0
     t = np.linspace(trim_px / length, 1 - trim_px / length, max(4, int(length)))
     pts = a + t[:, None] * (b - a)
-    h, w = grad.shape
-    u = np.clip(np.round(pts[:, 0]).astype(int), 0, w - 1)
-    v = np.clip(np.round(pts[:, 1]).astype(int), 0, h - 1)
-    return float(grad[v, u].mean())
+    return float(pixel_values(grad, pts).mean())
 
 
 def _diagonal_strengths(p: np.ndarray, pairs: list[tuple[int, int]], grad: np.ndarray, trim_px: float = 3.0,
@@ -67,10 +64,7 @@ def _diagonal_strengths(p: np.ndarray, pairs: list[tuple[int, int]], grad: np.nd
         return out
     pts, owner = np.concatenate(pts), np.concatenate(owner)
     clear = distance_to_segments(pts, p, np.roll(p, -1, axis=0) - p) >= clear_px
-    h, w = grad.shape
-    u = np.clip(np.round(pts[clear, 0]).astype(int), 0, w - 1)
-    v = np.clip(np.round(pts[clear, 1]).astype(int), 0, h - 1)
-    total = np.bincount(owner[clear], weights=grad[v, u], minlength=len(pairs))
+    total = np.bincount(owner[clear], weights=pixel_values(grad, pts[clear]), minlength=len(pairs))
     count = np.bincount(owner[clear], minlength=len(pairs))
     np.divide(total, count, out=out, where=count > 0)
     return out

@@ -14,24 +14,17 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .edges import edge_support
-from .polygons import area, clockwise, distance_to_segments, is_simple, perimeter, rasterize, sample_boundary
+from .edges import edge_distance, edge_support
+from .polygons import (area, clockwise, distance_to_segments, is_simple, perimeter, pixel_values, rasterize,
+                       sample_boundary)
 
 
 def _outline_distance(polys: list[np.ndarray], shape: tuple[int, int]) -> np.ndarray:
     """Distance (H, W) float32 in pixels from each pixel to the nearest outline of ``polys`` (one distance
     transform: looked up for many points, far cheaper than a point-polygon test each)."""
-    lines = np.full(shape, 255, np.uint8)
-    cv2.polylines(lines, [np.round(p).astype(np.int32) for p in polys], True, 0, 1)
-    return cv2.distanceTransform(lines, cv2.DIST_L2, 3)
-
-
-def _lookup(img: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    """Values of ``img`` (H, W) at the pixels nearest the points (m, 2), clipped to the image."""
-    h, w = img.shape
-    u = np.clip(np.round(pts[:, 0]).astype(int), 0, w - 1)
-    v = np.clip(np.round(pts[:, 1]).astype(int), 0, h - 1)
-    return img[v, u]
+    lines = np.zeros(shape, np.uint8)
+    cv2.polylines(lines, [np.round(p).astype(np.int32) for p in polys], True, 1, 1)
+    return edge_distance(lines)
 
 
 def _to_polyline(pts: np.ndarray, line: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -123,7 +116,7 @@ def thin_faces(segs: np.ndarray, dist: np.ndarray, found: list[np.ndarray], min_
     # nor does a found face's own side (most segments are): nothing thin lies beyond it
     frac = np.linspace(0.0, 1.0, 9)
     along = segs[:, None, :2] + frac[None, :, None] * (segs[:, None, 2:] - segs[:, None, :2])
-    on_side = np.mean(_lookup(to_found, along.reshape(-1, 2)).reshape(len(segs), -1) <= 1.5, axis=1) > 0.5
+    on_side = np.mean(pixel_values(to_found, along.reshape(-1, 2)).reshape(len(segs), -1) <= 1.5, axis=1) > 0.5
     length = np.where(useful & ~on_side, length, 0.0)
     out: list[np.ndarray] = []
     for line in _outer_edges(segs, length, min_len_px, min_kink_deg, max_kink_deg, reach_px):
@@ -137,7 +130,7 @@ def thin_faces(segs: np.ndarray, dist: np.ndarray, found: list[np.ndarray], min_
         sel = near & (side * off >= -1.0)
         pts, s_sel, piece_sel = corners[sel], s[sel], piece[sel]
         # the sliver's width: its corners' distance from the edge, or its kink's from the found outlines
-        kink = float(_lookup(to_found, line[1:-1]).max()) if len(line) > 2 else 0.0
+        kink = float(pixel_values(to_found, line[1:-1]).max()) if len(line) > 2 else 0.0
         width = max(float((side * off[sel]).max()), kink)
         if len(pts) + len(line) - 2 < 3 or width < min_gap_px:
             continue
@@ -182,4 +175,4 @@ def _sides_seen(poly: np.ndarray, line: np.ndarray, segs: np.ndarray, to_found: 
     to_seg = distance_to_segments(pts[outer], segs[:, :2], segs[:, 2:] - segs[:, :2])
     if np.mean(to_seg <= tol_px) < min_on_edge:
         return False
-    return bool(np.mean(_lookup(to_found, pts[~outer]) <= tol_px) >= min_inner)
+    return bool(np.mean(pixel_values(to_found, pts[~outer]) <= tol_px) >= min_inner)
