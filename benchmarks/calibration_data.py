@@ -1,7 +1,7 @@
 """Candidate facts of perceived dev scenes with their ground-truth labels and the measurements behind them:
 the data the confidence calibration (grounding/_calibration.py) is fitted on and checked against.
 
-    .venv/bin/python benchmarks/calibration_data.py --fresh --seed 30000 --per-class 50 --modalities rgbd,depth --out out/calib/s5_a50.pkl
+    .venv/bin/python benchmarks/calibration_data.py --fresh --seed 30000 --per-class 50 --modalities rgbd,depth --out out/calib/s6_a50.pkl
 
 Scenes are ``render_scene(cls, seed + 1000 * class_index + i, preset)`` for the 7 bench classes: dev seeds
 only (never the study's seed-0 data set). Each row: modality, predicate, raw probability (before any

@@ -3,8 +3,8 @@
 The refit (docs/grounding.md, "Calibration on perceived scenes"; ~15 min on 2 busy cores):
 
     for a in "30000 50 a50" "31000 50 b50" "32000 30 c30"; do set -- $a; .venv/bin/python benchmarks/calibration_data.py \
-        --fresh --seed $1 --per-class $2 --modalities rgbd,depth --out out/calib/s5_$3.pkl & done; wait
-    .venv/bin/python benchmarks/fit_calibration.py out/calib/s5_a50.pkl out/calib/s5_b50.pkl --check out/calib/s5_c30.pkl
+        --fresh --seed $1 --per-class $2 --modalities rgbd,depth --out out/calib/s6_$3.pkl & done; wait
+    .venv/bin/python benchmarks/fit_calibration.py out/calib/s6_a50.pkl out/calib/s6_b50.pkl --check out/calib/s6_c30.pkl
 
 For each (modality, predicate) four maps compete by 5-fold cross-validated log loss on the dev rows:
 the raw probability unchanged, a shift in logit space, Platt scaling (bias + slope on logit p), and Platt
