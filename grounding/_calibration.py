@@ -133,7 +133,12 @@ def _apply(compiled, p: float, x: dict | None) -> float:
     bias, terms, knots = compiled
     if terms is not None:
         x = x or {}
-        z = bias + sum(c * (logit(p) if n is None else scale(float(x.get(n, 0.0)))) for c, n, scale in terms)
+        # plain left-to-right sum from 0 (what sum() over a generator gave on Python 3.11), without
+        # building a generator per candidate
+        s = 0
+        for c, n, scale in terms:
+            s += c * (logit(p) if n is None else scale(float(x.get(n, 0.0))))
+        z = bias + s
         p = 1.0 / (1.0 + math.exp(-max(min(z, 50.0), -50.0)))
     return p if knots is None else _interp(knots, p)
 

@@ -68,19 +68,25 @@ def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 6
     eu, ev = nz.reshape(-1, 2).T.astype(np.intp)
     _, labels = cv2.distanceTransformWithLabels(cv2.bitwise_not(edges), cv2.DIST_L2, 5,
                                                 labelType=cv2.DIST_LABEL_PIXEL)
-    # squared gradient magnitudes, exact in int32 (below 2^24, so float32 would rank them the same)
-    sq = [x.astype(np.int32) ** 2 + y.astype(np.int32) ** 2 for x, y in zip(dxs, dys)]
-    # each edge pixel's gradient is that of its strongest channel (the first on ties)
+    # each edge pixel's gradient is that of its strongest channel (the first on ties), compared by squared
+    # magnitudes, exact in int32; read at the edge pixels only
     at = ev * w + eu
-    best = np.argmax(np.stack([m.ravel()[at] for m in sq]), axis=0)
-    pick = (best, np.arange(len(at)))
-    g = np.stack([np.stack([x.ravel()[at] for x in dxs])[pick], np.stack([y.ravel()[at] for y in dys])[pick]],
-                 1).astype(np.float32)
+    gx = np.stack([x.ravel().take(at) for x in dxs]).astype(np.int32)
+    gy = np.stack([y.ravel().take(at) for y in dys]).astype(np.int32)
+    pick = (np.argmax(gx * gx + gy * gy, axis=0), np.arange(len(at)))
+    g = np.stack([gx[pick], gy[pick]], 1).astype(np.float32)
     n = g / np.maximum(np.linalg.norm(g, axis=1, keepdims=True), 1e-6)
-    top = sq[0]
-    for m in sq[1:]:
-        top = np.maximum(top, m)
-    m = np.sqrt(top.astype(np.float32))
+    # the strongest channel's gradient magnitude at every pixel: dx^2 + dy^2 < 2^24 is exact in float32, so
+    # this is sqrt(float32(the int32 maximum)) bit for bit, in fewer passes over the box
+    m = None
+    for x, y in zip(dxs, dys):
+        sq = x.astype(np.float32)
+        sq *= sq
+        y2 = y.astype(np.float32)
+        y2 *= y2
+        sq += y2
+        m = sq if m is None else np.maximum(m, sq, out=m)
+    np.sqrt(m, out=m)
     # sub-pixel peak of the gradient magnitude along the normal (parabola through three samples)
     pts = np.stack([eu, ev], 1).astype(np.float32)
     samples = _bilinear(m, np.concatenate([pts - n, pts, pts + n])).reshape(3, -1)
@@ -89,10 +95,15 @@ def edge_distance_field(image: np.ndarray, *, low: float = 20.0, high: float = 6
     sub = pts + np.clip(offset, -0.5, 0.5)[:, None] * n
     # each pixel's signed distance to the line through its nearest edge point: u n_u + v n_v - sub . n
     c = np.sum(sub * n, axis=1, dtype=np.float32)
-    k = labels - 1
+    # in place, in the same order of operations: each full-box temporary costs as much as the arithmetic
+    k = np.subtract(labels, 1, out=labels)
     nu, nv = np.ascontiguousarray(n.T)
-    signed = (np.arange(w, dtype=np.float32)[None, :] * nu.take(k)
-              + np.arange(h, dtype=np.float32)[:, None] * nv.take(k) - c.take(k))
+    signed = nu.take(k)
+    signed *= np.arange(w, dtype=np.float32)[None, :]
+    tmp = nv.take(k)
+    tmp *= np.arange(h, dtype=np.float32)[:, None]
+    signed += tmp
+    signed -= c.take(k, out=tmp)
     return np.clip(signed, -cap_px, cap_px, out=signed)
 
 

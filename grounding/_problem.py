@@ -221,8 +221,10 @@ def _pack(polygons, *, intrinsics, planes, points, use_edges, edge_support, adja
                 p = np.asarray(points[f], np.float64)
                 if len(p) > MAX_POINTS:
                     near = np.abs(p @ plane_arr[f, :3] + plane_arr[f, 3]) <= gate_m
-                    # np.compress: the rows p[near] picks, several times quicker for (m, 3) arrays
-                    p = np.compress(near, p, axis=0) if np.count_nonzero(near) >= 3 else p
+                    kept = np.count_nonzero(near)
+                    # np.compress: the rows p[near] picks, several times quicker for (m, 3) arrays; no copy
+                    # where every point passes (describe's full-resolution points were gated already)
+                    p = np.compress(near, p, axis=0) if 3 <= kept < len(p) else p
                 memo[f, MAX_POINTS] = _compress(p, MAX_POINTS, intrinsics)
             p, w = memo[f, MAX_POINTS]
             pts[f, : len(p)] = p

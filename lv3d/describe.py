@@ -58,6 +58,11 @@ def _simplify(poly: np.ndarray, max_sides: int) -> np.ndarray:
     return poly
 
 
+def _plane_row(plane) -> np.ndarray:
+    """(n, d) of a plane as a (4,) float64 array (np.r_ of the same costs ten times as long)."""
+    return np.array([*plane.normal, plane.offset], np.float64)
+
+
 def _first(a, b):
     return b if a is None else a
 
@@ -171,7 +176,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     intr = (k.fx, k.fy, k.cx, k.cy)
     if field is None:
         field = edge_field(frame, scene.modality, scene)
-    support = None if scene.support_plane is None else np.r_[scene.support_plane.n, scene.support_plane.offset]
+    support = None if scene.support_plane is None else _plane_row(scene.support_plane)
     cands: list[tuple[str, tuple[str, ...], float, float | None]] = []
     results: list[ObjectResult] = []
     # pack every object (in chunks of MAX_FACES faces), ground them all in batched calls, then read facts
@@ -191,7 +196,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 pts = [p if p is None else _first(dense_face_points(f, frame), p) for f, p in zip(chunk, pts)]
             prob, index = grounding.pack_object(
                 polys, intrinsics=intr,
-                planes=[np.r_[f.plane.n, f.plane.offset] if hp else None for f, hp in zip(chunk, has_plane)],
+                planes=[_plane_row(f.plane) if hp else None for f, hp in zip(chunk, has_plane)],
                 points=pts,
                 adjacency=[(pos[a], pos[b]) for a, b in obj.adjacency if a in pos and b in pos],
                 support_plane=support)
@@ -210,43 +215,51 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 continue
             raw.append(([f.id for f in chunk], g))
             status = max(status, int(g["status"]))
-            c = g["conf"]
+            # every number a candidate carries, as Python floats in one call per array (indexing numpy
+            # scalars one at a time cost more than the rest of this loop)
+            c = {k: v.tolist() for k, v in g["conf"].items()}
+            tilt_l = g["quantities"]["tilt_deg"].tolist()
+            dih_l = g["quantities"]["dihedral_deg"].tolist()
+            par_l = g["quantities"]["parallel_deg"].tolist()
+            # float32 arithmetic, as on the scalars before
+            support_l = np.clip(g["conf"]["edge_support"] / grounding.SUPPORT_FULL, 0.0, 1.0).tolist()
             vstd_all = _largest_std(g["vertex_cov"])
+            ns = [len(p) for p in polys]
+            feats = _face_features(g, index, ns)
             for i, f in enumerate(chunk):
-                n = len(polys[i])
+                n = ns[i]
                 ids_i = index[i, :n]
-                vstd = vstd_all[ids_i]
-                face_results.append(FaceResult(f, g["vertices"][ids_i], g["planes"][i] if has_plane[i] else None, vstd,
-                                               _face_features(g, i, n, g["vertices"][ids_i], len(chunk))))
-                support_term = float(np.clip(c["edge_support"][i] / grounding.SUPPORT_FULL, 0.0, 1.0))
+                face_results.append(FaceResult(f, g["vertices"][ids_i], g["planes"][i] if has_plane[i] else None,
+                                               vstd_all[ids_i], feats[i]))
+                support_term = support_l[i]
                 face_conf[f.id] = support_term
                 cands.append(("face_of", (obj.id, f.id), support_term, None))
                 if n in SIDE_NAMES:
-                    cands.append((SIDE_NAMES[n], (f.id,), float(c["p_sides"][i]), float(n)))
+                    cands.append((SIDE_NAMES[n], (f.id,), c["p_sides"][i], float(n)))
                 if n == 4:
-                    cands.append(("parallelogram", (f.id,), float(c["p_parallelogram"][i]), float(c["para_dev_deg"][i])))
+                    cands.append(("parallelogram", (f.id,), c["p_parallelogram"][i], c["para_dev_deg"][i]))
                 if has_plane[i]:
                     if n == 4:
-                        cands.append(("square", (f.id,), float(c["p_square"][i]), float(c["side_ratio"][i])))
-                        cands.append(("rectangle", (f.id,), float(c["p_rectangle"][i]), float(c["right_dev_deg"][i])))
-                    cands.append(("regular", (f.id,), float(c["p_regular"][i]), float(c["side_ratio"][i])))
+                        cands.append(("square", (f.id,), c["p_square"][i], c["side_ratio"][i]))
+                        cands.append(("rectangle", (f.id,), c["p_rectangle"][i], c["right_dev_deg"][i]))
+                    cands.append(("regular", (f.id,), c["p_regular"][i], c["side_ratio"][i]))
                     if support is not None:
-                        tilt = float(g["quantities"]["tilt_deg"][i])
-                        cands.append(("horizontal", (f.id,), float(c["p_horizontal"][i]), tilt))
-                        cands.append(("vertical", (f.id,), float(c["p_vertical"][i]), tilt))
+                        tilt = tilt_l[i]
+                        cands.append(("horizontal", (f.id,), c["p_horizontal"][i], tilt))
+                        cands.append(("vertical", (f.id,), c["p_vertical"][i], tilt))
             adjacent = {(a, b) for a, b in obj.adjacency} | {(b, a) for a, b in obj.adjacency}
             for i, fi in enumerate(chunk):
                 for j, fj in enumerate(chunk):
                     if i == j or not (has_plane[i] and has_plane[j]):
                         continue
-                    dih = float(g["quantities"]["dihedral_deg"][i, j])
+                    dih = dih_l[i][j]
                     dihedrals[(fi.id, fj.id)] = dih
                     args = (fi.id, fj.id)
-                    cands.append(("perpendicular", args, float(c["p_perpendicular"][i, j]), dih))
-                    cands.append(("parallel", args, float(c["p_parallel"][i, j]), float(g["quantities"]["parallel_deg"][i, j])))
+                    cands.append(("perpendicular", args, c["p_perpendicular"][i][j], dih))
+                    cands.append(("parallel", args, c["p_parallel"][i][j], par_l[i][j]))
                     if args in adjacent:
-                        cands.append(("acute", args, float(c["p_acute"][i, j]), dih))
-                        cands.append(("obtuse", args, float(c["p_obtuse"][i, j]), dih))
+                        cands.append(("acute", args, c["p_acute"][i][j], dih))
+                        cands.append(("obtuse", args, c["p_obtuse"][i][j], dih))
         for a, b in obj.adjacency:
             if a in face_conf and b in face_conf:
                 p = min(face_conf[a], face_conf[b])  # the shared edge is as real as the weaker face
@@ -256,12 +269,21 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         results.append(ObjectResult(obj, face_results, dihedrals, status, raw))
     if calibrate:
         # measurements only for the candidates whose map reads them (they cost more than the maps)
-        needs = {pred: bool(grounding.measures_used(scene.modality, pred)) for pred in PREDICATES}
+        needs = _needs(scene.modality)
         feats = calibration_features([c for c in cands if needs[c[0]]], results)
         it = iter(feats)
-        cands = [(pred, args, grounding.calibrate(scene.modality, pred, p, next(it) if needs[pred] else None), value)
+        calibrate_one, modality = grounding.calibrate, scene.modality
+        cands = [(pred, args, calibrate_one(modality, pred, p, next(it) if needs[pred] else None), value)
                  for pred, args, p, value in cands]
     return cands, results
+
+
+@functools.cache
+def _needs(modality: str) -> dict[str, bool]:
+    """Per predicate whether its calibration map in ``modality`` reads face measurements."""
+    import grounding
+
+    return {pred: bool(grounding.measures_used(modality, pred)) for pred in PREDICATES}
 
 
 def _largest_std(cov: np.ndarray) -> np.ndarray:
@@ -271,15 +293,26 @@ def _largest_std(cov: np.ndarray) -> np.ndarray:
     return np.sqrt(np.clip(0.5 * (a + c) + np.hypot(0.5 * (a - c), b), 0.0, None))
 
 
-def _face_features(g: dict, i: int, n: int, poly: np.ndarray, faces_in_problem: int) -> dict:
-    """Measurements of face ``i`` of a grounding result that the calibration may read: the weakest corner's
-    turn in units of its spread (how sure the side count is), edge support, image area and shortest side."""
-    turn = 180.0 - g["quantities"]["corner_deg"][i, :n]
-    sd = np.hypot(g["std"]["corner_deg"][i, :n], 1.2)
-    return {"sides": n, "min_turn_deg": float(turn.min()), "min_turn_z": float(((turn - 15.0) / sd).min()),
-            "support": float(g["conf"]["edge_support"][i]), "log_area_px": float(np.log(max(area(poly), 1.0))),
-            "min_side_px": float(np.linalg.norm(np.diff(poly, axis=0, append=poly[:1]), axis=1).min()),
-            "faces": faces_in_problem}
+def _face_features(g: dict, index: np.ndarray, ns: list[int]) -> list[dict]:
+    """Measurements of each face of a grounding result that the calibration may read: the weakest corner's
+    turn in units of its spread (how sure the side count is), edge support, image area and shortest side.
+    ``index``: (faces, S) union vertex id of each polygon slot; ``ns``: each face's side count."""
+    nf = len(ns)
+    real = np.arange(index.shape[1])[None, :] < np.asarray(ns)[:, None]
+    # float32, as per face before; the minimum over each face's real corners (padding reads +inf)
+    turn = 180.0 - g["quantities"]["corner_deg"][:nf, :index.shape[1]]
+    sd = np.hypot(g["std"]["corner_deg"][:nf, :index.shape[1]], 1.2)
+    min_turn = np.where(real, turn, np.inf).min(1).tolist()
+    min_z = np.where(real, (turn - 15.0) / sd, np.inf).min(1).tolist()
+    support = g["conf"]["edge_support"][:nf].tolist()
+    out = []
+    for i, n in enumerate(ns):
+        poly = g["vertices"][index[i, :n]]
+        out.append({"sides": n, "min_turn_deg": min_turn[i], "min_turn_z": min_z[i], "support": support[i],
+                    "log_area_px": float(np.log(max(area(poly), 1.0))),
+                    "min_side_px": float(np.linalg.norm(np.diff(poly, axis=0, append=poly[:1]), axis=1).min()),
+                    "faces": nf})
+    return out
 
 
 def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]:

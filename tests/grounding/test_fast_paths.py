@@ -1,6 +1,6 @@
 """The quick paths kept for speed give what the plain computations give: Monte Carlo draws of only the
-quantities that are read, vertex merging and point compression in pack_object, and the edge field's
-per-channel gradients."""
+quantities that are read, vertex merging and point compression in pack_object, the edge field's
+per-channel gradients and float32 magnitudes, and describe's face features taken per problem at once."""
 
 import jax
 import jax.numpy as jnp
@@ -68,3 +68,37 @@ def test_edge_field_takes_each_edge_from_its_strongest_channel():
     assert abs(field[20, 79] + 0.5) < 0.15 and abs(field[20, 80] - 0.5) < 0.15
     assert abs(field[59, 20] + 0.5) < 0.15 and abs(field[60, 20] - 0.5) < 0.15
     assert abs(field[20, 70] + 9.5) < 0.2
+
+
+def test_edge_field_float32_magnitude_is_the_int32_one():
+    # the field takes sqrt(dx^2 + dy^2) in float32 straight from the int16 Sobel derivatives of uint8 images
+    # (|d| <= 4 * 255); that equals sqrt of the exact int32 sum, since every such sum is below 2^24
+    d = np.arange(-1020, 1021, 3, dtype=np.int16)
+    dx, dy = np.meshgrid(d, d)
+    exact = np.sqrt((dx.astype(np.int32) ** 2 + dy.astype(np.int32) ** 2).astype(np.float32))
+    fx, fy = dx.astype(np.float32), dy.astype(np.float32)
+    np.testing.assert_array_equal(np.sqrt(fx * fx + fy * fy), exact)
+
+
+def test_face_features_equal_the_per_face_computation():
+    from lv3d.describe import _face_features
+    from lv3d.perception.polygons import area
+
+    rng = np.random.default_rng(5)
+    f, s, u = 4, 6, 16
+    g = {"quantities": {"corner_deg": rng.uniform(60, 179, (f, s)).astype(np.float32)},
+         "std": {"corner_deg": rng.uniform(0.1, 5, (f, s)).astype(np.float32)},
+         "conf": {"edge_support": rng.uniform(0, 1, f).astype(np.float32)},
+         "vertices": rng.uniform(0, 400, (u, 2)).astype(np.float32)}
+    ns = [3, 6, 4]
+    index = rng.integers(0, u, (len(ns), s))
+    got = _face_features(g, index, ns)
+    for i, n in enumerate(ns):
+        turn = 180.0 - g["quantities"]["corner_deg"][i, :n]
+        sd = np.hypot(g["std"]["corner_deg"][i, :n], 1.2)
+        poly = g["vertices"][index[i, :n]]
+        want = {"sides": n, "min_turn_deg": float(turn.min()), "min_turn_z": float(((turn - 15.0) / sd).min()),
+                "support": float(g["conf"]["edge_support"][i]), "log_area_px": float(np.log(max(area(poly), 1.0))),
+                "min_side_px": float(np.linalg.norm(np.diff(poly, axis=0, append=poly[:1]), axis=1).min()),
+                "faces": len(ns)}
+        assert got[i] == want
