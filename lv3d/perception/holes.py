@@ -64,11 +64,13 @@ def hole_faces(no_reading: np.ndarray, object_px: np.ndarray, edge_dist: np.ndar
 
 def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[int], frame: RGBD,
                    box: tuple[int, int, int, int], object_px: np.ndarray, edge_dist: np.ndarray,
-                   max_taken: float = 0.3, max_share: float = 0.5) -> list[int]:
+                   max_taken: float = 0.3, max_share: float = 0.5,
+                   masks: dict[int, np.ndarray] | None = None) -> list[int]:
     """Faces seen so edge-on that depth has no reading there (:func:`hole_faces`), appended to ``faces`` with
     provenance 'rgb' (the outline is checked on colour edges; no plane), each made a neighbour (in ``pairs``)
     of the kept faces it touches. Returns their indices. ``box``: the crop (u0, v0, u1, v1) pixels that
-    ``object_px`` (the object's pixels) and ``edge_dist`` cover.
+    ``object_px`` (the object's pixels) and ``edge_dist`` cover; ``masks``: the ``keep`` faces' masks in that crop
+    when the caller has them already (index -> (H, W) bool; updated in place), else they are drawn here.
 
     A hole that the kept faces cover for at most ``max_taken`` of its pixels is a face beside them. One that a
     single kept face covers, as a part of at most ``max_share`` of that face, is a face the colour outline
@@ -82,7 +84,8 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
         return []
     off = np.array([u0, v0], float)
     shape = no_reading.shape
-    masks = {i: rasterize(faces[i].polygon - off, shape) for i in keep}
+    if masks is None:
+        masks = {i: rasterize(faces[i].polygon - off, shape) for i in keep}
     added = []
     for poly in hole_faces(no_reading, object_px, edge_dist):
         hole = rasterize(poly, shape)

@@ -208,9 +208,9 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         pairs = {(a, b) for a, b in pairs if a != b}
         merged = set(alias) | set(alias.values())
         keep = [i for i in _reliable(faces) if i not in alias and (i not in piece or i in merged)]
-        keep = _drop_covered(faces, keep, shape, off)
+        keep, masks = _drop_covered(faces, keep, shape, off)
         keep += add_hole_faces(faces, pairs, keep, frame, box, grid_to_pixels(o.obj.mask, stride, box),
-                                res.edge_dist)
+                                res.edge_dist, masks=masks)
         pairs = {(a, b) for a, b in pairs if a in keep and b in keep}
         _refine_outlines(faces, keep, frame.intrinsics)
         # stable ids: faces largest first
@@ -364,11 +364,12 @@ def _merge_coplanar(faces: list[Face], pairs: set[tuple[int, int]], max_excess: 
 
 
 def _drop_covered(faces: list[Face], keep: list[int], shape: tuple[int, int], off: np.ndarray,
-                  max_covered: float = 0.5) -> list[int]:
+                  max_covered: float = 0.5) -> tuple[list[int], dict[int, np.ndarray]]:
     """``keep`` without the depth-only faces lying mostly (> ``max_covered`` of their pixels) on other kept
     faces that have planes: a plane that straddles an edge, or a face's plane found a little off its place,
     left over when colour faces took the pixels around it. A plane that one colour face covers but that is
-    turned away from that face's plane stays: the colour outline merged it (an edge without contrast)."""
+    turned away from that face's plane stays: the colour outline merged it (an edge without contrast). Also
+    returns the kept faces' masks (``shape`` crop at pixel offset ``off``), for the next step to reuse."""
     masks = {i: rasterize(faces[i].polygon - off, shape) for i in keep}
     out = []
     for i in keep:
@@ -385,7 +386,7 @@ def _drop_covered(faces: list[Face], keep: list[int], shape: tuple[int, int], of
                 if not merged:
                     continue
         out.append(i)
-    return out
+    return out, {i: masks[i] for i in out}
 
 
 def _inside(poly_px: np.ndarray, mask_px: np.ndarray) -> float:

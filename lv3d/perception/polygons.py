@@ -52,11 +52,16 @@ def is_simple(poly: np.ndarray) -> bool:
     return True
 
 
-def simplify(poly: np.ndarray, rel_tol: float = 0.06, abs_tol: float = 2.0, min_turn_deg: float = 12.0) -> np.ndarray:
+def simplify(poly: np.ndarray, rel_tol: float = 0.06, abs_tol: float = 2.0, min_turn_deg: float = 12.0,
+             keep_area_frac: float | None = None) -> np.ndarray:
     """Drop nearly-collinear vertices until only the true corners remain: repeatedly remove the vertex that
     deviates least from the chord of its neighbours while that deviation is under
-    ``max(abs_tol px, rel_tol * chord)`` or the direction turns there by less than ``min_turn_deg``."""
+    ``max(abs_tol px, rel_tol * chord)`` or the direction turns there by less than ``min_turn_deg``. With
+    ``keep_area_frac``, a vertex whose removal would cut off more than that fraction of the polygon's area is a
+    corner whatever its deviation and turn: a face seen edge-on is a sliver whose corners lie a few px off the
+    chord of their neighbours and turn little, yet hold much of its area."""
     p = [(float(u), float(v)) for u, v in np.asarray(poly, dtype=np.float64)]
+    max_cut = math.inf if keep_area_frac is None else keep_area_frac * area(poly)
 
     def score(i: int) -> float:
         """dev / chord of vertex i, or inf when it is a corner to keep (plain floats: numpy calls on 2-vectors
@@ -71,7 +76,7 @@ def simplify(poly: np.ndarray, rel_tol: float = 0.06, abs_tol: float = 2.0, min_
         n1, n2 = math.hypot(d1x, d1y), math.hypot(d2x, d2y)
         turn = 0.0 if n1 < 1e-9 or n2 < 1e-9 else math.degrees(
             math.acos(min(1.0, max(-1.0, (d1x * d2x + d1y * d2y) / (n1 * n2)))))
-        ok = dev < max(abs_tol, rel_tol * L) or turn < min_turn_deg
+        ok = (dev < max(abs_tol, rel_tol * L) or turn < min_turn_deg) and 0.5 * dev * L <= max_cut
         return dev / L if ok else math.inf
 
     scores = [score(i) for i in range(len(p))]

@@ -10,7 +10,7 @@ import numpy as np
 
 from .edges import channels, edge_distance, edge_support, edges_and_gradient
 from .faces import bounded_faces, build_graph
-from .polygons import area, clockwise, drop_short_sides, is_simple, sample_boundary, simplify
+from .polygons import area, clockwise, drop_short_sides, is_simple, perimeter, sample_boundary, simplify
 from .segments import detect_color_segments, union_find_labels
 from .split import split_by_diagonal, split_concave
 from .thin import thin_faces
@@ -34,6 +34,10 @@ class RGBResult:
     adjacency: list[tuple[int, int]]  # pairs of face indices sharing a graph edge, i < j
     timings_ms: dict[str, float]
     edge_dist: np.ndarray             # (h, w) px from each pixel of the searched box to the nearest edge
+
+
+# a corner cutting off more than this fraction of a face's area is kept however little it turns (polygons.simplify)
+_KEEP_AREA = 0.1
 
 
 def _touches_frame(poly: np.ndarray, box: tuple[int, int, int, int], tol: float = 3.0) -> float:
@@ -78,7 +82,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         a = area(f.polygon)
         if a < min_area_px or a > max_area_frac * w * h:
             continue
-        poly = clockwise(drop_short_sides(simplify(f.polygon)))
+        poly = clockwise(drop_short_sides(simplify(f.polygon, keep_area_frac=_KEEP_AREA)))
         if len(poly) < 3 or not is_simple(poly) or area(poly) < min_area_px:
             continue
         if _touches_frame(poly, frame) > 0.5:
@@ -95,7 +99,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         # the cut is an edge the graph lacks: a shared made-up edge key makes the parts neighbours
         cut = (-1 - len(cands), -1 - len(cands))
         for q in pieces:
-            q = clockwise(drop_short_sides(simplify(q)))
+            q = clockwise(drop_short_sides(simplify(q, keep_area_frac=_KEEP_AREA)))
             qc = q.astype(np.float32).reshape(-1, 1, 2)
             own = frozenset(e for e in f.edges if cv2.pointPolygonTest(
                 qc, tuple(float(x) for x in 0.5 * (g.vertices[e[0]] + g.vertices[e[1]])), True) >= -2.0)
@@ -103,7 +107,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     # a face that contains another kept face is a region around it (table, wall), not an object face
     keep = [not any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
                     for j in range(len(cands))) for i in range(len(cands))]
-    cands = [c for c, k in zip(cands, keep) if k]
+    cands = _join_slivers([c for c, k in zip(cands, keep) if k], g.vertices, dist)
     cands += _thin_cands(cands, segs, dist, min_area_px)
     faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for p, e, s, a in cands]
     faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
@@ -117,6 +121,41 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     t3 = time.perf_counter()
     timings = {"edges": (t1 - t0) * 1e3, "segments": (t2 - t1) * 1e3, "faces": (t3 - t2) * 1e3}
     return RGBResult(faces, ordered, adjacency, timings, dist)
+
+
+def _join_slivers(cands: list, vertices: np.ndarray, dist: np.ndarray, max_width_px: float = 12.0,
+                  max_excess: float = 0.1, max_shared: float = 0.25) -> list:
+    """Candidates (polygon, graph edges, edge support, area) with each pair of thin ones (at most
+    ``max_width_px`` wide: twice the area over the perimeter) that share a graph edge and together make one
+    convex region (their hull at most ``max_excess`` above their summed area) joined into that region: the edge
+    between two faces, carried on across a face seen edge-on to the silhouette, cuts that sliver in two. Two
+    faces seen edge-on side by side share a long side instead and stay apart: the shared edges must be at most
+    ``max_shared`` of the shorter outline. A sliver traced with a slightly reflex corner and cut in two
+    (split.split_concave) is joined back the same way. ``vertices``: (V, 2) the graph's vertex pixels."""
+    def thin(c) -> bool:
+        return 2.0 * c[3] / perimeter(c[0]) <= max_width_px
+
+    out = list(cands)
+    i = 0
+    while i < len(out):
+        for j in range(i + 1, len(out)):
+            shared = out[i][1] & out[j][1]
+            if not shared or not thin(out[i]) or not thin(out[j]):
+                continue
+            # a made-up key (< 0) is the cut between two parts of one split outline: it adds no length
+            length = sum(float(np.hypot(*(vertices[a] - vertices[b]))) for a, b in shared if a >= 0)
+            if length > max_shared * min(perimeter(out[i][0]), perimeter(out[j][0])):
+                continue
+            hull = cv2.convexHull(np.concatenate([out[i][0], out[j][0]]).astype(np.float32)).reshape(-1, 2)
+            if area(hull) > (1.0 + max_excess) * (out[i][3] + out[j][3]):
+                continue
+            poly = clockwise(drop_short_sides(simplify(hull.astype(np.float64), keep_area_frac=_KEEP_AREA)))
+            out[i] = (poly, out[i][1] ^ out[j][1], edge_support(poly, dist), area(poly))
+            del out[j]
+            break
+        else:
+            i += 1
+    return out
 
 
 def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: float,

@@ -110,7 +110,8 @@ def split_by_diagonal(poly: np.ndarray, grad: np.ndarray, min_area_px: float, re
     line detector missed: a thin face merged with its neighbour makes a convex outline, so only the gradient
     can tell. The diagonal's mean gradient must exceed ``rel_interior`` times the 90th percentile of the
     gradient inside the face (texture, noise), ``min_strength``, and ``rel_boundary`` times the outline's.
-    Returns ``[poly]`` when no diagonal qualifies."""
+    Returns ``[poly]`` when no diagonal qualifies, or when the face is too thin to have an interior (a face seen
+    edge-on)."""
     p = np.asarray(poly, np.float64)
     n = len(p)
     if n < 4:
@@ -137,6 +138,7 @@ def split_by_diagonal(poly: np.ndarray, grad: np.ndarray, min_area_px: float, re
     cv2.line(m, tuple(int(x) for x in np.round(p[i] - [u0, v0])), tuple(int(x) for x in np.round(p[j] - [u0, v0])),
              0, 7)
     inner = grad[v0:v1, u0:u1][m.astype(bool)]
-    if inner.size and strength < rel_interior * float(np.percentile(inner, 90)):
+    # a sliver has no interior: its diagonals run so close to its sides that their gradient says nothing
+    if not inner.size or strength < rel_interior * float(np.percentile(inner, 90)):
         return [p]
     return [a, b]
