@@ -88,11 +88,14 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
                          f"{_pct(per['classes']['multiclass'])} | {per['folds_done']} | {per['errors']} |")
         if summ["tests"]:
             lines += ["", "Paired tests over (fold, class) cells of binary accuracy (a − b; ties dropped):", "",
-                      "| a | b | cells | mean diff (pts) | a wins | b wins | ties | sign p | Wilcoxon p |",
-                      "|---|---|---|---|---|---|---|---|---|"]
+                      "| a | b | cells | mean diff (pts) | 95% interval (bootstrap) | a wins | b wins | ties | sign p "
+                      "| Wilcoxon p |",
+                      "|---|---|---|---|---|---|---|---|---|---|"]
             for t in summ["tests"]:
                 sg = t["sign"]
-                lines.append(f"| {t['a']} | {t['b']} | {t['cells']} | {100 * t['mean_diff']:+.1f} | {sg['wins']} | "
+                lo, hi = t.get("ci95", (float("nan"), float("nan")))
+                lines.append(f"| {t['a']} | {t['b']} | {t['cells']} | {100 * t['mean_diff']:+.1f} | "
+                             f"{100 * lo:+.1f} to {100 * hi:+.1f} | {sg['wins']} | "
                              f"{sg['losses']} | {sg['ties']} | {sg['p']:.4g} | {t['wilcoxon']['p']:.4g} |")
         lines.append("")
     versions = sorted({v for summ in summaries.values() for per in summ["systems"].values() for v in per.get("code", [])})

@@ -1,9 +1,12 @@
 """Folds are stratified, seeded and disjoint; the paired tests give the textbook p-values."""
 
+import math
+
+import numpy as np
 import pytest
 
 from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stratified_folds
-from lv3d.experiment.stats import mean_std, paired, sign_test, wilcoxon_test
+from lv3d.experiment.stats import mean_diff_ci, mean_std, paired, sign_test, wilcoxon_test
 
 
 def _items(per_class=10, classes=("a", "b", "c", "d")):
@@ -54,6 +57,17 @@ def test_wilcoxon_known_p():
     r = wilcoxon_test([0.9, 0.8, 0.7, 0.95, 0.85], [0.8, 0.6, 0.4, 0.55, 0.35])
     assert r["n"] == 5 and r["p"] == pytest.approx(0.0625)
     assert wilcoxon_test([0.5, 0.5], [0.5, 0.5])["p"] == 1.0
+
+
+def test_mean_diff_ci_is_seeded_and_holds_the_mean():
+    rng = np.random.default_rng(3)
+    a, b = rng.uniform(0.6, 1.0, 20), rng.uniform(0.4, 0.8, 20)
+    lo, hi = mean_diff_ci(a, b)
+    assert lo < float(np.mean(a - b)) < hi and hi - lo < 0.3
+    assert mean_diff_ci(a, b) == (lo, hi)                      # the same seed, the same interval
+    assert mean_diff_ci(a, b, level=0.5)[0] > lo               # a lower level, a narrower interval
+    assert mean_diff_ci([0.9, 0.8], [0.8, 0.7]) == pytest.approx((0.1, 0.1))  # every cell differs alike
+    assert all(math.isnan(x) for x in mean_diff_ci([0.9], [0.8]))
 
 
 def test_paired_and_mean_std():
