@@ -3,6 +3,7 @@
     .venv/bin/python benchmarks/bench_grounding.py            # 6 scenes per class, realsense and hard
     .venv/bin/python benchmarks/bench_grounding.py --quick    # 2 per class
     .venv/bin/python benchmarks/bench_grounding.py --no-speed --out out/bench_grounding
+    .venv/bin/python benchmarks/bench_grounding.py --presets realsense --sources perceived --no-speed --bins acute,parallel
 
 Per preset (rgbd perception of the target object): median vertex error (px) of faces whose side count is
 right and median interior-dihedral error (deg) of truly adjacent faces, without and with refinement;
@@ -30,7 +31,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.calibration_error import chance_ece, ece  # noqa: E402
+from benchmarks.calibration_error import chance_ece, ece, reliability_bins  # noqa: E402
 from benchmarks.grounding_truth import match_faces, truth_labels, truth_quantities, truth_scene  # noqa: E402
 from lv3d.describe import MIN_CONF, ground  # noqa: E402
 from lv3d.perception import perceive  # noqa: E402
@@ -198,6 +199,8 @@ def main(argv=None) -> int:
     ap.add_argument("--speed-runs", type=int, default=3, help="measured speed processes (after one that warms the cache)")
     ap.add_argument("--sources", default="truth,perceived",
                     help="scenes from 'truth' (grounding alone) and/or 'perceived' (end to end)")
+    ap.add_argument("--bins", default="", help="fact types (comma-separated) whose reliability bins to print: "
+                    "facts, mean confidence and share true per tenth of confidence")
     a = ap.parse_args(argv)
     per_class = 2 if a.quick else a.per_class
     for preset, source in [(p, s) for s in a.sources.split(",") for p in a.presets.split(",")]:
@@ -216,6 +219,9 @@ def main(argv=None) -> int:
             e = ece(p, y)
             tgt = f"  (target <= {ECE_TARGET}: {'met' if e <= ECE_TARGET else 'NOT met'})" if preset == "realsense" else ""
             print(f"  ECE {pred:14s} {e:.3f}  n={len(p):4d}  chance {chance_ece(p):.3f}  mean conf {p.mean():.2f}  true {y.mean():.2f}{tgt}")
+            if pred in a.bins.split(","):
+                for lo, n, conf, true in reliability_bins(p, y):
+                    print(f"      [{lo:.1f}, {lo + 0.1:.1f})  n={n:4d}  conf {conf:.2f}  true {true:.2f}")
         if allp:
             p, y = np.array(allp).T
             print(f"  ECE all facts      {ece(p, y):.3f}  n={len(p)}")

@@ -16,6 +16,14 @@ def ece(p: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
     return float(sum(abs(p[idx == b].mean() - y[idx == b].mean()) * np.mean(idx == b) for b in range(bins) if np.any(idx == b)))
 
 
+def reliability_bins(p: np.ndarray, y: np.ndarray, bins: int = 10) -> list[tuple[float, int, float, float]]:
+    """The bins :func:`ece` sums over: (lower edge, facts, mean confidence, share true) of each non-empty one."""
+    p, y = np.asarray(p, float), np.asarray(y, float)
+    idx = np.minimum((p * bins).astype(int), bins - 1)
+    return [(b / bins, int(np.sum(idx == b)), float(p[idx == b].mean()), float(y[idx == b].mean()))
+            for b in range(bins) if np.any(idx == b)]
+
+
 def chance_ece(p: np.ndarray, bins: int = 10, draws: int = 400, seed: int = 0) -> float:
     """The ECE a perfectly calibrated fact type with these confidences shows on average by sampling alone
     (labels drawn from the confidences): an ECE near it cannot be told from perfect calibration on this
