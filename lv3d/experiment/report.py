@@ -93,7 +93,7 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
                       "|---|---|---|---|---|---|---|---|---|---|"]
             for t in summ["tests"]:
                 sg = t["sign"]
-                lo, hi = t.get("ci95", (float("nan"), float("nan")))
+                lo, hi = t["ci95"]
                 lines.append(f"| {t['a']} | {t['b']} | {t['cells']} | {100 * t['mean_diff']:+.1f} | "
                              f"{100 * lo:+.1f} to {100 * hi:+.1f} | {sg['wins']} | "
                              f"{sg['losses']} | {sg['ties']} | {sg['p']:.4g} | {t['wilcoxon']['p']:.4g} |")

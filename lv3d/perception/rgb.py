@@ -40,6 +40,12 @@ class RGBResult:
 _KEEP_AREA = 0.1
 
 
+def _outline(poly: np.ndarray) -> np.ndarray:
+    """A traced face's outline with only its corners, short sides dropped, clockwise; a corner holding more than
+    ``_KEEP_AREA`` of the face's area stays however little it turns (polygons.simplify)."""
+    return clockwise(drop_short_sides(simplify(poly, keep_area_frac=_KEEP_AREA)))
+
+
 def _touches_frame(poly: np.ndarray, box: tuple[int, int, int, int], tol: float = 3.0) -> float:
     """Fraction of the polygon's vertices within ``tol`` px of the box (u0, v0, u1, v1) border."""
     u0, v0, u1, v1 = box
@@ -82,7 +88,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         a = area(f.polygon)
         if a < min_area_px or a > max_area_frac * w * h:
             continue
-        poly = clockwise(drop_short_sides(simplify(f.polygon, keep_area_frac=_KEEP_AREA)))
+        poly = _outline(f.polygon)
         if len(poly) < 3 or not is_simple(poly) or area(poly) < min_area_px:
             continue
         if _touches_frame(poly, frame) > 0.5:
@@ -99,7 +105,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         # the cut is an edge the graph lacks: a shared made-up edge key makes the parts neighbours
         cut = (-1 - len(cands), -1 - len(cands))
         for q in pieces:
-            q = clockwise(drop_short_sides(simplify(q, keep_area_frac=_KEEP_AREA)))
+            q = _outline(q)
             qc = q.astype(np.float32).reshape(-1, 1, 2)
             own = frozenset(e for e in f.edges if cv2.pointPolygonTest(
                 qc, tuple(float(x) for x in 0.5 * (g.vertices[e[0]] + g.vertices[e[1]])), True) >= -2.0)
@@ -149,7 +155,7 @@ def _join_slivers(cands: list, vertices: np.ndarray, dist: np.ndarray, max_width
             hull = cv2.convexHull(np.concatenate([out[i][0], out[j][0]]).astype(np.float32)).reshape(-1, 2)
             if area(hull) > (1.0 + max_excess) * (out[i][3] + out[j][3]):
                 continue
-            poly = clockwise(drop_short_sides(simplify(hull.astype(np.float64), keep_area_frac=_KEEP_AREA)))
+            poly = _outline(hull.astype(np.float64))
             out[i] = (poly, out[i][1] ^ out[j][1], edge_support(poly, dist), area(poly))
             del out[j]
             break
