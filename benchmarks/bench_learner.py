@@ -64,7 +64,7 @@ class Data:
     pipeline answer has target None)."""
 
     def __init__(self, folder: Path, modality: str = "rgbd"):
-        self.folder = folder
+        self.folder, self.modality = folder, modality
         raw = pickle.loads((folder / f"facts_{modality}.pkl").read_bytes())
         man = json.loads((folder / "manifest.json").read_text())
         self.items = [Item(it["id"], it["class"], it["dir"]) for it in man["items"] if it["id"] in raw]
@@ -76,7 +76,7 @@ class Data:
         out = {}
         for n, it in enumerate(self.items):
             meta = json.loads((self.folder / it.dir / "meta.json").read_text())
-            out[it.id] = truth_facts(meta, it.id, "rgbd", perturb=p, seed=seed + n)
+            out[it.id] = truth_facts(meta, it.id, self.modality, perturb=p, seed=seed + n)
         return out
 
 
@@ -186,7 +186,7 @@ def main(argv=None) -> int:
     ap.add_argument("--few-shot", action="store_true",
                     help="realsense class tasks of 1, 2, 4 positives (1.5 negatives each, one of each other class at least) only")
     ap.add_argument("--modality", default="rgbd", choices=("rgbd", "depth"),
-                    help="--few-shot only: whose facts (depth: made with dev_facts.py --modalities rgbd,depth)")
+                    help="whose facts every row learns from (depth: made with dev_facts.py --modalities depth)")
     ap.add_argument("--settings", type=json.loads, default=None, help="learner settings (JSON) for every fit")
     a = ap.parse_args(argv)
     if a.seed == 0:
@@ -197,7 +197,7 @@ def main(argv=None) -> int:
             show(f"{positives}-shot realsense {a.modality}", evaluate(rs, rs.pipeline, positives=positives, npp=1.5, seed=a.seed,
                                                           multiclass=False, draws=draws, settings=a.settings))
         return 0
-    clean, rs = (Data(dev_set(a.root, p, a.seed, a.per_class)) for p in ("clean", "realsense"))
+    clean, rs = (Data(dev_set(a.root, p, a.seed, a.per_class), a.modality) for p in ("clean", "realsense"))
     print(f"dev sets {clean.folder} and {rs.folder}: {len(clean.items)} scenes each; without a target: "
           f"clean {sum(not _has(clean.pipeline[i.id]) for i in clean.items)}, "
           f"realsense {sum(not _has(rs.pipeline[i.id]) for i in rs.items)}", flush=True)
