@@ -10,14 +10,15 @@ from ..errors import InputError
 from ..facts import MODALITIES, face_id, object_id
 from ..rgbd import RGBD
 from ..scene import Face, Scene, SceneObject
+from .cloud import PointGrid
 from .depth import DepthObjectResult, DepthResult, depth_scene
 from .boundary import grid_to_pixels
 from .confirm import replace_unconfirmed, unconfirmed
-from .face_plane import angle_deg, fit_face_plane
+from .face_plane import angle_deg, fit_face_plane, polygon_cells
 from .fuse import match_faces
 from .holes import add_hole_faces
 from .plane_outline import simplify_on_plane
-from .polygons import area, rasterize
+from .polygons import area, perimeter, rasterize
 from .rgb import RGBFace, rgb_faces
 from .support import noise_threshold
 
@@ -153,6 +154,7 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         on_plane = [max((_inside(poly_px[i], q) for q in plane_px), default=0.0) for i in mine]
         claimed = set(match.values())
         piece: set[int] = set()  # colour faces on a plane another face has: kept only if merged into it
+        edge_on: set[int] = set()  # colour faces seen edge-on, their points dropped as flying: kept however small
         colour_px = np.zeros(shape, bool)
         for i in mine:
             colour_px |= poly_px[i]
@@ -176,6 +178,8 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
                     continue  # a patch of print or shadow on a plane that depth already has: not a face
                 if own is None:
                     face = Face("", f.polygon, "rgb", edge_support=f.edge_support)
+                    if _edge_on(f.polygon, frame.depth, dres.grid, obj_grown):
+                        edge_on.add(len(faces))
                 else:
                     (plane, pts, rms), absorbed, on_claimed = own
                     if on_claimed:
@@ -207,7 +211,7 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         pairs = {tuple(sorted((alias.get(a, a), alias.get(b, b)))) for a, b in pairs}
         pairs = {(a, b) for a, b in pairs if a != b}
         merged = set(alias) | set(alias.values())
-        keep = [i for i in _reliable(faces) if i not in alias and (i not in piece or i in merged)]
+        keep = [i for i in _reliable(faces, edge_on) if i not in alias and (i not in piece or i in merged)]
         keep, masks = _drop_covered(faces, keep, shape, off)
         keep += add_hole_faces(faces, pairs, keep, frame, box, grid_to_pixels(o.obj.mask, stride, box),
                                 res.edge_dist, masks=masks)
@@ -244,13 +248,41 @@ _MIN_COLOUR_ONLY_FRACTION = 0.12   # of the object's total face area (px), colou
 _MIN_DEPTH_ONLY_FRACTION = 0.05    # depth plane with no colour face
 
 
-def _reliable(faces: list[Face]) -> list[int]:
+def _reliable(faces: list[Face], exempt: set[int] = frozenset()) -> list[int]:
     """Indices of the faces to keep: every face seen by both sensors, a one-sensor face only when it is not
-    small beside the others (fractions of the summed polygon areas above)."""
+    small beside the others (fractions of the summed polygon areas above) or is in ``exempt``."""
     areas = [area(f.polygon) for f in faces]
     total = max(sum(areas), 1e-9)
     floor = {"rgb": _MIN_COLOUR_ONLY_FRACTION, "depth": _MIN_DEPTH_ONLY_FRACTION}
-    return [i for i, f in enumerate(faces) if areas[i] >= floor.get(f.provenance, 0.0) * total]
+    return [i for i, f in enumerate(faces) if i in exempt or areas[i] >= floor.get(f.provenance, 0.0) * total]
+
+
+# a colour face seen edge-on (see _edge_on): as wide as thin.py's slivers (under 2.5 px: a hairline between two
+# outlines), most of its cells read by the sensor and few of them kept as points
+_EDGE_ON_MIN_WIDTH_PX = 2.5
+_EDGE_ON_WIDTH_PX = 12.0
+_EDGE_ON_MIN_READ = 0.8
+_EDGE_ON_MAX_VALID = 0.2
+
+
+def _edge_on(poly: np.ndarray, depth: np.ndarray, grid: PointGrid, obj_grown: np.ndarray,
+             min_cells: int = 8) -> bool:
+    """True when colour face ``poly`` (n, 2) pixels is a face seen edge-on whose depth readings were all dropped
+    as flying points: a sliver ``_EDGE_ON_MIN_WIDTH_PX`` to ``_EDGE_ON_WIDTH_PX`` wide (twice its area over its
+    perimeter), on the object's grown cells (``obj_grown``), whose grid cells (``min_cells`` or more; the outline
+    shrunk by a pixel, as the outer ones hold its neighbours' points) have readings in ``depth`` (H, W) metres
+    but nearly no point in ``grid``: along a surface seen edge-on depth jumps from pixel to pixel, and cloud.py
+    drops such points. A sliver of print or shading on a face, or a stripe of table, keeps its points; a face
+    with no reading at all (a sensor's grazing-angle hole) is holes.py's."""
+    if not _EDGE_ON_MIN_WIDTH_PX <= 2.0 * area(poly) / perimeter(poly) <= _EDGE_ON_WIDTH_PX:
+        return False
+    cells = polygon_cells(poly, grid.shape, grid.stride, shrink_px=1)
+    if len(cells) < min_cells or np.mean(obj_grown[cells[:, 0], cells[:, 1]]) < 0.5:
+        return False
+    z = depth[cells[:, 0] * grid.stride, cells[:, 1] * grid.stride]
+    read = np.isfinite(z) & (z > 0)
+    return float(np.mean(read)) >= _EDGE_ON_MIN_READ and \
+        float(np.mean(grid.valid[cells[:, 0], cells[:, 1]])) <= _EDGE_ON_MAX_VALID
 
 
 # a colour face that depth segmentation missed is a face of its own when the points inside it fit a plane that

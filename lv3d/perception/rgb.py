@@ -114,7 +114,9 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     keep = [not any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
                     for j in range(len(cands))) for i in range(len(cands))]
     cands = _join_slivers([c for c, k in zip(cands, keep) if k], g.vertices, dist)
+    n_traced = len(cands)
     cands += _thin_cands(cands, segs, dist, min_area_px)
+    cands = _join_slivers(cands, g.vertices, dist, new_from=n_traced)
     faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for p, e, s, a in cands]
     faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
@@ -130,14 +132,20 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
 
 
 def _join_slivers(cands: list, vertices: np.ndarray, dist: np.ndarray, max_width_px: float = 12.0,
-                  max_excess: float = 0.1, max_shared: float = 0.25) -> list:
+                  max_excess: float = 0.1, max_shared: float = 0.25, new_from: int | None = None,
+                  touch_px: float = 1.5, min_touch_px: float = 5.0) -> list:
     """Candidates (polygon, graph edges, edge support, area) with each pair of thin ones (at most
     ``max_width_px`` wide: twice the area over the perimeter) that share a graph edge and together make one
     convex region (their hull at most ``max_excess`` above their summed area) joined into that region: the edge
     between two faces, carried on across a face seen edge-on to the silhouette, cuts that sliver in two. Two
     faces seen edge-on side by side share a long side instead and stay apart: the shared edges must be at most
     ``max_shared`` of the shorter outline. A sliver traced with a slightly reflex corner and cut in two
-    (split.split_concave) is joined back the same way. ``vertices``: (V, 2) the graph's vertex pixels."""
+    (split.split_concave) is joined back the same way. ``vertices``: (V, 2) the graph's vertex pixels.
+
+    With ``new_from``, only pairs with a candidate from that index on (thin.py's slivers) are looked at, and they
+    need no shared graph edge: their shared side is where one's outline runs within ``touch_px`` of the other's,
+    at least ``min_touch_px`` long (the thin pass closes the part of a sliver the graph left, beside the part it
+    traced)."""
     def thin(c) -> bool:
         return 2.0 * c[3] / perimeter(c[0]) <= max_width_px
 
@@ -145,11 +153,20 @@ def _join_slivers(cands: list, vertices: np.ndarray, dist: np.ndarray, max_width
     i = 0
     while i < len(out):
         for j in range(i + 1, len(out)):
-            shared = out[i][1] & out[j][1]
-            if not shared or not thin(out[i]) or not thin(out[j]):
+            if not thin(out[i]) or not thin(out[j]):
                 continue
-            # a made-up key (< 0) is the cut between two parts of one split outline: it adds no length
-            length = sum(float(np.hypot(*(vertices[a] - vertices[b]))) for a, b in shared if a >= 0)
+            if new_from is None:
+                shared = out[i][1] & out[j][1]
+                if not shared:
+                    continue
+                # a made-up key (< 0) is the cut between two parts of one split outline: it adds no length
+                length = sum(float(np.hypot(*(vertices[a] - vertices[b]))) for a, b in shared if a >= 0)
+            else:
+                if j < new_from:
+                    continue
+                length = _touch_length(out[i][0], out[j][0], touch_px)
+                if length < min_touch_px:
+                    continue
             if length > max_shared * min(perimeter(out[i][0]), perimeter(out[j][0])):
                 continue
             hull = cv2.convexHull(np.concatenate([out[i][0], out[j][0]]).astype(np.float32)).reshape(-1, 2)
@@ -162,6 +179,14 @@ def _join_slivers(cands: list, vertices: np.ndarray, dist: np.ndarray, max_width
         else:
             i += 1
     return out
+
+
+def _touch_length(a: np.ndarray, b: np.ndarray, tol_px: float) -> float:
+    """Length (px) of polygon ``a``'s outline lying within ``tol_px`` of polygon ``b``'s outline."""
+    outline = b.astype(np.float32).reshape(-1, 1, 2)
+    pts = sample_boundary(a, 1.0)
+    d = [abs(cv2.pointPolygonTest(outline, (float(x), float(y)), True)) for x, y in pts]
+    return float(np.count_nonzero(np.array(d) <= tol_px))
 
 
 def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: float,

@@ -79,3 +79,23 @@ def test_far_reach_needs_edge_pixels_all_along_the_extension():
     edges = (dist == 0).astype(np.uint8) * 255
     cv2.line(edges, (10, 85), (10, 95), 0, 1)  # a 10 px hole in the edge along the gap
     assert bounded_faces(build_graph(segs, edge_dist=edge_distance(edges))) == []
+
+
+def test_overlapping_pieces_of_one_side_meet_where_one_ends_beside_the_other():
+    # the left side as two pieces a degree apart, side by side for 20 px (LSD splits an edge where a sliver
+    # beside it converges on it): their lines cross far off, so only the end of one lying on the other joins them
+    segs = np.array([[13, 10, 97, 10], [100, 13, 100, 97], [97, 100, 13, 100],
+                     [10, 13, 11, 70], [10.5, 50, 10, 97]], float)
+    assert bounded_faces(build_graph(segs, overlap_px=0.0)) == []
+    faces = bounded_faces(build_graph(segs))
+    assert len(faces) == 1
+    from lv3d.perception.polygons import area
+
+    assert abs(area(faces[0].polygon) - 90 * 90) < 150
+
+
+def test_parallel_pieces_further_apart_than_the_overlap_tolerance_stay_apart():
+    # two parallel lines 3 px apart (the two sides of a sliver) must not be joined
+    segs = np.array([[13, 10, 97, 10], [100, 13, 100, 97], [97, 100, 13, 100],
+                     [10, 13, 10, 70], [13, 50, 13, 97]], float)
+    assert bounded_faces(build_graph(segs)) == []

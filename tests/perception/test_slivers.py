@@ -60,3 +60,20 @@ def test_join_slivers_joins_two_halves_but_not_two_strips_side_by_side():
     verts = np.zeros((12, 2))
     verts[10], verts[11] = [0.0, 4.0], [200.0, 4.0]
     assert len(_join_slivers(strips, verts, np.zeros((20, 220), np.float32))) == 2
+
+
+def test_a_thin_pass_sliver_joins_the_traced_part_it_touches_without_a_shared_graph_edge():
+    vertices = np.array([[0.0, 0.0], [200.0, 0.0], [100.0, 8.0], [100.0, -2.0]])
+    traced = clockwise(vertices[[0, 2, 3]])
+    closed = clockwise(vertices[[3, 2, 1]])     # from thin.py: its made-up key is no graph edge of the other
+    cands = [(traced, frozenset({(0, 2), (2, 3), (0, 3)}), 1.0, area(traced)),
+             (closed, frozenset({(-10_000, -10_000)}), 1.0, area(closed))]
+    dist = np.zeros((20, 220), np.float32)
+    assert len(_join_slivers(cands, vertices, dist)) == 2
+    joined = _join_slivers(cands, vertices, dist, new_from=1)
+    assert len(joined) == 1 and len(joined[0][0]) == 4
+    # two strips side by side along a 200 px side stay two faces
+    a = np.array([[0.0, 0.0], [200.0, 0.0], [200.0, 4.0], [0.0, 4.0]])
+    b = a + [0.0, 4.0]
+    strips = [(a, frozenset({(0, 1)}), 1.0, area(a)), (b, frozenset({(-10_000, -10_000)}), 1.0, area(b))]
+    assert len(_join_slivers(strips, vertices, dist, new_from=1)) == 2

@@ -1,0 +1,47 @@
+"""Colour faces seen edge-on whose depth points were dropped as flying (perceive._edge_on): kept in rgbd."""
+import numpy as np
+
+from lv3d.perception.cloud import PointGrid
+from lv3d.perception.perceive import _edge_on, _reliable
+from lv3d.scene import Face
+
+STRIP = np.array([[20.0, 10.0], [26.0, 10.0], [26.0, 90.0], [20.0, 90.0]])   # 6 px wide, 80 px long
+SQUARE = np.array([[40.0, 10.0], [80.0, 10.0], [80.0, 50.0], [40.0, 50.0]])  # 40 px wide
+DEPTH = np.full((100, 100), 1.0)                                              # every pixel read, metres
+OBJECT = np.ones((50, 50), bool)
+
+
+def _grid(points: np.ndarray) -> PointGrid:
+    """A 50 x 50 grid of stride 2 over the 100 x 100 px image, with points where ``points`` (50, 50) is True."""
+    xyz = np.zeros((50, 50, 3), np.float32)
+    xyz[..., 2] = 1.0
+    return PointGrid(xyz, np.zeros_like(xyz), points, 2)
+
+
+def _dropped_strip() -> np.ndarray:
+    points = np.ones((50, 50), bool)
+    points[:, 10:13] = False                  # pixels u = 20..25 read, their points dropped as flying
+    return points
+
+
+def test_a_sliver_read_but_without_points_on_the_object_is_seen_edge_on():
+    assert _edge_on(STRIP, DEPTH, _grid(_dropped_strip()), OBJECT)
+    assert not _edge_on(STRIP, DEPTH, _grid(np.ones((50, 50), bool)), OBJECT)   # points: print or shading
+    assert not _edge_on(STRIP, DEPTH, _grid(_dropped_strip()), ~OBJECT)         # off the object
+    unread = DEPTH.copy()
+    unread[:, 20:26] = 0.0                    # no reading at all: a sensor's grazing-angle hole (holes.py's)
+    assert not _edge_on(STRIP, unread, _grid(_dropped_strip()), OBJECT)
+
+
+def test_a_wide_face_or_a_hairline_is_not_a_face_seen_edge_on():
+    none = _grid(np.zeros((50, 50), bool))
+    assert not _edge_on(SQUARE, DEPTH, none, OBJECT)
+    hair = np.array([[20.0, 10.0], [21.5, 10.0], [21.5, 90.0], [20.0, 90.0]])
+    assert not _edge_on(hair, DEPTH, none, OBJECT)
+
+
+def test_the_colour_only_floor_spares_exempt_faces():
+    big = Face("", SQUARE * 4, "rgbd")
+    small = Face("", STRIP, "rgb")
+    assert _reliable([big, small]) == [0]
+    assert _reliable([big, small], {1}) == [0, 1]
