@@ -174,11 +174,13 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
             else:
                 own = _own_plane(f.polygon, o, dres, obj_grown, on_plane[a], plane_px, poly_px[i], claimed,
                                  seed=k)
-                if own is None and on_plane[a] >= 0.5:
+                if own is None and on_plane[a] >= 0.5 and not _sliver_on_bare_plane(f, poly_px[i], plane_px,
+                                                                                     claimed):
                     continue  # a patch of print or shadow on a plane that depth already has: not a face
                 if own is None:
                     face = Face("", f.polygon, "rgb", edge_support=f.edge_support)
-                    if _edge_on(f.polygon, frame.depth, dres.grid, obj_grown):
+                    # a sliver on such a plane (just tested), or one whose points were all dropped as flying
+                    if on_plane[a] >= 0.5 or _edge_on(f.polygon, frame.depth, dres.grid, obj_grown):
                         edge_on.add(len(faces))
                 else:
                     (plane, pts, rms), absorbed, on_claimed = own
@@ -283,6 +285,25 @@ def _edge_on(poly: np.ndarray, depth: np.ndarray, grid: PointGrid, obj_grown: np
     read = np.isfinite(z) & (z > 0)
     return float(np.mean(read)) >= _EDGE_ON_MIN_READ and \
         float(np.mean(grid.valid[cells[:, 0], cells[:, 1]])) <= _EDGE_ON_MAX_VALID
+
+
+# a sliver on a plane no colour face has: all its outline on image edges, and wider than a hairline (a traced
+# triangle's twice area over perimeter is a little under its width)
+_BARE_SLIVER_SUPPORT = 0.9
+_BARE_SLIVER_MIN_WIDTH_PX = 2.0
+
+
+def _sliver_on_bare_plane(f: RGBFace, poly_px: np.ndarray, plane_px: list[np.ndarray], claimed: set[int]) -> bool:
+    """True when colour face ``f``, with too few points for a plane of its own and lying on the
+    pixels of depth planes (``plane_px``, crop masks like ``poly_px``; ``claimed``: the indices of the planes
+    colour faces matched or absorbed), is a face seen edge-on that depth merged into a
+    neighbour, not print: a sliver (``_BARE_SLIVER_MIN_WIDTH_PX`` to ``_EDGE_ON_WIDTH_PX`` wide) whose outline is
+    nearly all on image edges, lying only on planes no colour face claimed (print is on a face colour found)."""
+    width = 2.0 * area(f.polygon) / perimeter(f.polygon)
+    if not _BARE_SLIVER_MIN_WIDTH_PX <= width <= _EDGE_ON_WIDTH_PX or f.edge_support < _BARE_SLIVER_SUPPORT:
+        return False
+    under = [j for j, q in enumerate(plane_px) if np.count_nonzero(poly_px & q)]
+    return bool(under) and not any(j in claimed for j in under)
 
 
 # a colour face that depth segmentation missed is a face of its own when the points inside it fit a plane that

@@ -2,7 +2,9 @@
 import numpy as np
 
 from lv3d.perception.cloud import PointGrid
-from lv3d.perception.perceive import _edge_on, _reliable
+from lv3d.perception.perceive import _edge_on, _reliable, _sliver_on_bare_plane
+from lv3d.perception.polygons import rasterize
+from lv3d.perception.rgb import RGBFace
 from lv3d.scene import Face
 
 STRIP = np.array([[20.0, 10.0], [26.0, 10.0], [26.0, 90.0], [20.0, 90.0]])   # 6 px wide, 80 px long
@@ -45,3 +47,15 @@ def test_the_colour_only_floor_spares_exempt_faces():
     small = Face("", STRIP, "rgb")
     assert _reliable([big, small]) == [0]
     assert _reliable([big, small], {1}) == [0, 1]
+
+
+def test_a_sliver_on_a_plane_no_colour_face_has_is_a_face_not_print():
+    strip_px = rasterize(STRIP, (100, 100))
+    plane_px = [rasterize(SQUARE, (100, 100)), rasterize(STRIP * [1.0, 1.0] + [-2.0, 0.0], (100, 100))]
+    sliver = RGBFace(STRIP, frozenset(), 0.95, 480.0)
+    assert _sliver_on_bare_plane(sliver, strip_px, plane_px, claimed={0})      # the plane under it: unclaimed
+    assert not _sliver_on_bare_plane(sliver, strip_px, plane_px, claimed={1})  # a colour face has it: print
+    weak = RGBFace(STRIP, frozenset(), 0.7, 480.0)                             # outline off the image edges
+    assert not _sliver_on_bare_plane(weak, strip_px, plane_px, claimed=set())
+    wide = RGBFace(SQUARE, frozenset(), 0.95, 1600.0)
+    assert not _sliver_on_bare_plane(wide, rasterize(SQUARE, (100, 100)), plane_px, claimed={1})
