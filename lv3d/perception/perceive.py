@@ -10,15 +10,15 @@ from ..errors import InputError
 from ..facts import MODALITIES, face_id, object_id
 from ..rgbd import RGBD
 from ..scene import Face, Scene, SceneObject
-from .cloud import PointGrid
 from .depth import DepthObjectResult, DepthResult, depth_scene
+from .edge_on import on_unclaimed_plane, points_dropped
 from .boundary import grid_to_pixels
 from .confirm import replace_unconfirmed, unconfirmed
-from .face_plane import angle_deg, fit_face_plane, polygon_cells
+from .face_plane import angle_deg, fit_face_plane
 from .fuse import match_faces
 from .holes import add_hole_faces
 from .plane_outline import simplify_on_plane
-from .polygons import area, perimeter, rasterize
+from .polygons import area, rasterize
 from .rgb import RGBFace, rgb_faces
 from .support import noise_threshold
 
@@ -174,13 +174,12 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
             else:
                 own = _own_plane(f.polygon, o, dres, obj_grown, on_plane[a], plane_px, poly_px[i], claimed,
                                  seed=k)
-                if own is None and on_plane[a] >= 0.5 and not _sliver_on_bare_plane(f, poly_px[i], plane_px,
-                                                                                     claimed):
+                if own is None and on_plane[a] >= 0.5 and not on_unclaimed_plane(f, poly_px[i], plane_px, claimed):
                     continue  # a patch of print or shadow on a plane that depth already has: not a face
                 if own is None:
                     face = Face("", f.polygon, "rgb", edge_support=f.edge_support)
                     # a sliver on such a plane (just tested), or one whose points were all dropped as flying
-                    if on_plane[a] >= 0.5 or _edge_on(f.polygon, frame.depth, dres.grid, obj_grown):
+                    if on_plane[a] >= 0.5 or points_dropped(f.polygon, frame.depth, dres.grid, obj_grown):
                         edge_on.add(len(faces))
                 else:
                     (plane, pts, rms), absorbed, on_claimed = own
@@ -257,53 +256,6 @@ def _reliable(faces: list[Face], exempt: set[int] = frozenset()) -> list[int]:
     total = max(sum(areas), 1e-9)
     floor = {"rgb": _MIN_COLOUR_ONLY_FRACTION, "depth": _MIN_DEPTH_ONLY_FRACTION}
     return [i for i, f in enumerate(faces) if i in exempt or areas[i] >= floor.get(f.provenance, 0.0) * total]
-
-
-# a colour face seen edge-on (see _edge_on): as wide as thin.py's slivers (under 2.5 px: a hairline between two
-# outlines), most of its cells read by the sensor and few of them kept as points
-_EDGE_ON_MIN_WIDTH_PX = 2.5
-_EDGE_ON_WIDTH_PX = 12.0
-_EDGE_ON_MIN_READ = 0.8
-_EDGE_ON_MAX_VALID = 0.2
-
-
-def _edge_on(poly: np.ndarray, depth: np.ndarray, grid: PointGrid, obj_grown: np.ndarray,
-             min_cells: int = 8) -> bool:
-    """True when colour face ``poly`` (n, 2) pixels is a face seen edge-on whose depth readings were all dropped
-    as flying points: a sliver ``_EDGE_ON_MIN_WIDTH_PX`` to ``_EDGE_ON_WIDTH_PX`` wide (twice its area over its
-    perimeter), on the object's grown cells (``obj_grown``), whose grid cells (``min_cells`` or more; the outline
-    shrunk by a pixel, as the outer ones hold its neighbours' points) have readings in ``depth`` (H, W) metres
-    but nearly no point in ``grid``: along a surface seen edge-on depth jumps from pixel to pixel, and cloud.py
-    drops such points. A sliver of print or shading on a face, or a stripe of table, keeps its points; a face
-    with no reading at all (a sensor's grazing-angle hole) is holes.py's."""
-    if not _EDGE_ON_MIN_WIDTH_PX <= 2.0 * area(poly) / perimeter(poly) <= _EDGE_ON_WIDTH_PX:
-        return False
-    cells = polygon_cells(poly, grid.shape, grid.stride, shrink_px=1)
-    if len(cells) < min_cells or np.mean(obj_grown[cells[:, 0], cells[:, 1]]) < 0.5:
-        return False
-    z = depth[cells[:, 0] * grid.stride, cells[:, 1] * grid.stride]
-    read = np.isfinite(z) & (z > 0)
-    return float(np.mean(read)) >= _EDGE_ON_MIN_READ and \
-        float(np.mean(grid.valid[cells[:, 0], cells[:, 1]])) <= _EDGE_ON_MAX_VALID
-
-
-# a sliver on a plane no colour face has: all its outline on image edges, and wider than a hairline (a traced
-# triangle's twice area over perimeter is a little under its width)
-_BARE_SLIVER_SUPPORT = 0.9
-_BARE_SLIVER_MIN_WIDTH_PX = 2.0
-
-
-def _sliver_on_bare_plane(f: RGBFace, poly_px: np.ndarray, plane_px: list[np.ndarray], claimed: set[int]) -> bool:
-    """True when colour face ``f``, with too few points for a plane of its own and lying on the
-    pixels of depth planes (``plane_px``, crop masks like ``poly_px``; ``claimed``: the indices of the planes
-    colour faces matched or absorbed), is a face seen edge-on that depth merged into a
-    neighbour, not print: a sliver (``_BARE_SLIVER_MIN_WIDTH_PX`` to ``_EDGE_ON_WIDTH_PX`` wide) whose outline is
-    nearly all on image edges, lying only on planes no colour face claimed (print is on a face colour found)."""
-    width = 2.0 * area(f.polygon) / perimeter(f.polygon)
-    if not _BARE_SLIVER_MIN_WIDTH_PX <= width <= _EDGE_ON_WIDTH_PX or f.edge_support < _BARE_SLIVER_SUPPORT:
-        return False
-    under = [j for j, q in enumerate(plane_px) if np.count_nonzero(poly_px & q)]
-    return bool(under) and not any(j in claimed for j in under)
 
 
 # a colour face that depth segmentation missed is a face of its own when the points inside it fit a plane that

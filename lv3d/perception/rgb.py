@@ -10,7 +10,7 @@ import numpy as np
 
 from .edges import channels, edge_distance, edge_support, edges_and_gradient
 from .faces import bounded_faces, build_graph
-from .polygons import area, clockwise, drop_short_sides, is_simple, perimeter, sample_boundary, simplify
+from .polygons import area, clockwise, drop_short_sides, is_simple, mean_width, perimeter, sample_boundary, simplify
 from .segments import detect_color_segments, union_find_labels
 from .split import split_by_diagonal, split_concave
 from .thin import thin_faces
@@ -147,7 +147,7 @@ def _join_slivers(cands: list, vertices: np.ndarray, dist: np.ndarray, max_width
     at least ``min_touch_px`` long (the thin pass closes the part of a sliver the graph left, beside the part it
     traced)."""
     def thin(c) -> bool:
-        return 2.0 * c[3] / perimeter(c[0]) <= max_width_px
+        return mean_width(c[0], c[3]) <= max_width_px
 
     out = list(cands)
     i = 0

@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 from .edges import edge_distance, edge_support
-from .polygons import (area, clockwise, distance_to_segments, is_simple, perimeter, pixel_values, rasterize,
+from .polygons import (area, clockwise, distance_to_segments, is_simple, mean_width, pixel_values, rasterize,
                        sample_boundary)
 
 
@@ -144,7 +144,7 @@ def thin_faces(segs: np.ndarray, dist: np.ndarray, found: list[np.ndarray], min_
         keep = [k for k in range(len(hull)) if np.hypot(*(hull[k] - hull[k - 1])) > 2.0]
         poly = clockwise(hull[keep])
         if len(poly) < 3 or area(poly) < min_area_px or not is_simple(poly) \
-                or 2.0 * area(poly) / perimeter(poly) > max_width_px:
+                or mean_width(poly) > max_width_px:
             continue
         if not _sides_seen(poly, line, segs, to_found, min_on_edge, min_inner):
             continue

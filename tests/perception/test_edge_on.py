@@ -1,8 +1,9 @@
-"""Colour faces seen edge-on whose depth points were dropped as flying (perceive._edge_on): kept in rgbd."""
+"""Colour faces seen edge-on whose depth points were dropped as flying (edge_on.points_dropped): kept in rgbd."""
 import numpy as np
 
 from lv3d.perception.cloud import PointGrid
-from lv3d.perception.perceive import _edge_on, _reliable, _sliver_on_bare_plane
+from lv3d.perception.edge_on import on_unclaimed_plane, points_dropped
+from lv3d.perception.perceive import _reliable
 from lv3d.perception.polygons import rasterize
 from lv3d.perception.rgb import RGBFace
 from lv3d.scene import Face
@@ -27,19 +28,19 @@ def _dropped_strip() -> np.ndarray:
 
 
 def test_a_sliver_read_but_without_points_on_the_object_is_seen_edge_on():
-    assert _edge_on(STRIP, DEPTH, _grid(_dropped_strip()), OBJECT)
-    assert not _edge_on(STRIP, DEPTH, _grid(np.ones((50, 50), bool)), OBJECT)   # points: print or shading
-    assert not _edge_on(STRIP, DEPTH, _grid(_dropped_strip()), ~OBJECT)         # off the object
+    assert points_dropped(STRIP, DEPTH, _grid(_dropped_strip()), OBJECT)
+    assert not points_dropped(STRIP, DEPTH, _grid(np.ones((50, 50), bool)), OBJECT)   # points: print or shading
+    assert not points_dropped(STRIP, DEPTH, _grid(_dropped_strip()), ~OBJECT)         # off the object
     unread = DEPTH.copy()
     unread[:, 20:26] = 0.0                    # no reading at all: a sensor's grazing-angle hole (holes.py's)
-    assert not _edge_on(STRIP, unread, _grid(_dropped_strip()), OBJECT)
+    assert not points_dropped(STRIP, unread, _grid(_dropped_strip()), OBJECT)
 
 
-def test_a_wide_face_or_a_hairline_is_not_a_face_seen_edge_on():
+def test_a_wide_face_or_a_hairline_is_not_a_face_seenpoints_dropped():
     none = _grid(np.zeros((50, 50), bool))
-    assert not _edge_on(SQUARE, DEPTH, none, OBJECT)
+    assert not points_dropped(SQUARE, DEPTH, none, OBJECT)
     hair = np.array([[20.0, 10.0], [21.5, 10.0], [21.5, 90.0], [20.0, 90.0]])
-    assert not _edge_on(hair, DEPTH, none, OBJECT)
+    assert not points_dropped(hair, DEPTH, none, OBJECT)
 
 
 def test_the_colour_only_floor_spares_exempt_faces():
@@ -53,9 +54,9 @@ def test_a_sliver_on_a_plane_no_colour_face_has_is_a_face_not_print():
     strip_px = rasterize(STRIP, (100, 100))
     plane_px = [rasterize(SQUARE, (100, 100)), rasterize(STRIP * [1.0, 1.0] + [-2.0, 0.0], (100, 100))]
     sliver = RGBFace(STRIP, frozenset(), 0.95, 480.0)
-    assert _sliver_on_bare_plane(sliver, strip_px, plane_px, claimed={0})      # the plane under it: unclaimed
-    assert not _sliver_on_bare_plane(sliver, strip_px, plane_px, claimed={1})  # a colour face has it: print
+    assert on_unclaimed_plane(sliver, strip_px, plane_px, claimed={0})      # the plane under it: unclaimed
+    assert not on_unclaimed_plane(sliver, strip_px, plane_px, claimed={1})  # a colour face has it: print
     weak = RGBFace(STRIP, frozenset(), 0.7, 480.0)                             # outline off the image edges
-    assert not _sliver_on_bare_plane(weak, strip_px, plane_px, claimed=set())
+    assert not on_unclaimed_plane(weak, strip_px, plane_px, claimed=set())
     wide = RGBFace(SQUARE, frozenset(), 0.95, 1600.0)
-    assert not _sliver_on_bare_plane(wide, rasterize(SQUARE, (100, 100)), plane_px, claimed={1})
+    assert not on_unclaimed_plane(wide, rasterize(SQUARE, (100, 100)), plane_px, claimed={1})
