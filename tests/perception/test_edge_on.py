@@ -1,4 +1,5 @@
-"""Colour faces seen edge-on whose depth points were dropped as flying (edge_on.points_dropped): kept in rgbd."""
+"""Colour faces seen edge-on that rgbd fusion keeps without a plane of their own (perception/edge_on.py): points
+dropped as flying, or a sliver on a depth plane no colour face claimed."""
 import numpy as np
 
 from lv3d.perception.cloud import PointGrid
