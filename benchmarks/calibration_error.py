@@ -9,11 +9,9 @@ import numpy as np
 def ece(p: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
     """Expected calibration error: sum over equal-width confidence bins of |mean confidence - share true| *
     share of facts in the bin. ``p`` (n,) confidences in [0, 1]; ``y`` (n,) truth as 0/1 or bool."""
-    p, y = np.asarray(p, float), np.asarray(y, float)
     if len(p) == 0:
         return float("nan")
-    idx = np.minimum((p * bins).astype(int), bins - 1)
-    return float(sum(abs(p[idx == b].mean() - y[idx == b].mean()) * np.mean(idx == b) for b in range(bins) if np.any(idx == b)))
+    return float(sum(abs(conf - true) * n / len(p) for _, n, conf, true in reliability_bins(p, y, bins)))
 
 
 def reliability_bins(p: np.ndarray, y: np.ndarray, bins: int = 10) -> list[tuple[float, int, float, float]]:
