@@ -154,7 +154,9 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         on_plane = [max((_inside(poly_px[i], q) for q in plane_px), default=0.0) for i in mine]
         claimed = set(match.values())
         piece: set[int] = set()  # colour faces on a plane another face has: kept only if merged into it
-        edge_on: set[int] = set()  # colour faces seen edge-on, their points dropped as flying: kept however small
+        # colour faces seen edge-on (edge_on.py): their points dropped as flying, or on a plane depth merged into a
+        # neighbour's; kept however small
+        edge_on: set[int] = set()
         colour_px = np.zeros(shape, bool)
         for i in mine:
             colour_px |= poly_px[i]

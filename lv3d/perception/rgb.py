@@ -10,7 +10,8 @@ import numpy as np
 
 from .edges import channels, edge_distance, edge_support, edges_and_gradient
 from .faces import bounded_faces, build_graph
-from .polygons import area, clockwise, drop_short_sides, is_simple, mean_width, perimeter, sample_boundary, simplify
+from .polygons import (area, clockwise, distance_to_segments, drop_short_sides, is_simple, mean_width, perimeter,
+                       sample_boundary, simplify)
 from .segments import detect_color_segments, union_find_labels
 from .split import split_by_diagonal, split_concave
 from .thin import thin_faces
@@ -84,6 +85,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     cw, ch = u1 - u0, v1 - v0
     frame = (0, 0, cw - 1, ch - 1)
     cands = []
+    image_cuts = set()  # made-up keys of cuts along an image edge (split_by_diagonal): never joined back
     for f in bounded_faces(g):
         a = area(f.polygon)
         if a < min_area_px or a > max_area_frac * w * h:
@@ -97,13 +99,16 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         if sup < min_support:
             continue
         pieces = split_concave(poly, grad, min_area_px)
-        if len(pieces) == 1:
+        by_gradient = len(pieces) == 1
+        if by_gradient:
             pieces = split_by_diagonal(poly, grad, min_area_px)
         if len(pieces) == 1:
             cands.append((poly, f.edges, sup, area(poly)))
             continue
         # the cut is an edge the graph lacks: a shared made-up edge key makes the parts neighbours
         cut = (-1 - len(cands), -1 - len(cands))
+        if by_gradient:
+            image_cuts.add(cut)
         for q in pieces:
             q = _outline(q)
             qc = q.astype(np.float32).reshape(-1, 1, 2)
@@ -113,10 +118,10 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     # a face that contains another kept face is a region around it (table, wall), not an object face
     keep = [not any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
                     for j in range(len(cands))) for i in range(len(cands))]
-    cands = _join_slivers([c for c, k in zip(cands, keep) if k], g.vertices, dist)
+    cands = _join_on_graph_edges([c for c, k in zip(cands, keep) if k], g.vertices, dist, image_cuts)
     n_traced = len(cands)
     cands += _thin_cands(cands, segs, dist, min_area_px)
-    cands = _join_slivers(cands, g.vertices, dist, new_from=n_traced)
+    cands = _join_thin_to_traced(cands, n_traced, dist)
     faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for p, e, s, a in cands]
     faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
@@ -131,50 +136,72 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     return RGBResult(faces, ordered, adjacency, timings, dist)
 
 
-def _join_slivers(cands: list, vertices: np.ndarray, dist: np.ndarray, max_width_px: float = 12.0,
-                  max_excess: float = 0.1, max_shared: float = 0.25, new_from: int | None = None,
-                  touch_px: float = 1.5, min_touch_px: float = 5.0) -> list:
-    """Candidates (polygon, graph edges, edge support, area) with each pair of thin ones (at most
-    ``max_width_px`` wide: twice the area over the perimeter) that share a graph edge and together make one
-    convex region (their hull at most ``max_excess`` above their summed area) joined into that region: the edge
-    between two faces, carried on across a face seen edge-on to the silhouette, cuts that sliver in two. Two
-    faces seen edge-on side by side share a long side instead and stay apart: the shared edges must be at most
-    ``max_shared`` of the shorter outline. A sliver traced with a slightly reflex corner and cut in two
-    (split.split_concave) is joined back the same way. ``vertices``: (V, 2) the graph's vertex pixels.
+def _join_on_graph_edges(cands: list, vertices: np.ndarray, dist: np.ndarray,
+                         image_cuts: frozenset | set = frozenset(), min_aspect: float = 3.0) -> list:
+    """Candidates (polygon, graph edges, edge support, area) with each pair of thin ones that share a graph edge
+    and make one convex region joined (``_join_thin_pairs``): the edge between two faces, carried on across a face
+    seen edge-on to the silhouette, cuts that sliver in two, and a sliver traced with a slightly reflex corner is
+    cut in two by split.split_concave. ``vertices``: (V, 2) the graph's vertex pixels. Parts sharing a key of
+    ``image_cuts`` (a cut split.split_by_diagonal made where the image has an edge) are joined only when together
+    they are long, their minimum-area rectangle at least ``min_aspect`` times as long as wide: a sliver's diagonal
+    runs so close to its long sides that it picks up their gradient, while two small faces, such as a far
+    pyramid's, are thin by the width measure too and the edge between them is real."""
+    def shared_length(out: list, i: int, j: int) -> float | None:
+        shared = out[i][1] & out[j][1]
+        if not shared:
+            return None
+        if shared & image_cuts:
+            size = cv2.minAreaRect(np.concatenate([out[i][0], out[j][0]]).astype(np.float32))[1]
+            if max(size) < min_aspect * min(size):
+                return None
+        # a made-up key (< 0) is the cut between two parts of one split outline: it adds no length
+        return sum(float(np.hypot(*(vertices[a] - vertices[b]))) for a, b in shared if a >= 0)
 
-    With ``new_from``, only pairs with a candidate from that index on (thin.py's slivers) are looked at, and they
-    need no shared graph edge: their shared side is where one's outline runs within ``touch_px`` of the other's,
-    at least ``min_touch_px`` long (the thin pass closes the part of a sliver the graph left, beside the part it
-    traced)."""
-    def thin(c) -> bool:
-        return mean_width(c[0], c[3]) <= max_width_px
+    return _join_thin_pairs(cands, dist, shared_length)
 
+
+def _join_thin_to_traced(cands: list, new_from: int, dist: np.ndarray, touch_px: float = 1.5,
+                         min_touch_px: float = 5.0) -> list:
+    """Candidates with each thin one from index ``new_from`` on (thin.py's slivers) joined to a thin candidate it
+    touches where together they make one convex region (``_join_thin_pairs``): the thin pass closes the part of a
+    sliver the graph left, beside the part it traced, with no graph edge in common. Their shared side is where
+    one's outline runs within ``touch_px`` of the other's, at least ``min_touch_px`` long."""
+    def touch_length(out: list, i: int, j: int) -> float | None:
+        if j < new_from:
+            return None
+        length = _touch_length(out[i][0], out[j][0], touch_px)
+        return length if length >= min_touch_px else None
+
+    return _join_thin_pairs(cands, dist, touch_length)
+
+
+def _join_thin_pairs(cands: list, dist: np.ndarray, shared_length, max_width_px: float = 12.0,
+                     max_excess: float = 0.1, max_shared: float = 0.25) -> list:
+    """Candidates (polygon, graph edges, edge support, area) with each pair of thin ones (at most ``max_width_px``
+    wide: twice the area over the perimeter) that touch and together make one convex region (their hull at most
+    ``max_excess`` above their summed area) joined into that region. ``shared_length(out, i, j)``, for i < j
+    indices into the current list, is the length (px) of the side they share, or None where they do not touch.
+    Two faces seen edge-on side by side share a long side instead and stay apart: the shared side must be at most
+    ``max_shared`` of the shorter outline."""
     out = list(cands)
+    # each candidate's perimeter and thinness, measured once; a joined pair's replace the first's
+    per = [perimeter(c[0]) for c in out]
+    thin = [mean_width(c[0], c[3]) <= max_width_px for c in out]
     i = 0
     while i < len(out):
         for j in range(i + 1, len(out)):
-            if not thin(out[i]) or not thin(out[j]):
+            if not thin[i] or not thin[j]:
                 continue
-            if new_from is None:
-                shared = out[i][1] & out[j][1]
-                if not shared:
-                    continue
-                # a made-up key (< 0) is the cut between two parts of one split outline: it adds no length
-                length = sum(float(np.hypot(*(vertices[a] - vertices[b]))) for a, b in shared if a >= 0)
-            else:
-                if j < new_from:
-                    continue
-                length = _touch_length(out[i][0], out[j][0], touch_px)
-                if length < min_touch_px:
-                    continue
-            if length > max_shared * min(perimeter(out[i][0]), perimeter(out[j][0])):
+            length = shared_length(out, i, j)
+            if length is None or length > max_shared * min(per[i], per[j]):
                 continue
             hull = cv2.convexHull(np.concatenate([out[i][0], out[j][0]]).astype(np.float32)).reshape(-1, 2)
             if area(hull) > (1.0 + max_excess) * (out[i][3] + out[j][3]):
                 continue
             poly = _outline(hull.astype(np.float64))
             out[i] = (poly, out[i][1] ^ out[j][1], edge_support(poly, dist), area(poly))
-            del out[j]
+            per[i], thin[i] = perimeter(poly), mean_width(poly, out[i][3]) <= max_width_px
+            del out[j], per[j], thin[j]
             break
         else:
             i += 1
@@ -183,10 +210,14 @@ def _join_slivers(cands: list, vertices: np.ndarray, dist: np.ndarray, max_width
 
 def _touch_length(a: np.ndarray, b: np.ndarray, tol_px: float) -> float:
     """Length (px) of polygon ``a``'s outline lying within ``tol_px`` of polygon ``b``'s outline."""
-    outline = b.astype(np.float32).reshape(-1, 1, 2)
-    pts = sample_boundary(a, 1.0)
-    d = [abs(cv2.pointPolygonTest(outline, (float(x), float(y)), True)) for x, y in pts]
-    return float(np.count_nonzero(np.array(d) <= tol_px))
+    d = _outline_distance(sample_boundary(a, 1.0), b)
+    return float(np.count_nonzero(d <= tol_px))
+
+
+def _outline_distance(pts: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """Distance (m,) in px from each of ``pts`` (m, 2) to the closed outline of ``poly`` (n, 2)."""
+    p = np.asarray(poly, dtype=np.float64)
+    return distance_to_segments(pts, p, np.roll(p, -1, axis=0) - p)
 
 
 def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: float,
@@ -198,9 +229,7 @@ def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: fl
         key = (-10_000 - k, -10_000 - k)
         pts = sample_boundary(q, 1.0)
         for n, c in enumerate(cands):
-            outline = c[0].astype(np.float32).reshape(-1, 1, 2)
-            d = np.abs([cv2.pointPolygonTest(outline, (float(x), float(y)), True) for x, y in pts])
-            if np.mean(d <= touch_px) >= 0.15:
+            if np.mean(_outline_distance(pts, c[0]) <= touch_px) >= 0.15:
                 cands[n] = (c[0], c[1] | {key}, c[2], c[3])
         out.append((q, frozenset({key}), edge_support(q, dist), area(q)))
     return out
