@@ -2,7 +2,8 @@ import cv2
 import numpy as np
 
 from lv3d.perception.polygons import area, drop_short_sides
-from lv3d.perception.split import gradient_magnitude, reflex_corners, split_by_diagonal, split_concave
+from lv3d.perception.split import (_diagonal_strengths, gradient_magnitude, reflex_corners, split_by_diagonal,
+                                   split_concave)
 
 
 def _image(polys_colours, shape=(200, 200), background=90):
@@ -32,6 +33,21 @@ def test_a_convex_outline_splits_only_where_the_image_has_an_edge():
     assert len(split_by_diagonal(quad, faint, min_area_px=100.0)) == 2
     flat = gradient_magnitude(_image([(quad, (200, 60, 60))]))
     assert len(split_by_diagonal(quad, flat, min_area_px=100.0)) == 1
+
+
+def test_a_faint_edge_under_sensor_noise_is_cut_and_noise_alone_is_not():
+    # two faces 14 grey levels apart under Gaussian sensor noise (sigma 4 levels, as the realsense preset), lightly
+    # blurred as edges.channels does: the diagonal's mean gradient is about twice the interior's 90th percentile
+    quad = np.array([[40.0, 40.0], [160.0, 40.0], [160.0, 160.0], [40.0, 160.0]])
+    tri = np.array([[40.0, 40.0], [160.0, 160.0], [40.0, 160.0]])
+    rng = np.random.default_rng(3)
+    for lower, cuts in ((186, 2), (200, 1)):
+        img = np.full((200, 200, 3), 90.0)
+        cv2.fillPoly(img, [quad.astype(np.int32)], (200, 60, 60))
+        cv2.fillPoly(img, [tri.astype(np.int32)], (lower, 60, 60))
+        noisy = cv2.GaussianBlur(np.clip(img + rng.normal(0.0, 4.0, img.shape), 0, 255).astype(np.uint8), (3, 3), 0)
+        grad = gradient_magnitude([np.ascontiguousarray(noisy[:, :, c]) for c in range(3)])
+        assert len(split_by_diagonal(quad, grad, min_area_px=100.0)) == cuts
 
 
 def test_a_corner_traced_as_two_goes_back_to_one():
@@ -66,3 +82,16 @@ def test_a_diagonal_running_close_along_the_outline_is_not_taken_for_an_edge():
     grad = gradient_magnitude(_image([(below, (225, 195, 245)), (hexagon, (230, 200, 250))], shape=(300, 400),
                                      background=20))
     assert len(split_by_diagonal(hexagon, grad, min_area_px=150.0)) == 1
+
+
+def test_a_diagonal_within_a_blurred_edge_of_the_outline_has_no_strength_measured_clear_of_it():
+    # the diagonal from corner 0 to corner 2 passes 1.9 px from corner 1: all along it lies within 2.5 px of the
+    # outline, inside the blurred silhouette edge (sigma 1 px); measured 1 px clear it picks up that edge, which
+    # is why split_by_diagonal's fainter test measures 2.5 px clear
+    poly = np.array([[20.0, 60.0], [70.0, 38.0], [120.0, 20.0], [130.0, 90.0], [30.0, 100.0]])
+    img = np.full((130, 160), 60.0)
+    cv2.fillPoly(img, [np.round(poly).astype(np.int32)], 160)
+    grad = gradient_magnitude([cv2.GaussianBlur(img, (0, 0), 1.0).astype(np.uint8)])
+    shallow, across = _diagonal_strengths(poly, [(0, 2), (1, 3)], grad, clear_px=2.5)
+    assert shallow == 0.0 and across < 5.0
+    assert _diagonal_strengths(poly, [(0, 2)], grad, clear_px=1.0)[0] > 50.0
