@@ -167,8 +167,10 @@ def fit_final(oof: dict, seed: int = 0) -> tuple[dict, dict]:
             cands["own"] = np.empty(len(c))
         for k in range(5):
             te = f == k
+            if not te.any():  # a rare type (depth parallel: 8 rows in session 9) may miss a fold
+                continue
             cands["pooled"][te] = pooled[k].predict(c[te])
-            if "own" in cands and te.any():
+            if "own" in cands:
                 cands["own"][te] = _isotonic(c[~te], t[~te]).predict(c[te])
         losses[pred] = {name: _logloss(v, t) for name, v in cands.items()}
         best = min(losses[pred], key=losses[pred].get)

@@ -1,0 +1,64 @@
+import numpy as np
+
+from lv3d.perception.planes import DepthPlane, merge_strips
+from lv3d.perception.support import refine
+from lv3d.plane import Plane
+
+
+def _piece(mask: np.ndarray, depth_of_cell, rng: np.random.Generator, sigma_m: float = 0.002,
+           plane: Plane | None = None) -> DepthPlane:
+    """A DepthPlane of the cells of ``mask`` (rows i, columns j; 2 mm per cell) at depth ``depth_of_cell(i, j)``
+    (metres) plus Gaussian noise; its plane is ``plane`` or the least-squares fit."""
+    i, j = np.nonzero(mask)
+    pts = np.stack([j * 0.002, i * 0.002, depth_of_cell(i, j) + rng.normal(0, sigma_m, len(i))], 1)
+    p = plane if plane is not None else refine(pts)
+    rms = float(np.sqrt(np.mean(p.distance(pts) ** 2)))
+    return DepthPlane(p, mask, pts.astype(np.float32), rms)
+
+
+def _angle(a: Plane, b: Plane) -> float:
+    return float(np.degrees(np.arccos(min(1.0, abs(a.n @ b.n)))))
+
+
+def test_a_strip_of_a_face_with_a_tilted_plane_joins_its_face():
+    rng = np.random.default_rng(0)
+    flat = lambda i, j: np.full(len(i), 1.0)  # a face square to the camera at 1 m
+    face = np.zeros((40, 40), bool)
+    face[:, 3:] = True
+    strip = np.zeros((40, 40), bool)
+    strip[:, :3] = True  # three cells wide along the silhouette, as perception peels them off
+    big = _piece(face, flat, rng)
+    # the strip's points lie on the face, but its fitted plane is tilted by 50 deg about the strip's long axis
+    tilted = Plane.from_arrays([np.sin(np.radians(50)), 0.0, -np.cos(np.radians(50))],
+                               np.cos(np.radians(50)) * 1.0 - np.sin(np.radians(50)) * 0.002)
+    small = _piece(strip, flat, rng, plane=tilted)
+    assert _angle(small.plane, big.plane) > 45
+    out = merge_strips([big, small], dist_m=0.008)
+    assert len(out) == 1
+    assert out[0].mask.sum() == 1600 and len(out[0].points) == 1600
+    assert _angle(out[0].plane, Plane.from_arrays([0, 0, -1], 1.0)) < 1.0
+
+
+def test_a_true_neighbouring_face_stays_apart():
+    rng = np.random.default_rng(1)
+    a = np.zeros((40, 40), bool)
+    a[:, 20:] = True
+    b = ~a
+    # two faces meeting along column 20 at 100 deg between their planes (a ridge 80 deg from flat)
+    t = np.tan(np.radians(40))
+    left = _piece(b, lambda i, j: 1.0 + (20 - j) * 0.002 * t, rng)
+    right = _piece(a, lambda i, j: 1.0 + (j - 20) * 0.002 * t, rng)
+    out = merge_strips([right, left], dist_m=0.008)
+    assert len(out) == 2
+    assert {len(p.points) for p in out} == {800}
+
+
+def test_a_coplanar_piece_that_does_not_touch_stays_apart():
+    rng = np.random.default_rng(2)
+    flat = lambda i, j: np.full(len(i), 1.0)
+    a = np.zeros((40, 40), bool)
+    a[:, :15] = True
+    b = np.zeros((40, 40), bool)
+    b[:, 30:] = True
+    out = merge_strips([_piece(a, flat, rng), _piece(b, flat, rng)], dist_m=0.008)
+    assert len(out) == 2
