@@ -48,14 +48,14 @@ from lv3d.truth_facts import truth_facts  # noqa: E402
 CLASSES = ("cube", "square_pyramid", "triangular_prism", "pentagonal_prism")
 
 
-def dev_set(root: Path, preset: str, seed: int, per_class: int) -> Path:
-    """<root>/<preset><seed>, rendered and its rgbd facts cached by dev_facts.py if not there yet."""
+def dev_set(root: Path, preset: str, seed: int, per_class: int, modality: str = "rgbd") -> Path:
+    """<root>/<preset><seed>, rendered and its ``modality`` facts cached by dev_facts.py if not there yet."""
     out = root / f"{preset}{seed}"
-    if not (out / "facts_rgbd.pkl").is_file():
-        print(f"making {out} (render + pipeline facts, minutes) ...", flush=True)
+    if not (out / f"facts_{modality}.pkl").is_file():
+        print(f"making {out} {modality} facts (render + pipeline facts, minutes) ...", flush=True)
         subprocess.run([sys.executable, str(ROOT / "benchmarks" / "dev_facts.py"), "--preset", preset,
                         "--seed", str(seed), "--per-class", str(per_class), "--out", str(out),
-                        "--modalities", "rgbd"], check=True)
+                        "--modalities", modality], check=True)
     return out
 
 
@@ -192,12 +192,12 @@ def main(argv=None) -> int:
     if a.seed == 0:
         raise SystemExit("seed 0 is the study's; use a dev seed")
     if a.few_shot:
-        rs = Data(dev_set(a.root, "realsense", a.seed, a.per_class), a.modality)
+        rs = Data(dev_set(a.root, "realsense", a.seed, a.per_class, a.modality), a.modality)
         for positives, draws in ((1, 4), (2, 4), (4, 2)):
             show(f"{positives}-shot realsense {a.modality}", evaluate(rs, rs.pipeline, positives=positives, npp=1.5, seed=a.seed,
                                                           multiclass=False, draws=draws, settings=a.settings))
         return 0
-    clean, rs = (Data(dev_set(a.root, p, a.seed, a.per_class), a.modality) for p in ("clean", "realsense"))
+    clean, rs = (Data(dev_set(a.root, p, a.seed, a.per_class, a.modality), a.modality) for p in ("clean", "realsense"))
     print(f"dev sets {clean.folder} and {rs.folder}: {len(clean.items)} scenes each; without a target: "
           f"clean {sum(not _has(clean.pipeline[i.id]) for i in clean.items)}, "
           f"realsense {sum(not _has(rs.pipeline[i.id]) for i in rs.items)}", flush=True)
