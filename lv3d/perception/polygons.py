@@ -123,6 +123,12 @@ def distance_to_segments(points: np.ndarray, starts: np.ndarray, steps: np.ndarr
     return np.sqrt(((rel - t[..., None] * steps[None]) ** 2).sum(-1)).min(axis=1)
 
 
+def outline_distance(points: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """Distance (m,) in pixels from each of ``points`` (m, 2) to the closed outline of ``poly`` (n, 2)."""
+    p = np.asarray(poly, dtype=np.float64)
+    return distance_to_segments(points, p, np.roll(p, -1, axis=0) - p)
+
+
 def pixel_values(img: np.ndarray, pts: np.ndarray) -> np.ndarray:
     """Values of ``img`` (H, W) at the pixels nearest the points (m, 2) (u, v pixels), clipped to the image."""
     h, w = img.shape[:2]

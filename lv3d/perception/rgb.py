@@ -10,8 +10,8 @@ import numpy as np
 
 from .edges import channels, edge_distance, edge_support, edges_and_gradient
 from .faces import bounded_faces, build_graph
-from .polygons import (area, clockwise, distance_to_segments, drop_short_sides, is_simple, mean_width, perimeter,
-                       sample_boundary, simplify)
+from .polygons import (area, clockwise, drop_short_sides, is_simple, outline_distance, perimeter, sample_boundary,
+                       simplify)
 from .segments import detect_color_segments, union_find_labels
 from .split import split_by_diagonal, split_concave
 from .thin import thin_faces
@@ -186,7 +186,7 @@ def _join_thin_pairs(cands: list, dist: np.ndarray, shared_length, max_width_px:
     out = list(cands)
     # each candidate's perimeter and thinness, measured once; a joined pair's replace the first's
     per = [perimeter(c[0]) for c in out]
-    thin = [mean_width(c[0], c[3]) <= max_width_px for c in out]
+    thin = [2.0 * c[3] / p <= max_width_px for c, p in zip(out, per)]
     i = 0
     while i < len(out):
         for j in range(i + 1, len(out)):
@@ -200,7 +200,8 @@ def _join_thin_pairs(cands: list, dist: np.ndarray, shared_length, max_width_px:
                 continue
             poly = _outline(hull.astype(np.float64))
             out[i] = (poly, out[i][1] ^ out[j][1], edge_support(poly, dist), area(poly))
-            per[i], thin[i] = perimeter(poly), mean_width(poly, out[i][3]) <= max_width_px
+            per[i] = perimeter(poly)
+            thin[i] = 2.0 * out[i][3] / per[i] <= max_width_px
             del out[j], per[j], thin[j]
             break
         else:
@@ -210,14 +211,8 @@ def _join_thin_pairs(cands: list, dist: np.ndarray, shared_length, max_width_px:
 
 def _touch_length(a: np.ndarray, b: np.ndarray, tol_px: float) -> float:
     """Length (px) of polygon ``a``'s outline lying within ``tol_px`` of polygon ``b``'s outline."""
-    d = _outline_distance(sample_boundary(a, 1.0), b)
+    d = outline_distance(sample_boundary(a, 1.0), b)
     return float(np.count_nonzero(d <= tol_px))
-
-
-def _outline_distance(pts: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    """Distance (m,) in px from each of ``pts`` (m, 2) to the closed outline of ``poly`` (n, 2)."""
-    p = np.asarray(poly, dtype=np.float64)
-    return distance_to_segments(pts, p, np.roll(p, -1, axis=0) - p)
 
 
 def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: float,
@@ -229,7 +224,7 @@ def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: fl
         key = (-10_000 - k, -10_000 - k)
         pts = sample_boundary(q, 1.0)
         for n, c in enumerate(cands):
-            if np.mean(_outline_distance(pts, c[0]) <= touch_px) >= 0.15:
+            if np.mean(outline_distance(pts, c[0]) <= touch_px) >= 0.15:
                 cands[n] = (c[0], c[1] | {key}, c[2], c[3])
         out.append((q, frozenset({key}), edge_support(q, dist), area(q)))
     return out

@@ -11,7 +11,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .polygons import area, distance_to_segments, pixel_values, signed_area
+from .polygons import area, outline_distance, pixel_values, signed_area
 
 
 def gradient_magnitude(channels: list[np.ndarray]) -> np.ndarray:
@@ -45,12 +45,12 @@ def _line_strength(a: np.ndarray, b: np.ndarray, grad: np.ndarray, trim_px: floa
     return float(pixel_values(grad, pts).mean())
 
 
-def _diagonal_strengths(p: np.ndarray, pairs: list[tuple[int, int]], grad: np.ndarray, trim_px: float = 3.0,
-                        clear_px: float = 1.0) -> np.ndarray:
-    """Mean gradient magnitude (len(pairs),) along each diagonal (i, j) of the polygon ``p`` (n, 2), as
-    :func:`_line_strength` measures it but leaving out the points within ``clear_px`` of the polygon's sides too:
-    a diagonal that runs close along the outline would pick up the outline's own edge (0 when no point is
-    left). All diagonals in one go: the polygons are small and numpy calls cost more than the arithmetic."""
+def _diagonal_samples(p: np.ndarray, pairs: list[tuple[int, int]], grad: np.ndarray,
+                      trim_px: float = 3.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Points along each diagonal (i, j) of the polygon ``p`` (n, 2), as :func:`_line_strength` samples them
+    (``trim_px`` left out at each end): which diagonal each point belongs to (m,), the gradient magnitude there
+    (m,) and its distance to the polygon's outline (m,), in pixels. All diagonals in one go: the polygons are
+    small and numpy calls cost more than the arithmetic."""
     pts, owner = [], []
     for k, (i, j) in enumerate(pairs):
         length = float(np.hypot(*(p[j] - p[i])))
@@ -59,15 +59,30 @@ def _diagonal_strengths(p: np.ndarray, pairs: list[tuple[int, int]], grad: np.nd
         t = np.linspace(trim_px / length, 1 - trim_px / length, max(4, int(length)))
         pts.append(p[i] + t[:, None] * (p[j] - p[i]))
         owner.append(np.full(len(t), k))
-    out = np.zeros(len(pairs))
     if not pts:
-        return out
-    pts, owner = np.concatenate(pts), np.concatenate(owner)
-    clear = distance_to_segments(pts, p, np.roll(p, -1, axis=0) - p) >= clear_px
-    total = np.bincount(owner[clear], weights=pixel_values(grad, pts[clear]), minlength=len(pairs))
-    count = np.bincount(owner[clear], minlength=len(pairs))
+        return np.zeros(0, int), np.zeros(0), np.zeros(0)
+    pts = np.concatenate(pts)
+    return np.concatenate(owner), pixel_values(grad, pts), outline_distance(pts, p)
+
+
+def _mean_clear_of_outline(n_pairs: int, owner: np.ndarray, values: np.ndarray, clearance: np.ndarray,
+                           clear_px: float) -> np.ndarray:
+    """Mean gradient magnitude (n_pairs,) along each diagonal over its samples (from :func:`_diagonal_samples`)
+    lying ``clear_px`` or more from the outline: a diagonal that runs close along the outline would pick up the
+    outline's own edge (0 when no point is left)."""
+    clear = clearance >= clear_px
+    total = np.bincount(owner[clear], weights=values[clear], minlength=n_pairs)
+    count = np.bincount(owner[clear], minlength=n_pairs)
+    out = np.zeros(n_pairs)
     np.divide(total, count, out=out, where=count > 0)
     return out
+
+
+def _diagonal_strengths(p: np.ndarray, pairs: list[tuple[int, int]], grad: np.ndarray, trim_px: float = 3.0,
+                        clear_px: float = 1.0) -> np.ndarray:
+    """Mean gradient magnitude (len(pairs),) along each diagonal (i, j) of the polygon ``p`` (n, 2), as
+    :func:`_line_strength` measures it but leaving out the points within ``clear_px`` of the polygon's sides."""
+    return _mean_clear_of_outline(len(pairs), *_diagonal_samples(p, pairs, grad, trim_px), clear_px)
 
 
 def split_concave(poly: np.ndarray, grad: np.ndarray, min_area_px: float, depth: int = 2) -> list[np.ndarray]:
@@ -123,31 +138,37 @@ def split_by_diagonal(poly: np.ndarray, grad: np.ndarray, min_area_px: float, re
     Returns ``[poly]`` when no diagonal qualifies, or when the face is too thin to have an interior (a face seen
     edge-on)."""
     p = np.asarray(poly, np.float64)
-    if len(p) < 4:
+    n = len(p)
+    if n < 4:
         return [p]
+    pairs = [(i, j) for i in range(n) for j in range(i + 2, n) if not (i == 0 and j == n - 1)]
+    # both tests read the same samples along the diagonals, thresholded at their own clearance
+    samples = _diagonal_samples(p, pairs, grad)
+    boundary = []  # the outline's mean strength, measured once when first needed
     for rel, clear in ((rel_interior, 1.0), (faint_rel_interior, faint_clear_px)):
-        parts = _cut(p, grad, min_area_px, rel, clear, min_strength, rel_boundary)
+        strengths = _mean_clear_of_outline(len(pairs), *samples, clear)
+        parts = _cut(p, pairs, strengths, grad, min_area_px, rel, min_strength, rel_boundary, boundary)
         if parts is not None:
             return parts
     return [p]
 
 
-def _cut(p: np.ndarray, grad: np.ndarray, min_area_px: float, rel_interior: float, clear_px: float,
-         min_strength: float, rel_boundary: float) -> list[np.ndarray] | None:
-    """The two parts of ``p`` (n >= 4, 2) cut along its strongest diagonal, its strength measured
-    ``clear_px`` from the outline, when that passes :func:`split_by_diagonal`'s tests with ``rel_interior``;
-    else None."""
+def _cut(p: np.ndarray, pairs: list[tuple[int, int]], strengths: np.ndarray, grad: np.ndarray,
+         min_area_px: float, rel_interior: float, min_strength: float, rel_boundary: float,
+         boundary: list[float]) -> list[np.ndarray] | None:
+    """The two parts of ``p`` (n >= 4, 2) cut along its strongest diagonal (``strengths`` of ``pairs``), when
+    that passes :func:`split_by_diagonal`'s tests with ``rel_interior``; else None. ``boundary`` holds the
+    outline's mean strength once measured (empty before)."""
     n = len(p)
-    pairs = [(i, j) for i in range(n) for j in range(i + 2, n) if not (i == 0 and j == n - 1)]
-    strength, i, j = max((float(st), i, j) for st, (i, j) in
-                         zip(_diagonal_strengths(p, pairs, grad, clear_px=clear_px), pairs))
+    strength, i, j = max((float(st), i, j) for st, (i, j) in zip(strengths, pairs))
     if strength < min_strength:
         return None
     a, b = p[i:j + 1], np.concatenate([p[j:], p[:i + 1]])
     if min(area(a), area(b)) < min_area_px:
         return None
-    boundary = np.mean([_line_strength(p[k], p[(k + 1) % n], grad) for k in range(n)])
-    if strength < rel_boundary * boundary:
+    if not boundary:
+        boundary.append(np.mean([_line_strength(p[k], p[(k + 1) % n], grad) for k in range(n)]))
+    if strength < rel_boundary * boundary[0]:
         return None
     # the interior: the polygon shrunk by a few pixels, in a box around it
     u0, v0 = np.floor(p.min(axis=0)).astype(int)
