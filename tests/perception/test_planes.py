@@ -62,3 +62,21 @@ def test_a_coplanar_piece_that_does_not_touch_stays_apart():
     b[:, 30:] = True
     out = merge_strips([_piece(a, flat, rng), _piece(b, flat, rng)], dist_m=0.008)
     assert len(out) == 2
+
+
+def test_a_thin_face_seen_edge_on_with_its_neighbours_strip_stays_apart():
+    rng = np.random.default_rng(3)
+    flat = lambda i, j: np.full(len(i), 1.0)
+    face = np.zeros((40, 40), bool)
+    face[:, 5:] = True
+    # a piece five cells wide: three of the face's own cells and, beyond them, two columns of a face turned
+    # 80 deg away (seen nearly edge-on), on a plane of its own
+    piece = np.zeros((40, 40), bool)
+    piece[:, :5] = True
+    edge_on = lambda i, j: 1.0 + np.maximum(0, 2 - j) * 0.002 * np.tan(np.radians(80))
+    big = _piece(face, flat, rng, sigma_m=0.0)
+    small = _piece(piece, edge_on, rng, sigma_m=0.0)
+    assert len(merge_strips([big, small], dist_m=0.008)) == 2
+    # the same piece with its off-plane points scattered like flying pixels joins the face
+    fly = lambda i, j: np.where(j < 2, 1.0 + rng.uniform(0.01, 0.05, len(i)), 1.0)
+    assert len(merge_strips([big, _piece(piece, fly, rng, sigma_m=0.0)], dist_m=0.008)) == 1
