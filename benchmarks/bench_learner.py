@@ -1,7 +1,7 @@
 """The learner's accuracy under noise and its speed; prints each figure beside its target (issue 5).
 
     .venv/bin/python benchmarks/bench_learner.py [--seed 778] [--per-class 30] [--root /tmp/lv3d_bench]
-        [--quick | --noise | --few-shot] [--modality depth] [--settings '{"extra_literals": 0}']
+        [--quick | --noise | --few-shot [--draws 16]] [--modality depth] [--settings '{"extra_literals": 0}']
 
 Data: two DEV data sets (never the study's seed 0), 640x480 like the study, rendered from the same
 seed with the clean and the realsense preset, their pipeline and ground-truth rgbd facts cached by
@@ -18,7 +18,9 @@ Rows (pipeline facts, i.e. perception + grounding, unless marked truth):
   labels-20%           clean, with 20 % of the training labels flipped (seeded); target as above
   one-shot             1 positive + 3 negatives (one of each other class) per class task, 4 draws a fold
   --few-shot           realsense class tasks of 1, 2, 4 positives, 1.5 negatives a positive (at least
-                       one of each other class), 4, 4, 2 draws a fold
+                       one of each other class), 4, 4, 2 draws a fold (--draws N: N at every size; one
+                       task's binary accuracy has a 9-point SD, so 4 draws x 20 tasks leave a 1-point
+                       standard error on a mean, 16 draws half a point)
   truth ...            context only: facts from the ground truth, exact or perturbed (lv3d.truth_facts)
   fit-100, classify    seconds to learn one class from 100 scenes, ms to classify one scene
 Timings on a shared machine are pessimistic.
@@ -185,6 +187,7 @@ def main(argv=None) -> int:
     ap.add_argument("--noise", action="store_true", help="clean, realsense and labels-20%% rows only (issue 5)")
     ap.add_argument("--few-shot", action="store_true",
                     help="realsense class tasks of 1, 2, 4 positives (1.5 negatives each, one of each other class at least) only")
+    ap.add_argument("--draws", type=int, default=None, help="--few-shot: draws a fold at every task size (default 4, 4, 2)")
     ap.add_argument("--modality", default="rgbd", choices=("rgbd", "depth"),
                     help="whose facts every row learns from (depth: made with dev_facts.py --modalities depth)")
     ap.add_argument("--settings", type=json.loads, default=None, help="learner settings (JSON) for every fit")
@@ -194,6 +197,7 @@ def main(argv=None) -> int:
     if a.few_shot:
         rs = Data(dev_set(a.root, "realsense", a.seed, a.per_class, a.modality), a.modality)
         for positives, draws in ((1, 4), (2, 4), (4, 2)):
+            draws = a.draws or draws
             show(f"{positives}-shot realsense {a.modality}", evaluate(rs, rs.pipeline, positives=positives, npp=1.5, seed=a.seed,
                                                           multiclass=False, draws=draws, settings=a.settings))
         return 0

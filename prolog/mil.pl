@@ -52,6 +52,7 @@ default(few_shot(4)).          % learn_noisy: the size principle and extra_liter
 default(size_principle(true)). % learn_noisy: in few-shot tasks break ties of J by the size principle (false: by Soft, support, cost)
 default(extension_miss(0)).    % size principle: an uncovered reference object counts its near proof, absent facts at this (0: counts 0)
 default(literal_prior(0)).     % size principle: log prior of a hypothesis, -this per body literal (Occam; 0: flat prior)
+default(predicate_prior([])).  % size principle: [[P, Nats], ...] log prior -Nats more per body literal of predicate P
 default(seed(0)).
 
 %!  metarule(?Name, ?Subs, ?Head, ?Body) is nondet.  The library of metarules; the first element
@@ -133,7 +134,9 @@ learn_noisy(Task, Settings0, Best, Score) :-
 %   hypotheses the few examples cannot tell apart, the one that covers the positives confidently
 %   (robust to a doubtful fact) and holds of few other objects (not over-general); with many
 %   examples J decides and this only breaks its ties.  With literal_prior(L) > 0 the prior
-%   exp(-L * literals) multiplies it (Occam): a literal must shrink |h| by more than e^L.
+%   exp(-L * literals) multiplies it (Occam): a literal must shrink |h| by more than e^L; with
+%   predicate_prior([[P, N], ...]) each literal of P costs N nats more (a predicate the caller
+%   knows to generalise badly from one view: docs/learner.md).
 %   Then the old key (Soft, support, cost, order).
 %   Only for few-shot tasks (at most few_shot(K) positives): with many positives the n log |h|
 %   term favours the most specific of J's ties, which cost a multi-class scene on both dev seeds.
@@ -146,11 +149,11 @@ best_specific(Ctx, Settings, Pos, All, Best, Score) :-
     aggregate_all(max(J), member(k(J, _, _, _, _)-_, All), JMax),
     option(reference(Ref0), Settings), append(Pos, Ref0, Ref1), sort(Ref1, Ref),
     option(extension_miss(Eps), Settings), near_ctx(Ctx, Eps, NCtx),
-    option(literal_prior(LP), Settings),
+    option(literal_prior(LP), Settings), option(predicate_prior(PP), Settings),
     findall(k(B, Soft, W, C, O)-(Prog-S),
             ( member(k(J, Soft, W, C, O)-(Prog-S), All), J >= JMax - 1.0e-9,
               size_likelihood(Ctx, NCtx, Prog, Pos, Ref, L),
-              literals(Prog, NL), B is L - LP * NL ), Top),
+              literals(Prog, NL), predicate_cost(PP, Prog, PC), B is L - LP * NL - PC ), Top),
     max_member(_-(Best-Score), Top).
 
 size_likelihood(Ctx, NCtx, Prog, Pos, Ref, B) :-
@@ -160,6 +163,11 @@ size_likelihood(Ctx, NCtx, Prog, Pos, Ref, B) :-
 
 %   The number of body literals of a program (its clauses' together).
 literals(Prog, N) :- aggregate_all(sum(K), (member(sub(_, [_|Syms], _), Prog), length(Syms, K)), N).
+
+%   The log prior a program's body literals cost under predicate_prior: Nats per literal of P.
+predicate_cost([], _, 0) :- !.
+predicate_cost(PP, Prog, Cost) :-
+    aggregate_all(sum(N), ( member(sub(_, [_|Syms], _), Prog), member(Q, Syms), memberchk([Q, N], PP) ), Cost).
 
 %   An object's share of |h|: 1 when h covers it, else the confidence of its best near proof
 %   (none without extension_miss).

@@ -74,7 +74,7 @@ def test_extension_miss_counts_near_proofs_of_uncovered_objects():
     # (extension_miss), a clutter triangle nearly holds "a square face" (0.1) but the conjunction
     # only at 0.01, so the conjunction is the smaller hypothesis
     scenes, labels = _square_regular_task()
-    opts = {"metarules": ["part", "part2"], "disjunctions": 0, "extra_literals": 1}
+    opts = {"metarules": ["part", "part2"], "disjunctions": 0, "extra_literals": 1, "predicate_prior": []}
     count = fit(scenes, labels, "box", settings=opts).clauses[0]
     assert "square(B)" in count and "regular" not in count
     near = fit(scenes, labels, "box", settings={**opts, "extension_miss": 0.1}).clauses[0]
@@ -86,8 +86,24 @@ def test_literal_prior_charges_each_literal_against_the_extension_it_saves():
     # |"a square, regular face"| = 1 + 6 x 0.01 = 1.06, a gain of log(1.6 / 1.06) = 0.41 nats for
     # one more literal; a prior of exp(-0.2) a literal lets it pay, exp(-1) does not
     scenes, labels = _square_regular_task()
-    opts = {"metarules": ["part", "part2"], "disjunctions": 0, "extra_literals": 1, "extension_miss": 0.1}
+    opts = {"metarules": ["part", "part2"], "disjunctions": 0, "extra_literals": 1, "extension_miss": 0.1,
+            "predicate_prior": []}
     cheap = fit(scenes, labels, "box", settings={**opts, "literal_prior": 0.2}).clauses[0]
     assert "square(B)" in cheap and "regular(B)" in cheap
     dear = fit(scenes, labels, "box", settings={**opts, "literal_prior": 1.0}).clauses[0]
     assert "square(B)" in dear and "regular" not in dear
+
+
+def test_predicate_prior_charges_the_literals_of_a_named_predicate():
+    # "a regular face" (believed 1.0) and "a square face" (0.9) both hold of the positive alone:
+    # by c / |h| the regular one wins; a prior of 0.5 nats a `regular` literal (the shape
+    # default, docs/learner.md) outweighs log(1 / 0.9) = 0.11 nats, so the square one wins
+    pos = _scene(0, [("square", 0.9), ("regular", 1.0)], [])
+    negs = [_scene(k, [(p, 1.0)], []) for k, p in ((1, "triangle"), (2, "pentagon"))]
+    scenes, labels = [pos] + negs, ["box", "other", "other"]
+    opts = {"metarules": ["part"], "disjunctions": 0}
+    flat = fit(scenes, labels, "box", settings={**opts, "predicate_prior": []}).clauses[0]
+    assert "regular(B)" in flat
+    charged = fit(scenes, labels, "box", settings={**opts, "predicate_prior": [["regular", 0.5]]}).clauses[0]
+    assert "square(B)" in charged and "regular" not in charged
+    assert fit(scenes, labels, "box", settings=opts).clauses[0] == charged
