@@ -9,12 +9,14 @@ The refit (docs/grounding.md, "Calibration on perceived scenes"; ~15 min on 2 bu
 For each (modality, predicate) four maps compete by 5-fold cross-validated log loss on the dev rows:
 the raw probability unchanged, a shift in logit space, Platt scaling (bias + slope on logit p), and Platt
 plus a few face measurements (``FEATURES``) and, for predicates with a tolerance, the measured value in
-tolerances (``tol_frac``). The winner is refitted on all rows (L2-regularised logistic regression,
+tolerances (``tol_frac``); for facts about two faces (``PAIR_PREDS``) also that map plus the length of the side
+the two faces share (``PAIR_FEATURES``). The winner is refitted on all rows (L2-regularised logistic regression,
 measurements standardised, the standardisation folded into the coefficients). A map whose slope on
 logit p comes out negative is not used (confidence must grow with the measured probability). Then the
-final map (``FINAL``) of out-of-fold confidences: per modality one isotonic map of every type pooled, and
-per type the best by scene-grouped 5-fold CV log loss of none, the pooled map and the type's own isotonic
-map (``fit_final``).
+final map (``FINAL``) of out-of-fold confidences: per modality one isotonic map of every type pooled, one of
+the per-face types (``FACE_PREDS``) pooled, and per type the best by scene-grouped 5-fold CV log loss of
+none, its group's pooled map (per-face types: the per-face one, so the pair types' inputs cannot move their
+choice) and the type's own isotonic map (``fit_final``).
 ``--check`` prints per-type ECE on another dev set (rows with confidence >= 0.05, as facts are emitted)
 for the raw probabilities, the table in the tree and the new one, and each modality's ECE and log loss
 over all facts. Rows come from dev seeds only, never the study's data.
@@ -36,6 +38,7 @@ sys.path.insert(0, str(ROOT))
 
 from benchmarks.calibration_error import chance_ece, ece  # noqa: E402
 from grounding._calibration import TOL_FRAC_PREDS, inputs  # noqa: E402
+from lv3d.facts import PREDICATES  # noqa: E402
 
 MODALITIES = ("rgbd", "depth")  # rgb is left raw: see docs/grounding.md (its labels need a look first)
 FEATURES = ["support", "log_area_px", "min_turn_z", "min_side_px"]
@@ -44,6 +47,12 @@ C_REG = 0.5          # inverse L2 strength of the logistic fits (standardised in
 MIN_CONF = 0.05
 MIN_OWN_FINAL = 50   # fewer rows of either label: a type's own isotonic map would be steps of a few facts
 SUPPORT_PREDS = ("face_of", "adjacent", "object")
+# facts about two faces whose map may also read the side the faces share (0: none, e.g. pyramid laterals
+# touching at the apex); not parallel: ~60 fit rows, and out of sample it made parallel's log loss worse
+PAIR_PREDS = ("adjacent", "acute", "obtuse", "perpendicular")
+PAIR_FEATURES = ["shared_side_px"]
+# facts about one face: their final maps are chosen on their rows alone (fit_final)
+FACE_PREDS = tuple(p for p, (arity, _) in PREDICATES.items() if arity == 1 and p != "object")
 
 
 def _logloss(p, y):
@@ -109,6 +118,8 @@ def fit_one(rows: list[dict], seed: int = 0):
     folds = np.random.default_rng(seed).permutation(len(rows)) % 5
     tol = ["tol_frac"] if rows[0]["pred"] in TOL_FRAC_PREDS else []  # the measured value in tolerances
     cands = {"raw": "raw", "shift": None, "platt": ["logit_p"], "platt+measures": ["logit_p"] + FEATURES + tol}
+    if rows[0]["pred"] in PAIR_PREDS:
+        cands["platt+measures+shared"] = ["logit_p"] + FEATURES + PAIR_FEATURES + tol
     if rows[0]["pred"] in SUPPORT_PREDS:  # p is edge support, not a geometric probability: may be ignored
         cands["const"] = []
     losses, oof = {}, {}
@@ -143,25 +154,20 @@ def _knots(iso) -> dict:
     return {"x": [round(float(v), 5) for v in iso.X_thresholds_], "y": [round(float(v), 5) for v in iso.y_thresholds_]}
 
 
-def fit_final(oof: dict, seed: int = 0) -> tuple[dict, dict]:
-    """The final maps of one modality from ``oof`` {pred: (out-of-fold stage-1 confidences (n,), truth (n,),
-    scene seeds (n,))}: the pooled isotonic map of every type together, and per type the final map with the
-    best 5-fold cross-validated log loss among none, the pooled map and the type's own isotonic map (only
-    with ``MIN_OWN_FINAL`` rows of each label). Folds are whole scenes: a scene's facts share its view and
-    perception errors. Returns (the ``FINAL`` entry: pooled knots with "by_pred" {pred: own knots, or None
-    for no final stage} for types that do not take the pooled map, {pred: {choice: CV log loss}})."""
-    preds = sorted(oof)
-    conf, y, seeds = (np.concatenate([oof[p][i] for p in preds]) for i in range(3))
-    owner = np.concatenate([[p] * len(oof[p][0]) for p in preds])
+def _choose_final(oof: dict, pool: list[str], members: list[str], seed: int) -> tuple[dict, dict, dict]:
+    """Fit the isotonic map of the rows of the types in ``pool`` together and choose, for each type in
+    ``members``, among none, that pooled map and the type's own (with ``MIN_OWN_FINAL`` rows of each label)
+    by scene-grouped 5-fold CV log loss on its own rows. Returns (pooled knots, {member: "pooled", None or
+    own knots}, {member: {choice: CV log loss}}). Nothing outside ``pool`` enters the choice."""
+    conf, y, seeds = (np.concatenate([oof[p][i] for p in pool]) for i in range(3))
     scenes = np.unique(seeds)
     fold = dict(zip(scenes, np.random.default_rng(seed).permutation(len(scenes)) % 5))
     folds = np.array([fold[s] for s in seeds])
     pooled = [_isotonic(conf[folds != k], y[folds != k]) for k in range(5)]
-    final, losses = _knots(_isotonic(conf, y)), {}
-    by_pred = {}
-    for pred in preds:
-        mine = owner == pred
-        c, t, f = conf[mine], y[mine], folds[mine]
+    choice, losses = {}, {}
+    for pred in members:
+        c, t = oof[pred][0], oof[pred][1]
+        f = np.array([fold[s] for s in oof[pred][2]])
         cands = {"none": c, "pooled": np.empty(len(c))}
         if min(t.sum(), len(t) - t.sum()) >= MIN_OWN_FINAL:
             cands["own"] = np.empty(len(c))
@@ -174,8 +180,28 @@ def fit_final(oof: dict, seed: int = 0) -> tuple[dict, dict]:
                 cands["own"][te] = _isotonic(c[~te], t[~te]).predict(c[te])
         losses[pred] = {name: _logloss(v, t) for name, v in cands.items()}
         best = min(losses[pred], key=losses[pred].get)
-        if best != "pooled":
-            by_pred[pred] = None if best == "none" else _knots(_isotonic(c, t))
+        choice[pred] = best if best == "pooled" else None if best == "none" else _knots(_isotonic(c, t))
+    return _knots(_isotonic(conf, y)), choice, losses
+
+
+def fit_final(oof: dict, seed: int = 0) -> tuple[dict, dict]:
+    """The final maps of one modality from ``oof`` {pred: (out-of-fold stage-1 confidences (n,), truth (n,),
+    scene seeds (n,))}. Per-face types (``FACE_PREDS``) choose among none, the pooled isotonic map of the
+    per-face types' rows and their own isotonic map; the other types among none, the pooled map of every
+    type's rows and their own (:func:`_choose_final`, scene-grouped 5-fold CV log loss: a scene's facts share
+    its view and perception errors). So a per-face type's final map depends on per-face rows only: a new
+    input of the pair types' maps cannot move it (session 9: it flipped rgbd pentagon to the pooled map).
+    Returns (the ``FINAL`` entry: the every-type pooled knots, "faces" the per-face pooled knots and
+    "by_pred" {pred: own knots, None for no final stage, or "faces"} for each type that does not take the
+    every-type pooled map, {pred: {choice: CV log loss}})."""
+    preds = sorted(oof)
+    faces = [p for p in preds if p in FACE_PREDS]
+    final, choice, losses = _choose_final(oof, preds, [p for p in preds if p not in FACE_PREDS], seed)
+    by_pred = {p: c for p, c in choice.items() if c != "pooled"}
+    if faces:
+        final["faces"], choice, face_losses = _choose_final(oof, faces, faces, seed)
+        by_pred.update({p: "faces" if c == "pooled" else c for p, c in choice.items()})
+        losses.update(face_losses)
     return {**final, "by_pred": by_pred}, losses
 
 

@@ -11,9 +11,10 @@ of the faces behind it into a calibrated one:
 then a final non-decreasing piecewise-linear map (isotonic regression of out-of-fold confidences,
 ``FINAL``) corrects what the logistic form leaves over: per type calibrated on average, the pooled middle
 bins (0.4-0.85) came out over-confident. Per (modality, predicate) the final map is the type's own (fitted
-on its rows alone), the modality's pooled one (every type together), or none, whichever had the best
-scene-grouped cross-validated log loss: one pooled map helped some types far less than their own map
-(perpendicular) and hurt others (triangle, acute, parallel).
+on its rows alone), a pooled one of the modality, or none, whichever had the best scene-grouped
+cross-validated log loss: one pooled map helped some types far less than their own map (perpendicular) and
+hurt others (triangle, acute, parallel). Facts about one face (shape, orientation) pool only with each
+other, so what the maps of pair facts read cannot move theirs; the other types pool every type.
 The maps are fitted (L2-regularised logistic regression, ``benchmarks/fit_calibration.py``) on perceived
 dev scenes (realsense preset, seeds 30000+; never the study's data) and live in
 ``_calibration_table.py``; a (modality, predicate) pair without a map keeps its raw probability (then the
@@ -41,7 +42,8 @@ def logit(p: float) -> float:
 
 # measurements on tame scales: a corner's turn in spreads clipped (a 40-spread corner is no surer than a
 # 20-spread one), the shortest side as a log; absent measurements (e.g. of `object`) read as 0
-_SCALE = {"min_turn_z": lambda v: min(max(v, -5.0), 20.0), "min_side_px": lambda v: math.log(max(v, 1.0))}
+_SCALE = {"min_turn_z": lambda v: min(max(v, -5.0), 20.0), "min_side_px": lambda v: math.log(max(v, 1.0)),
+          "shared_side_px": lambda v: math.log(max(v, 1.0))}
 
 # "tol_frac": the fact's measured value (describe's candidate value) as a fraction of its predicate's
 # tolerance, 1 at the boundary, below 1 inside it. The Gaussian probability reads the same value in units of
@@ -89,8 +91,9 @@ def calibrate(modality: str, pred: str, p: float, x: dict | None = None) -> floa
 def calibrate_with(table: dict, modality: str, pred: str, p: float, x: dict | None = None,
                    final: dict | None = None) -> float:
     """:func:`calibrate` with the maps of ``table`` (same layout as ``TABLE``) and the final maps of ``final``
-    (layout of ``FINAL``: per modality pooled knots {"x", "y"} and optionally "by_pred", {pred: knots of the
-    type's own map, or None for no final stage}; None: no final stage)."""
+    (layout of ``FINAL``: per modality pooled knots {"x", "y"}, optionally "faces", the knots pooled over
+    facts about one face, and "by_pred", {pred: knots of the type's own map, None for no final stage, or
+    "faces"}; None: no final stage)."""
     return _apply(_compile(pred, table.get(modality, {}).get(pred), (final or {}).get(modality)), p, x)
 
 
@@ -102,11 +105,13 @@ def _inputs(pred: str, names: list[str]) -> list:
 
 def _final_knots(pred: str, final: dict | None) -> dict | None:
     """The final map of ``pred`` in one modality's ``final`` (layout of a ``FINAL`` value): the type's own
-    (or None, no final stage) where "by_pred" names it, else the pooled one."""
+    (or None, no final stage) where "by_pred" names it, the per-face pooled one ("faces") where it says
+    "faces", else the pooled one of every type."""
     if final is None:
         return None
     by_pred = final.get("by_pred", {})
-    return by_pred[pred] if pred in by_pred else final
+    knots = by_pred[pred] if pred in by_pred else final
+    return final["faces"] if knots == "faces" else knots
 
 
 def _compile(pred: str, entry: dict | None, final: dict | None):

@@ -315,11 +315,32 @@ def _face_features(g: dict, index: np.ndarray, ns: list[int]) -> list[dict]:
     return out
 
 
+def shared_side_px(a: np.ndarray, b: np.ndarray) -> float:
+    """Length in pixels of the longest side two refined polygons (n, 2) and (m, 2) have in common, 0 if none.
+    Grounding merges vertices of different faces closer than its ``merge_px`` into one union vertex, so a
+    shared vertex has the same coordinates in both: two faces that meet along an edge share a side, two that
+    touch at a point (opposite laterals of a pyramid at its apex) share one vertex and no side."""
+    same = np.all(a[:, None, :] == b[None, :, :], axis=2)  # (n, m)
+    ia, ib = np.nonzero(same)
+    if len(ia) < 2:
+        return 0.0
+    in_b = dict(zip(ia.tolist(), ib.tolist()))
+    n, m = len(a), len(b)
+    best = 0.0
+    for i, j in in_b.items():
+        k = in_b.get((i + 1) % n)
+        if k is not None and (k - j) % m in (1, m - 1):  # consecutive in both: a common side
+            best = max(best, float(np.linalg.norm(a[(i + 1) % n] - a[i])))
+    return best
+
+
 def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]:
     """Per candidate the face measurements its calibration may read (:func:`_face_features`); for a fact
-    about two faces, the weaker of each (smaller value), for ``object`` the object's best face; and, for a
+    about two faces, the weaker of each (smaller value) and the length of the side they share
+    (``shared_side_px``, :func:`shared_side_px`), for ``object`` the object's best face; and, for a
     candidate with a measured value, that value as ``value``."""
     by_face = {fr.face.id: fr.features for res in results for fr in res.faces}
+    by_poly = {fr.face.id: fr.polygon for res in results for fr in res.faces}
     by_obj = {res.obj.id: [fr.features for fr in res.faces] for res in results}
     weaker: dict[tuple[str, ...], dict] = {}  # by faces: a pair has up to six facts, each in both orders
 
@@ -328,6 +349,8 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
         if key not in weaker:
             fs = [by_face[a] for a in key if a in by_face]
             weaker[key] = {k: min(f[k] for f in fs) for k in fs[0]} if fs else {}
+            if len(key) == 2 and key[0] in by_poly and key[1] in by_poly:
+                weaker[key]["shared_side_px"] = shared_side_px(by_poly[key[0]], by_poly[key[1]])
         return weaker[key]
 
     out = []

@@ -1,9 +1,11 @@
 """grounding.calibrate: the shipped per-(modality, predicate) maps are monotone in the raw probability,
 stay in (0, 1), leave unmapped predicates and impossible facts alone, read a fact's value in tolerances,
-take a type's own final map (or none) over the pooled one;
+take a type's own final map (or none) over the pooled one, per-face types the per-face pooled one, chosen
+without the pair types' rows;
 pack_object picks the small padded shape for small objects."""
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -11,7 +13,7 @@ import grounding
 from grounding._calibration import FINAL, TABLE, calibrate_with
 from grounding._confidence import EQUAL_SIDES_RATIO, RIGHT_ANGLE_DEG
 from grounding._problem import SIZES
-from lv3d.describe import calibration_features
+from lv3d.describe import calibration_features, shared_side_px
 
 MEASURES = {"support": 0.9, "log_area_px": 8.0, "min_turn_z": 6.0, "min_side_px": 40.0, "sides": 4, "faces": 3,
             "value": 1.05}
@@ -58,6 +60,29 @@ def test_calibration_features_carry_each_candidates_value():
     assert [f.get("value") for f in feats] == [1.05, 3.0, None]
 
 
+def test_shared_side_is_the_longest_side_two_polygons_have_in_common():
+    a = np.array([[0.0, 0.0], [30.0, 0.0], [30.0, 40.0], [0.0, 40.0]])
+    edge = np.array([[30.0, 0.0], [60.0, 0.0], [60.0, 40.0], [30.0, 40.0]])   # shares a's side x = 30 (40 px)
+    point = np.array([[30.0, 40.0], [60.0, 40.0], [60.0, 80.0]])               # touches a at one vertex
+    across = np.array([[30.0, 0.0], [50.0, 20.0], [0.0, 40.0]])                # two shared vertices, not a side
+    assert shared_side_px(a, edge) == 40.0 and shared_side_px(edge, a) == 40.0
+    assert shared_side_px(a, point) == 0.0 and shared_side_px(a, across) == 0.0
+    assert shared_side_px(a, a + 0.5) == 0.0
+
+
+def test_calibration_features_give_a_pair_its_shared_side():
+    from lv3d.describe import FaceResult, ObjectResult
+
+    def face(fid, poly):
+        return FaceResult(SimpleNamespace(id=fid), np.asarray(poly, float), None, np.zeros(len(poly)), dict(MEASURES))
+
+    res = ObjectResult(SimpleNamespace(id="o1"), [face("f1", [[0, 0], [30, 0], [30, 40], [0, 40]]),
+                                                  face("f2", [[30, 0], [60, 0], [60, 40], [30, 40]])], {}, 0, [])
+    feats = calibration_features([("acute", ("f1", "f2"), 1.0, 60.0), ("acute", ("f2", "f1"), 1.0, 60.0),
+                                  ("square", ("f1",), 0.9, 1.05)], [res])
+    assert feats[0]["shared_side_px"] == feats[1]["shared_side_px"] == 40.0 and "shared_side_px" not in feats[2]
+
+
 def test_calibrate_is_calibrate_with_the_shipped_table():
     # calibrate keeps each map's inputs looked up; the numbers must be those of the general function
     for modality, maps in TABLE.items():
@@ -72,7 +97,8 @@ def test_final_map_interpolates_its_knots_and_keeps_zero():
     got = [calibrate_with({}, "rgbd", "triangle", p, None, final) for p in (0.0, 0.1, 0.4, 0.6, 0.7, 0.9)]
     assert np.allclose(got, [0.0, 0.1, 0.2, 0.5, 0.6, 0.7])
     for final in FINAL.values():
-        for knots in [final, *(k for k in final.get("by_pred", {}).values() if k is not None)]:
+        own = [k for k in final.get("by_pred", {}).values() if isinstance(k, dict)]
+        for knots in [final, *([final["faces"]] if "faces" in final else []), *own]:
             assert np.all(np.diff(knots["x"]) >= 0) and np.all(np.diff(knots["y"]) >= 0)
 
 
@@ -82,6 +108,29 @@ def test_a_type_takes_its_own_final_map_or_none_before_the_pooled_one():
     got = {pred: calibrate_with({}, "rgbd", pred, 0.7, None, final) for pred in ("square", "parallel", "triangle")}
     assert got == {"square": 0.5, "parallel": 0.7, "triangle": 0.2}
     assert calibrate_with({}, "rgbd", "square", 0.0, None, final) == 0.0  # impossible stays impossible
+    final["rgbd"]["faces"] = {"x": [0.0, 1.0], "y": [0.4, 0.4]}         # per-face pooled: everything to 0.4
+    final["rgbd"]["by_pred"]["pentagon"] = "faces"
+    assert calibrate_with({}, "rgbd", "pentagon", 0.7, None, final) == 0.4
+    assert calibrate_with({}, "rgbd", "acute", 0.7, None, final) == 0.2
+
+
+def test_pair_types_cannot_move_a_per_face_types_final_map():
+    from benchmarks.fit_calibration import fit_final
+
+    rng = np.random.default_rng(1)
+    n = 2000
+    seeds = np.repeat(np.arange(n // 10), 10)
+    c = rng.uniform(0.05, 0.95, (3, n))
+    oof = {"pentagon": (c[0], (rng.random(n) < c[0] ** 2).astype(float), seeds),
+           "square": (c[1], (rng.random(n) < c[1]).astype(float), seeds),
+           "acute": (c[2], (rng.random(n) < c[2]).astype(float), seeds)}
+    final, losses = fit_final(oof)
+    # the pair type's rows made over-confident: the every-type pooled map moves, the per-face choices do not
+    moved, moved_losses = fit_final({**oof, "acute": (c[2], (rng.random(n) < c[2] ** 4).astype(float), seeds)})
+    assert final["x"] != moved["x"] or final["y"] != moved["y"]
+    for pred in ("pentagon", "square"):
+        assert final["by_pred"][pred] == moved["by_pred"][pred] and losses[pred] == moved_losses[pred]
+    assert final["faces"] == moved["faces"] and set(final["by_pred"]) >= {"pentagon", "square"}
 
 
 def _square(x0, y0, s=40.0):
