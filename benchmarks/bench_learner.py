@@ -187,13 +187,16 @@ def main(argv=None) -> int:
     ap.add_argument("--noise", action="store_true", help="clean, realsense and labels-20%% rows only (issue 5)")
     ap.add_argument("--few-shot", action="store_true",
                     help="realsense class tasks of 1, 2, 4 positives (1.5 negatives each, one of each other class at least) only")
-    ap.add_argument("--draws", type=int, default=None, help="--few-shot: draws a fold at every task size (default 4, 4, 2)")
+    ap.add_argument("--draws", type=int, default=None,
+                    help="--few-shot: draws a fold at every task size (default 4, 4, 2)")
     ap.add_argument("--modality", default="rgbd", choices=("rgbd", "depth"),
                     help="whose facts every row learns from (depth: made with dev_facts.py --modalities depth)")
     ap.add_argument("--settings", type=json.loads, default=None, help="learner settings (JSON) for every fit")
     a = ap.parse_args(argv)
     if a.seed == 0:
         raise SystemExit("seed 0 is the study's; use a dev seed")
+    if a.draws is not None and a.draws < 1:
+        raise SystemExit(f"--draws must be at least 1, got {a.draws}")
     if a.few_shot:
         rs = Data(dev_set(a.root, "realsense", a.seed, a.per_class, a.modality), a.modality)
         for positives, draws in ((1, 4), (2, 4), (4, 2)):
