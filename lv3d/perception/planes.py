@@ -127,7 +127,9 @@ def merge_strips(planes: list[DepthPlane], dist_m: float, max_median: float = 0.
             # median distance within the limit, counted (np.median cost more than the rest of this loop)
             if 2 * np.count_nonzero(d <= max_median * dist_m) < len(d):
                 continue
-            if _holds_face(small.points[d > dist_m], len(d), dist_m, [q.plane for q in planes if q is not small]):
+            # the other planes found: big's own is left out, as the far points lie off it by their definition
+            others = [q.plane for q in planes if q is not small and q is not big]
+            if _holds_face(small.points[d > dist_m], len(d), dist_m, others):
                 continue
             # the strip's flying pixels (behind the silhouette) stay out of the refit
             near = d <= dist_m

@@ -26,10 +26,11 @@ def perimeter(poly: np.ndarray) -> float:
     return float(np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1).sum())
 
 
-def mean_width(poly: np.ndarray, area_px: float | None = None) -> float:
-    """Twice the area over the perimeter (px): a long strip's width, a sliver's measure. ``area_px`` is the
-    area when the caller has it already (``area(poly)`` otherwise)."""
-    return 2.0 * (area(poly) if area_px is None else area_px) / perimeter(poly)
+def mean_width(poly: np.ndarray, area_px: float | None = None, perimeter_px: float | None = None) -> float:
+    """Twice the area over the perimeter (px): a long strip's width, a sliver's measure. ``area_px`` and
+    ``perimeter_px`` are the area and perimeter when the caller has them already (measured here otherwise)."""
+    return 2.0 * (area(poly) if area_px is None else area_px) / (perimeter(poly) if perimeter_px is None
+                                                                 else perimeter_px)
 
 
 def _segments_cross(a, b, c, d) -> bool:

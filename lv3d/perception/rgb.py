@@ -10,8 +10,8 @@ import numpy as np
 
 from .edges import channels, edge_distance, edge_support, edges_and_gradient
 from .faces import bounded_faces, build_graph
-from .polygons import (area, clockwise, drop_short_sides, is_simple, outline_distance, perimeter, sample_boundary,
-                       simplify)
+from .polygons import (area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
+                       sample_boundary, simplify)
 from .segments import detect_color_segments, union_find_labels
 from .split import split_by_diagonal, split_concave
 from .thin import thin_faces
@@ -186,7 +186,7 @@ def _join_thin_pairs(cands: list, dist: np.ndarray, shared_length, max_width_px:
     out = list(cands)
     # each candidate's perimeter and thinness, measured once; a joined pair's replace the first's
     per = [perimeter(c[0]) for c in out]
-    thin = [2.0 * c[3] / p <= max_width_px for c, p in zip(out, per)]
+    thin = [mean_width(c[0], c[3], p) <= max_width_px for c, p in zip(out, per)]
     i = 0
     while i < len(out):
         for j in range(i + 1, len(out)):
@@ -201,7 +201,7 @@ def _join_thin_pairs(cands: list, dist: np.ndarray, shared_length, max_width_px:
             poly = _outline(hull.astype(np.float64))
             out[i] = (poly, out[i][1] ^ out[j][1], edge_support(poly, dist), area(poly))
             per[i] = perimeter(poly)
-            thin[i] = 2.0 * out[i][3] / per[i] <= max_width_px
+            thin[i] = mean_width(poly, out[i][3], per[i]) <= max_width_px
             del out[j], per[j], thin[j]
             break
         else:

@@ -8,6 +8,8 @@ image gradient along it is taken.
 
 from __future__ import annotations
 
+import functools
+
 import cv2
 import numpy as np
 
@@ -78,13 +80,6 @@ def _mean_clear_of_outline(n_pairs: int, owner: np.ndarray, values: np.ndarray, 
     return out
 
 
-def _diagonal_strengths(p: np.ndarray, pairs: list[tuple[int, int]], grad: np.ndarray, trim_px: float = 3.0,
-                        clear_px: float = 1.0) -> np.ndarray:
-    """Mean gradient magnitude (len(pairs),) along each diagonal (i, j) of the polygon ``p`` (n, 2), as
-    :func:`_line_strength` measures it but leaving out the points within ``clear_px`` of the polygon's sides."""
-    return _mean_clear_of_outline(len(pairs), *_diagonal_samples(p, pairs, grad, trim_px), clear_px)
-
-
 def split_concave(poly: np.ndarray, grad: np.ndarray, min_area_px: float, depth: int = 2) -> list[np.ndarray]:
     """Convex pieces of ``poly`` (n, 2) pixels: ``[poly]`` when it is convex (or cannot be cut into convex
     parts), else the parts of the best cut from a reflex corner to another corner, each split again up to
@@ -144,7 +139,11 @@ def split_by_diagonal(poly: np.ndarray, grad: np.ndarray, min_area_px: float, re
     pairs = [(i, j) for i in range(n) for j in range(i + 2, n) if not (i == 0 and j == n - 1)]
     # both tests read the same samples along the diagonals, thresholded at their own clearance
     samples = _diagonal_samples(p, pairs, grad)
-    boundary = []  # the outline's mean strength, measured once when first needed
+
+    @functools.cache
+    def boundary():  # the outline's mean strength, measured once and only when a test gets that far
+        return np.mean([_line_strength(p[k], p[(k + 1) % n], grad) for k in range(n)])
+
     for rel, clear in ((rel_interior, 1.0), (faint_rel_interior, faint_clear_px)):
         strengths = _mean_clear_of_outline(len(pairs), *samples, clear)
         parts = _cut(p, pairs, strengths, grad, min_area_px, rel, min_strength, rel_boundary, boundary)
@@ -155,20 +154,17 @@ def split_by_diagonal(poly: np.ndarray, grad: np.ndarray, min_area_px: float, re
 
 def _cut(p: np.ndarray, pairs: list[tuple[int, int]], strengths: np.ndarray, grad: np.ndarray,
          min_area_px: float, rel_interior: float, min_strength: float, rel_boundary: float,
-         boundary: list[float]) -> list[np.ndarray] | None:
+         boundary) -> list[np.ndarray] | None:
     """The two parts of ``p`` (n >= 4, 2) cut along its strongest diagonal (``strengths`` of ``pairs``), when
-    that passes :func:`split_by_diagonal`'s tests with ``rel_interior``; else None. ``boundary`` holds the
-    outline's mean strength once measured (empty before)."""
-    n = len(p)
+    that passes :func:`split_by_diagonal`'s tests with ``rel_interior``; else None. ``boundary()``: the
+    outline's mean strength."""
     strength, i, j = max((float(st), i, j) for st, (i, j) in zip(strengths, pairs))
     if strength < min_strength:
         return None
     a, b = p[i:j + 1], np.concatenate([p[j:], p[:i + 1]])
     if min(area(a), area(b)) < min_area_px:
         return None
-    if not boundary:
-        boundary.append(np.mean([_line_strength(p[k], p[(k + 1) % n], grad) for k in range(n)]))
-    if strength < rel_boundary * boundary[0]:
+    if strength < rel_boundary * boundary():
         return None
     # the interior: the polygon shrunk by a few pixels, in a box around it
     u0, v0 = np.floor(p.min(axis=0)).astype(int)

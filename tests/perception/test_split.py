@@ -2,8 +2,8 @@ import cv2
 import numpy as np
 
 from lv3d.perception.polygons import area, drop_short_sides
-from lv3d.perception.split import (_diagonal_strengths, gradient_magnitude, reflex_corners, split_by_diagonal,
-                                   split_concave)
+from lv3d.perception.split import (_diagonal_samples, _mean_clear_of_outline, gradient_magnitude, reflex_corners,
+                                   split_by_diagonal, split_concave)
 
 
 def _image(polys_colours, shape=(200, 200), background=90):
@@ -92,6 +92,7 @@ def test_a_diagonal_within_a_blurred_edge_of_the_outline_has_no_strength_measure
     img = np.full((130, 160), 60.0)
     cv2.fillPoly(img, [np.round(poly).astype(np.int32)], 160)
     grad = gradient_magnitude([cv2.GaussianBlur(img, (0, 0), 1.0).astype(np.uint8)])
-    shallow, across = _diagonal_strengths(poly, [(0, 2), (1, 3)], grad, clear_px=2.5)
+    samples = _diagonal_samples(poly, [(0, 2), (1, 3)], grad)
+    shallow, across = _mean_clear_of_outline(2, *samples, clear_px=2.5)
     assert shallow == 0.0 and across < 5.0
-    assert _diagonal_strengths(poly, [(0, 2)], grad, clear_px=1.0)[0] > 50.0
+    assert _mean_clear_of_outline(2, *samples, clear_px=1.0)[0] > 50.0
