@@ -15,6 +15,7 @@ from .cloud import PointGrid, point_grid
 from .objects import DepthObject, segment_objects, support_band
 from .planes import DepthPlane, object_planes, plane_adjacency
 from .plane_outline import simplify_on_plane
+from .polygons import merge_close_corners
 from .snap import add_triple_corners, snap_polygons
 from .support import noise_threshold
 
@@ -68,6 +69,8 @@ def depth_scene(frame: RGBD, stride: int = 2, seed: int = 0, max_objects: int = 
             # corners judged on the face's plane, where an edge-on face is not squeezed
             polys = [None if q is None else simplify_on_plane(q, p.plane, frame.intrinsics)
                      for q, p in zip(polys, planes)]
+            # a side shorter than a grid cell and a half is below what the grid can measure: a corner cut
+            polys = [None if q is None else merge_close_corners(q, 1.5 * stride) for q in polys]
         t_boundary += time.perf_counter() - tb
         t_planes += tb - ta
         ij = np.argwhere(o.mask)

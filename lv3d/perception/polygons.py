@@ -149,28 +149,59 @@ def sample_boundary(poly: np.ndarray, step: float = 1.0) -> np.ndarray:
     return p[side] + t[:, None] * d[side]
 
 
+def _crossing(p: np.ndarray, s: int) -> np.ndarray | None:
+    """Where the sides before and after side s (p[s] -> p[s+1]) of the closed polygon ``p`` cross, or None
+    where they are parallel."""
+    n = len(p)
+    a0, b0 = p[s - 1], p[(s + 1) % n]
+    u, v = p[s] - a0, p[(s + 2) % n] - b0
+    cross = u[0] * v[1] - u[1] * v[0]
+    if abs(cross) < 1e-9 * max(1.0, np.hypot(*u) * np.hypot(*v)):
+        return None
+    w = b0 - a0
+    return a0 + (w[0] * v[1] - w[1] * v[0]) / cross * u
+
+
+def _join_side(p: np.ndarray, s: int, x: np.ndarray) -> np.ndarray:
+    """``p`` with side s's two corners made one, at ``x``."""
+    n = len(p)
+    p = np.delete(p, (s + 1) % n, axis=0)
+    p[s if (s + 1) % n != 0 or s == 0 else s - 1] = x
+    return p
+
+
+def _shortest_side(p: np.ndarray) -> tuple[int, np.ndarray]:
+    d = np.roll(p, -1, axis=0) - p
+    length = np.hypot(d[:, 0], d[:, 1])
+    return int(np.argmin(length)), length
+
+
 def drop_short_sides(poly: np.ndarray, rel_len: float = 0.15, reach: float = 1.5) -> np.ndarray:
     """Remove sides shorter than ``rel_len`` of the mean side by extending their neighbours to where they
     cross, if that point lies within ``reach`` times the side's length (+2 px) of it: a junction of three
     edges is often traced as two corners a few pixels apart, and no face of the solids has such a side."""
     p = np.asarray(poly, dtype=np.float64)
     while len(p) > 3:
-        d = np.roll(p, -1, axis=0) - p
-        length = np.hypot(d[:, 0], d[:, 1])
-        s = int(np.argmin(length))
+        s, length = _shortest_side(p)
         if length[s] >= rel_len * length.mean():
             break
-        n = len(p)
-        a0, a1 = p[s - 1], p[s]                 # side before: (s-1) -> s
-        b0, b1 = p[(s + 1) % n], p[(s + 2) % n]  # side after: (s+1) -> (s+2)
-        u, v = a1 - a0, b1 - b0
-        cross = u[0] * v[1] - u[1] * v[0]
-        if abs(cross) < 1e-9 * max(1.0, np.hypot(*u) * np.hypot(*v)):
+        x = _crossing(p, s)
+        if x is None or np.hypot(*(x - 0.5 * (p[s] + p[(s + 1) % len(p)]))) > reach * length[s] + 2.0:
             break
-        w = b0 - a0
-        x = a0 + (w[0] * v[1] - w[1] * v[0]) / cross * u
-        if np.hypot(*(x - 0.5 * (p[s] + p[(s + 1) % n]))) > reach * length[s] + 2.0:
+        p = _join_side(p, s, x)
+    return p
+
+
+def merge_close_corners(poly: np.ndarray, min_len: float) -> np.ndarray:
+    """Join each pair of neighbouring corners closer than ``min_len`` px into one corner: the crossing of the
+    sides on either side of them where that lies within ``min_len`` of their midpoint, else the midpoint. A side
+    shorter than the grid that traced it can measure is one corner cut off."""
+    p = np.asarray(poly, dtype=np.float64)
+    while len(p) > 3:
+        s, length = _shortest_side(p)
+        if length[s] >= min_len:
             break
-        p = np.delete(p, (s + 1) % n, axis=0)
-        p[s if (s + 1) % n != 0 or s == 0 else s - 1] = x
+        mid = 0.5 * (p[s] + p[(s + 1) % len(p)])
+        x = _crossing(p, s)
+        p = _join_side(p, s, x if x is not None and np.hypot(*(x - mid)) <= min_len else mid)
     return p

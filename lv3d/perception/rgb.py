@@ -13,7 +13,7 @@ from .faces import bounded_faces, build_graph
 from .polygons import (area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
                        sample_boundary, simplify)
 from .segments import detect_color_segments, union_find_labels
-from .split import split_by_diagonal, split_concave
+from .split import reflex_corners, split_by_diagonal, split_concave
 from .thin import thin_faces
 
 
@@ -39,12 +39,42 @@ class RGBResult:
 
 # a corner cutting off more than this fraction of a face's area is kept however little it turns (polygons.simplify)
 _KEEP_AREA = 0.1
+# a part cut off a traced face at most this wide (twice its area over its perimeter, px) is outlined anew from the
+# traced vertices it holds
+_THIN_PART_PX = 12.0
+# parts cut off an outline tile it when their areas sum to its area within this fraction of it
+_TILE_TOL = 1e-6
 
 
 def _outline(poly: np.ndarray) -> np.ndarray:
     """A traced face's outline with only its corners, short sides dropped, clockwise; a corner holding more than
     ``_KEEP_AREA`` of the face's area stays however little it turns (polygons.simplify)."""
     return clockwise(drop_short_sides(simplify(poly, keep_area_frac=_KEEP_AREA)))
+
+
+def _traced_parts(traced: np.ndarray, outline: np.ndarray, pieces: list[np.ndarray]) -> list[np.ndarray]:
+    """``pieces`` of ``outline`` (the corners of polygon ``traced``, cut along diagonals between its corners) as
+    pieces of ``traced`` itself: between two corners that neighbour on ``outline`` each piece runs through the
+    traced vertices there. The corners were chosen for the whole face: a bend holding a small part of it is
+    dropped, though it holds much of the thin part cut off."""
+    t = clockwise(np.asarray(traced, np.float64))
+    n = len(t)
+    near = lambda q: [int(np.argmin(np.hypot(*(t - v).T))) for v in q]  # noqa: E731
+    corners = near(outline)
+    out = []
+    for q in pieces:
+        idx = near(q)
+        run = []
+        for a, b in zip(idx, idx[1:] + idx[:1]):
+            run.append(a)
+            ia, ib = corners.index(a) if a in corners else -1, corners.index(b) if b in corners else -1
+            if ia >= 0 and ib == (ia + 1) % len(corners):  # a side of the outline, not a cut
+                k = (a + 1) % n
+                while k != b:
+                    run.append(k)
+                    k = (k + 1) % n
+        out.append(t[run])
+    return out
 
 
 def _touches_frame(poly: np.ndarray, box: tuple[int, int, int, int], tol: float = 3.0) -> float:
@@ -109,8 +139,14 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         cut = (-1 - len(cands), -1 - len(cands))
         if by_gradient:
             image_cuts.add(cut)
-        for q in pieces:
-            q = _outline(q)
+        # split_by_diagonal may cut a non-convex outline across a notch: the part cut off lies outside the traced
+        # face, its traced vertices are the notch's, and the parts do not tile the outline
+        tiled = abs(sum(area(q) for q in pieces) - area(poly)) <= _TILE_TOL * area(poly)
+        for q, traced in zip(pieces, _traced_parts(f.polygon, poly, pieces)):
+            # a thin part of a tiled outline keeps the bends of its traced outline where they hold much of its
+            # area and leave it convex (_traced_parts)
+            bent = _outline(traced) if tiled and mean_width(q) <= _THIN_PART_PX else None
+            q = bent if bent is not None and not reflex_corners(bent) else _outline(q)
             qc = q.astype(np.float32).reshape(-1, 1, 2)
             own = frozenset(e for e in f.edges if cv2.pointPolygonTest(
                 qc, tuple(float(x) for x in 0.5 * (g.vertices[e[0]] + g.vertices[e[1]])), True) >= -2.0)

@@ -1,6 +1,7 @@
 import numpy as np
 
-from lv3d.perception.polygons import area, clockwise, is_simple, rasterize, sample_boundary, signed_area, simplify
+from lv3d.perception.polygons import (area, clockwise, is_simple, merge_close_corners, rasterize, sample_boundary,
+                                      signed_area, simplify)
 
 
 def test_simplify_keeps_only_true_corners():
@@ -45,3 +46,21 @@ def test_simplify_removes_the_least_deviating_vertex_first():
     # two candidates: the near-collinear one goes, the true corner of the triangle-with-a-bump stays
     poly = np.array([[0, 0], [50, 1], [100, 0], [50, 80]], float)
     np.testing.assert_allclose(simplify(poly), [[0, 0], [100, 0], [50, 80]])
+
+
+def test_merge_close_corners_joins_a_cut_tip():
+    # a sliver's sharp tip traced as two corners 1.9 px apart whose sides cross 5 px away: one corner, midway
+    sliver = np.array([[299.4, 214.8], [301.1, 215.7], [310.8, 241.6], [309.6, 265.4], [301.8, 243.8]])
+    out = merge_close_corners(sliver, 3.0)
+    assert len(out) == 4
+    assert np.allclose(out[0], [300.25, 215.25])
+    # corners 2 px apart whose sides cross within 3 px: the crossing
+    square = np.array([[0, 0], [40, 0], [40, 39], [39, 40], [0, 40]], float)
+    assert np.allclose(merge_close_corners(square, 3.0), [[0, 0], [40, 0], [40, 40], [0, 40]])
+
+
+def test_merge_close_corners_keeps_sides_it_can_measure():
+    strip = np.array([[0, 0], [100, 0], [100, 3.5], [0, 3.5]])  # a hairline's short ends are real sides
+    assert len(merge_close_corners(strip, 3.0)) == 4
+    tiny = np.array([[0, 0], [2, 0], [1, 1]], float)  # never fewer than three corners
+    assert len(merge_close_corners(tiny, 3.0)) == 3
