@@ -38,6 +38,7 @@ DEFAULTS: dict = {
         "positives": 40,                # per class task; capped by what the training folds hold
         "negatives_per_positive": 1.5,  # spread evenly over the other classes (40 -> 20 of each of 3)
         "multiclass": True,             # also train on all classes at once and report multi-class accuracy
+        "draws": 1,                     # training samples drawn per task and fold; scores are their means
     },
     "systems": list(SYSTEMS),
     "lv3d": {
@@ -143,6 +144,8 @@ def validate(cfg: dict, where: Path) -> None:
     need(isinstance(t["positives"], int) and t["positives"] >= 1, "train.positives", "must be a positive integer")
     need(isinstance(t["negatives_per_positive"], (int, float)) and t["negatives_per_positive"] > 0,
          "train.negatives_per_positive", "must be a positive number")
+    need(isinstance(t["draws"], int) and not isinstance(t["draws"], bool) and t["draws"] >= 1, "train.draws",
+         "must be a positive integer")
     need(isinstance(cfg["systems"], list) and cfg["systems"], "systems", "needs a non-empty list")
     for s in cfg["systems"]:
         need(s in SYSTEMS, "systems", f"unknown system {s!r}; known: {', '.join(SYSTEMS)}")

@@ -25,9 +25,9 @@ from .folds import Item, class_task, multiclass_task, split, stratified_folds
 from .systems import make_system, modality_of, negative_label
 
 
-def task_seed(seed: int, fold: int, task: int) -> int:
-    """A seed for one (fold, task) cell, independent of the system."""
-    return int(np.random.SeedSequence([seed, fold, task]).generate_state(1)[0])
+def task_seed(seed: int, fold: int, task: int, draw: int = 0) -> int:
+    """A seed for one draw of one (fold, task) cell, independent of the system."""
+    return int(np.random.SeedSequence([seed, fold, task] + ([draw] if draw else [])).generate_state(1)[0])
 
 
 def fold_path(out: Path, condition: str, system: str, fold: int) -> Path:
@@ -37,6 +37,8 @@ def fold_path(out: Path, condition: str, system: str, fold: int) -> Path:
 def result_key(cfg: dict, system: str, fold: int) -> str:
     """What a fold result depends on: a finished result with another key is recomputed."""
     relevant = {k: cfg[k] for k in ("seed", "folds", "data", "train")}
+    if relevant["train"].get("draws") == 1:  # one draw is the protocol from before draws: its results keep their keys
+        relevant["train"] = {k: v for k, v in relevant["train"].items() if k != "draws"}
     relevant["system"] = system
     relevant["fold"] = fold
     if system in LOGIC_SYSTEMS:
@@ -66,37 +68,61 @@ def score_binary(preds: list[tuple[str, float]], test: list[Item], cls: str) -> 
 
 def run_fold(system, cfg: dict, train: list[Item], test: list[Item], fold: int,
              programs: Path | None) -> dict:
-    """Train and test every task of one fold for one bound system; returns the fold's record."""
+    """Train and test every task of one fold for one bound system; returns the fold's record.
+
+    With ``train.draws`` > 1 each task is trained on that many independently seeded samples: its accuracies
+    are their means, its counts their sums, ``per_draw`` lists each draw's accuracy, its predictions and
+    programs are per draw (``draw<d>``); draw 0 is the sample one draw takes."""
     t = cfg["train"]
+    draws = t.get("draws", 1)
     classes = list(cfg["data"]["classes"])
     test_ids = [it.id for it in test]
     record: dict = {"tasks": {}, "predictions": {}}
+
+    def save(fitted, task: str, d: int) -> None:
+        if programs is not None:
+            fitted.save(programs / task if draws == 1 else programs / task / f"draw{d}")
+
+    def keep(task: str, scores: list[dict], preds: list[list]) -> None:
+        as_json = [[[i, str(l), float(c)] for i, (l, c) in zip(test_ids, p)] for p in preds]
+        record["predictions"][task] = as_json[0] if draws == 1 else as_json
+        if draws == 1:
+            record["tasks"][task] = scores[0]
+            return
+        out = dict(scores[0])
+        out.update({k: float(np.mean([s[k] for s in scores])) for k in ("accuracy", "balanced_accuracy") if k in out})
+        out.update({k: sum(s[k] for s in scores) for k in ("tp", "fp", "tn", "fn") if k in out})
+        out.update(seconds=round(sum(s["seconds"] for s in scores), 3), per_draw=[s["accuracy"] for s in scores])
+        record["tasks"][task] = out
+
     for j, cls in enumerate(classes):
-        seed = task_seed(cfg["seed"], fold, j)
-        examples, positive = class_task(train, cls, t["positives"], t["negatives_per_positive"], seed)
-        labels = [cls if p else negative_label(cls) for p in positive]
-        t0 = time.perf_counter()
-        fitted = system.fit([it.id for it in examples], labels, seed, positive=cls)
-        preds = fitted.predict(test_ids)
-        score = score_binary(preds, test, cls)
-        score.update(n_pos=sum(positive), n_neg=len(positive) - sum(positive),
-                     seconds=round(time.perf_counter() - t0, 3))
-        record["tasks"][cls] = score
-        record["predictions"][cls] = [[i, str(l), float(c)] for i, (l, c) in zip(test_ids, preds)]
-        if programs is not None:
-            fitted.save(programs / cls)
+        scores, preds = [], []
+        for d in range(draws):
+            seed = task_seed(cfg["seed"], fold, j, d)
+            examples, positive = class_task(train, cls, t["positives"], t["negatives_per_positive"], seed)
+            labels = [cls if p else negative_label(cls) for p in positive]
+            t0 = time.perf_counter()
+            fitted = system.fit([it.id for it in examples], labels, seed, positive=cls)
+            preds.append(fitted.predict(test_ids))
+            score = score_binary(preds[-1], test, cls)
+            score.update(n_pos=sum(positive), n_neg=len(positive) - sum(positive),
+                         seconds=round(time.perf_counter() - t0, 3))
+            scores.append(score)
+            save(fitted, cls, d)
+        keep(cls, scores, preds)
     if t["multiclass"]:
-        seed = task_seed(cfg["seed"], fold, len(classes))
-        examples = multiclass_task(train, t["positives"], seed)
-        t0 = time.perf_counter()
-        fitted = system.fit([it.id for it in examples], [it.cls for it in examples], seed)
-        preds = fitted.predict(test_ids)
-        correct = [label == it.cls for (label, _), it in zip(preds, test)]
-        record["tasks"]["multiclass"] = {"accuracy": float(np.mean(correct)), "n": len(correct),
-                                         "n_train": len(examples), "seconds": round(time.perf_counter() - t0, 3)}
-        record["predictions"]["multiclass"] = [[i, str(l), float(c)] for i, (l, c) in zip(test_ids, preds)]
-        if programs is not None:
-            fitted.save(programs / "multiclass")
+        scores, preds = [], []
+        for d in range(draws):
+            seed = task_seed(cfg["seed"], fold, len(classes), d)
+            examples = multiclass_task(train, t["positives"], seed)
+            t0 = time.perf_counter()
+            fitted = system.fit([it.id for it in examples], [it.cls for it in examples], seed)
+            preds.append(fitted.predict(test_ids))
+            correct = [label == it.cls for (label, _), it in zip(preds[-1], test)]
+            scores.append({"accuracy": float(np.mean(correct)), "n": len(correct), "n_train": len(examples),
+                           "seconds": round(time.perf_counter() - t0, 3)})
+            save(fitted, "multiclass", d)
+        keep("multiclass", scores, preds)
     return record
 
 

@@ -52,29 +52,26 @@ def _outline(poly: np.ndarray) -> np.ndarray:
     return clockwise(drop_short_sides(simplify(poly, keep_area_frac=_KEEP_AREA)))
 
 
-def _traced_parts(traced: np.ndarray, outline: np.ndarray, pieces: list[np.ndarray]) -> list[np.ndarray]:
-    """``pieces`` of ``outline`` (the corners of polygon ``traced``, cut along diagonals between its corners) as
-    pieces of ``traced`` itself: between two corners that neighbour on ``outline`` each piece runs through the
-    traced vertices there. The corners were chosen for the whole face: a bend holding a small part of it is
-    dropped, though it holds much of the thin part cut off."""
+def _traced_part(traced: np.ndarray, outline: np.ndarray, piece: np.ndarray) -> np.ndarray:
+    """``piece`` of ``outline`` (the corners of polygon ``traced``, cut along diagonals between its corners) as a
+    piece of ``traced`` itself: between two corners that neighbour on ``outline`` it runs through the traced
+    vertices there. The corners were chosen for the whole face: a bend holding a small part of it is dropped,
+    though it holds much of the thin part cut off."""
     t = clockwise(np.asarray(traced, np.float64))
     n = len(t)
     near = lambda q: [int(np.argmin(np.hypot(*(t - v).T))) for v in q]  # noqa: E731
     corners = near(outline)
-    out = []
-    for q in pieces:
-        idx = near(q)
-        run = []
-        for a, b in zip(idx, idx[1:] + idx[:1]):
-            run.append(a)
-            ia, ib = corners.index(a) if a in corners else -1, corners.index(b) if b in corners else -1
-            if ia >= 0 and ib == (ia + 1) % len(corners):  # a side of the outline, not a cut
-                k = (a + 1) % n
-                while k != b:
-                    run.append(k)
-                    k = (k + 1) % n
-        out.append(t[run])
-    return out
+    idx = near(piece)
+    run = []
+    for a, b in zip(idx, idx[1:] + idx[:1]):
+        run.append(a)
+        ia, ib = corners.index(a) if a in corners else -1, corners.index(b) if b in corners else -1
+        if ia >= 0 and ib == (ia + 1) % len(corners):  # a side of the outline, not a cut
+            k = (a + 1) % n
+            while k != b:
+                run.append(k)
+                k = (k + 1) % n
+    return t[run]
 
 
 def _touches_frame(poly: np.ndarray, box: tuple[int, int, int, int], tol: float = 3.0) -> float:
@@ -121,7 +118,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         if a < min_area_px or a > max_area_frac * w * h:
             continue
         poly = _outline(f.polygon)
-        if len(poly) < 3 or not is_simple(poly) or area(poly) < min_area_px:
+        a = area(poly) if len(poly) >= 3 else 0.0
+        if len(poly) < 3 or not is_simple(poly) or a < min_area_px:
             continue
         if _touches_frame(poly, frame) > 0.5:
             continue
@@ -133,7 +131,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         if by_gradient:
             pieces = split_by_diagonal(poly, grad, min_area_px)
         if len(pieces) == 1:
-            cands.append((poly, f.edges, sup, area(poly)))
+            cands.append((poly, f.edges, sup, a))
             continue
         # the cut is an edge the graph lacks: a shared made-up edge key makes the parts neighbours
         cut = (-1 - len(cands), -1 - len(cands))
@@ -141,11 +139,11 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
             image_cuts.add(cut)
         # split_by_diagonal may cut a non-convex outline across a notch: the part cut off lies outside the traced
         # face, its traced vertices are the notch's, and the parts do not tile the outline
-        tiled = abs(sum(area(q) for q in pieces) - area(poly)) <= _TILE_TOL * area(poly)
-        for q, traced in zip(pieces, _traced_parts(f.polygon, poly, pieces)):
+        tiled = abs(sum(area(q) for q in pieces) - a) <= _TILE_TOL * a
+        for q in pieces:
             # a thin part of a tiled outline keeps the bends of its traced outline where they hold much of its
-            # area and leave it convex (_traced_parts)
-            bent = _outline(traced) if tiled and mean_width(q) <= _THIN_PART_PX else None
+            # area and leave it convex (_traced_part)
+            bent = _outline(_traced_part(f.polygon, poly, q)) if tiled and mean_width(q) <= _THIN_PART_PX else None
             q = bent if bent is not None and not reflex_corners(bent) else _outline(q)
             qc = q.astype(np.float32).reshape(-1, 1, 2)
             own = frozenset(e for e in f.edges if cv2.pointPolygonTest(

@@ -89,3 +89,38 @@ def test_learner_settings_reach_the_learner(tmp_path, tiny_config, fake_world):
     run_study(tiny_config, tmp_path / "s", ["systems=[lv3d-rgb]", "folds=2", "lv3d.settings.sample_pos=99"],
               progress=False)
     assert fake_world.last_settings == {"sample_pos": 99}
+
+
+def test_draws_average_independent_samples_and_one_draw_keeps_the_old_keys(tmp_path, tiny_config, fake_world):
+    from lv3d.experiment.config import conditions, load_config
+    from lv3d.experiment.runner import result_key
+
+    one, three = tmp_path / "one", tmp_path / "three"
+    sets = ["systems=[tree-rgbd]", "train.positives=1"]
+    run_study(tiny_config, one, sets, progress=False)
+    run_study(tiny_config, three, sets + ["train.draws=3"], progress=False)
+    r1 = json.loads((one / "folds" / "base" / "tree-rgbd" / "fold0.json").read_text())
+    r3 = json.loads((three / "folds" / "base" / "tree-rgbd" / "fold0.json").read_text())
+    for task, sc in r3["tasks"].items():
+        # draw 0 is the one-draw sample; the score is the mean of the draws'
+        assert len(sc["per_draw"]) == 3 and sc["per_draw"][0] == r1["tasks"][task]["accuracy"]
+        assert abs(sc["accuracy"] - sum(sc["per_draw"]) / 3) < 1e-12
+        assert len(r3["predictions"][task]) == 3 and r3["predictions"][task][0] == r1["predictions"][task]
+    assert r3["tasks"]["cube"]["tp"] + r3["tasks"]["cube"]["fn"] == 3 * (r1["tasks"]["cube"]["tp"] + r1["tasks"]["cube"]["fn"])
+    # a study written before draws existed (no train.draws) has the key a one-draw study has now
+    cfg = load_config(tiny_config, sets)
+    ccfg = conditions(cfg, tiny_config)["base"]
+    before = {**ccfg, "train": {k: v for k, v in ccfg["train"].items() if k != "draws"}}
+    assert result_key(ccfg, "tree-rgbd", 0) == result_key(before, "tree-rgbd", 0)
+    assert result_key({**ccfg, "train": {**ccfg["train"], "draws": 3}}, "tree-rgbd", 0) != result_key(ccfg, "tree-rgbd", 0)
+
+
+def test_draws_must_be_a_positive_integer(tmp_path, tiny_config):
+    import pytest
+
+    from lv3d.errors import InputError
+    from lv3d.experiment.config import load_config
+
+    for bad in ("0", "1.5", "true"):
+        with pytest.raises(InputError, match="train.draws"):
+            load_config(tiny_config, [f"train.draws={bad}"])

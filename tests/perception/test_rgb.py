@@ -48,9 +48,9 @@ def test_box_limits_the_search():
     assert res.faces[0].polygon[:, 0].min() > 180
 
 
-def test_traced_parts_keep_the_traced_bends_between_outline_corners():
+def test_traced_part_keeps_the_traced_bends_between_outline_corners():
     from lv3d.perception.polygons import clockwise
-    from lv3d.perception.rgb import _traced_parts
+    from lv3d.perception.rgb import _traced_part
 
     # a wide face and a thin one merged: the bend at (104, 50) was simplified away from the merged outline,
     # which is cut along its diagonal a-c as the split functions cut (runs of the outline's corners)
@@ -59,7 +59,7 @@ def test_traced_parts_keep_the_traced_bends_between_outline_corners():
     outline = clockwise(np.array([(0.0, 0.0), (100.0, 0.0), (110.0, 100.0), (0.0, 100.0)]))
     i, j = sorted(int(np.argmin(np.hypot(*(outline - v).T))) for v in ((0.0, 0.0), (110.0, 100.0)))
     pieces = [outline[i:j + 1], np.concatenate([outline[j:], outline[:i + 1]])]
-    parts = _traced_parts(traced, outline, pieces)
+    parts = [_traced_part(traced, outline, q) for q in pieces]
     # the part holding (100, 0) runs through the bend; the other is its piece
     for q, part in zip(pieces, parts):
         if any(np.allclose(v, (100.0, 0.0)) for v in q):
