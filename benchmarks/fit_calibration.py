@@ -1,12 +1,13 @@
 """Fit the per-(modality, predicate) confidence calibration maps and write grounding/_calibration_table.py.
 
-The refit (docs/grounding.md, "Calibration on perceived scenes"; ~15 min on 2 busy cores):
+The refit (docs/grounding.md, "Calibration on perceived scenes"; session 12: ~5.5 min for the two 1050-scene
+fit sets in parallel on 2 cores, ~1.5 min for the 420-scene check set, ~2 min for the fit):
 
-    for a in "30000 50 a50" "31000 50 b50" "32000 30 c30"; do set -- $a; .venv/bin/python benchmarks/calibration_data.py \
-        --fresh --seed $1 --per-class $2 --modalities rgbd,depth --out out/calib/s6_$3.pkl & done; wait
-    .venv/bin/python benchmarks/fit_calibration.py out/calib/s6_a50.pkl out/calib/s6_b50.pkl --check out/calib/s6_c30.pkl
+    for a in "30000 150 a150" "40000 150 b150" "50000 60 c60"; do set -- $a; .venv/bin/python benchmarks/calibration_data.py \
+        --fresh --seed $1 --per-class $2 --modalities rgbd,depth --out out/calib/$3.pkl & done; wait
+    .venv/bin/python benchmarks/fit_calibration.py out/calib/a150.pkl out/calib/b150.pkl --check out/calib/c60.pkl
 
-For each (modality, predicate) four maps compete by 5-fold cross-validated log loss on the dev rows:
+For each (modality, predicate) four maps compete by scene-grouped 5-fold cross-validated log loss on the dev rows:
 the raw probability unchanged, a shift in logit space, Platt scaling (bias + slope on logit p), and Platt
 plus a few face measurements (``FEATURES``) and, for predicates with a tolerance, the measured value in
 tolerances (``tol_frac``); for facts about two faces (``PAIR_PREDS``) also that map plus the length of the side
@@ -108,14 +109,23 @@ def _fit_monotone(rows: list[dict], feats: list[str] | None):
     return b, c, feats
 
 
+def _scene_fold_of(seeds, seed: int) -> dict:
+    """{scene (its render seed): one of 5 folds} over the scenes of ``seeds``, seeded: every row of one scene
+    goes to the same fold. A scene's facts share its view and its perception errors; rows of one scene on both
+    sides of a split would reward a map for learning the scene rather than the fact type."""
+    scenes = np.unique(np.asarray(seeds))
+    return dict(zip(scenes.tolist(), np.random.default_rng(seed).permutation(len(scenes)) % 5))
+
+
 def fit_one(rows: list[dict], seed: int = 0):
-    """The best map for one (modality, predicate) by 5-fold CV log loss: (None (raw) or a table entry,
-    {map: CV log loss}, the winner's out-of-fold confidences (n,))."""
+    """The best map for one (modality, predicate) by scene-grouped 5-fold CV log loss (:func:`_scene_fold_of`):
+    (None (raw) or a table entry, {map: CV log loss}, the winner's out-of-fold confidences (n,))."""
     y = np.array([r["y"] for r in rows], float)
     p = np.array([r["p"] for r in rows])
     if len(rows) < MIN_ROWS:
         return None, {}, np.clip(p, 0, 1)
-    folds = np.random.default_rng(seed).permutation(len(rows)) % 5
+    fold = _scene_fold_of([r["seed"] for r in rows], seed)
+    folds = np.array([fold[r["seed"]] for r in rows])
     tol = ["tol_frac"] if rows[0]["pred"] in TOL_FRAC_PREDS else []  # the measured value in tolerances
     cands = {"raw": "raw", "shift": None, "platt": ["logit_p"], "platt+measures": ["logit_p"] + FEATURES + tol}
     if rows[0]["pred"] in PAIR_PREDS:
@@ -160,9 +170,8 @@ def _choose_final(oof: dict, pool: list[str], members: list[str], seed: int) -> 
     by scene-grouped 5-fold CV log loss on its own rows. Returns (pooled knots, {member: "pooled", None or
     own knots}, {member: {choice: CV log loss}}). Nothing outside ``pool`` enters the choice."""
     conf, y, seeds = (np.concatenate([oof[p][i] for p in pool]) for i in range(3))
-    scenes = np.unique(seeds)
-    fold = dict(zip(scenes, np.random.default_rng(seed).permutation(len(scenes)) % 5))
-    folds = np.array([fold[s] for s in seeds])
+    fold = _scene_fold_of(seeds, seed)
+    folds = np.array([fold[s] for s in seeds.tolist()])
     pooled = [_isotonic(conf[folds != k], y[folds != k]) for k in range(5)]
     choice, losses = {}, {}
     for pred in members:

@@ -1,5 +1,5 @@
-"""benchmarks/fit_calibration.fit_final: per type, the final map with the best scene-grouped CV log loss
-among none, the pooled isotonic map and the type's own."""
+"""benchmarks/fit_calibration: fit_final's choice per type of the final map with the best scene-grouped CV log
+loss among none, the pooled isotonic map and the type's own; the scene-grouped folds."""
 
 import numpy as np
 
@@ -20,3 +20,13 @@ def test_fit_final_gives_a_miscalibrated_type_its_own_map_and_leaves_a_calibrate
     assert np.interp(0.5, own["x"], own["y"]) < 0.25
     assert "calibrated" not in final["by_pred"] or final["by_pred"]["calibrated"] is None  # pooled would pull it down
     assert np.all(np.diff(final["x"]) >= 0) and np.all(np.diff(final["y"]) >= 0)
+
+
+def test_cross_validation_keeps_every_fact_of_a_scene_in_one_fold():
+    from benchmarks.fit_calibration import _scene_fold_of
+
+    seeds = np.repeat([30001, 30002, 31005, 40000, 40007, 40009, 50000], 9)
+    fold = _scene_fold_of(seeds.tolist(), 0)
+    assert set(fold) == set(seeds.tolist()) and set(fold.values()) <= set(range(5))
+    assert len(set(fold.values())) == 5                      # 7 scenes cover all 5 folds
+    assert _scene_fold_of(seeds[::-1].tolist(), 0) == fold   # the order of the rows does not matter
