@@ -14,6 +14,7 @@ from .polygons import (area, clockwise, drop_short_sides, is_simple, mean_width,
                        sample_boundary, simplify)
 from .segments import detect_color_segments, union_find_labels
 from .split import reflex_corners, split_by_diagonal, split_concave
+from .step_edge import smoothed_gradients, step_cut
 from .thin import thin_faces
 
 
@@ -89,11 +90,16 @@ def _contains(outer: np.ndarray, inner: np.ndarray) -> bool:
 
 
 def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, min_area_px: float = 150.0,
-              max_area_frac: float = 0.35, min_support: float = 0.55) -> RGBResult:
+              max_area_frac: float = 0.35, min_support: float = 0.55, faint_cuts: bool = False) -> RGBResult:
     """Faces in the colour image (H, W, 3) uint8 RGB, or only inside ``box`` = (u0, v0, u1, v1) pixels
     (a crop around an object found in depth). Faces smaller than ``min_area_px``, larger than ``max_area_frac``
     of the searched area, hugging its frame, non-simple, poorly supported by edges (< ``min_support`` of the
-    perimeter), or containing another face (a background region around an object) are dropped."""
+    perimeter), or containing another face (a background region around an object) are dropped. With
+    ``faint_cuts`` (colour alone, no depth to part faces), a kept face whose outline the graph traced whole is cut
+    along a faint straight edge from one of its corners (step_edge.step_cut): most colour-only misses on noisy
+    renders are two faces of one colour traced as one. With depth (rgbd), the planes part such faces; cut there
+    too, the colour part that keeps a thin neighbour's strip outvotes that neighbour's plane (realsense rgbd
+    recall fell by one face on dev seeds 1000 and 2000)."""
     import time
 
     t0 = time.perf_counter()
@@ -131,7 +137,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         if by_gradient:
             pieces = split_by_diagonal(poly, grad, min_area_px)
         if len(pieces) == 1:
-            cands.append((poly, f.edges, sup, a))
+            cands.append((poly, f.edges, sup, a, True))
             continue
         # the cut is an edge the graph lacks: a shared made-up edge key makes the parts neighbours
         cut = (-1 - len(cands), -1 - len(cands))
@@ -145,14 +151,23 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
             # area and leave it convex (_traced_part)
             bent = _outline(_traced_part(f.polygon, poly, q)) if tiled and mean_width(q) <= _THIN_PART_PX else None
             q = bent if bent is not None and not reflex_corners(bent) else _outline(q)
-            qc = q.astype(np.float32).reshape(-1, 1, 2)
-            own = frozenset(e for e in f.edges if cv2.pointPolygonTest(
-                qc, tuple(float(x) for x in 0.5 * (g.vertices[e[0]] + g.vertices[e[1]])), True) >= -2.0)
-            cands.append((q, own | {cut}, edge_support(q, dist), area(q)))
+            cands.append(_part(q, f.edges, cut, g.vertices, dist) + (False,))
     # a face that contains another kept face is a region around it (table, wall), not an object face
     keep = [not any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
                     for j in range(len(cands))) for i in range(len(cands))]
-    cands = _join_on_graph_edges([c for c, k in zip(cands, keep) if k], g.vertices, dist, image_cuts)
+    sgrads = smoothed_gradients(chans) if faint_cuts else None
+    kept = []
+    for (poly, es, sup, a, whole), k in zip(cands, keep):
+        if not k:
+            continue
+        parts = step_cut(poly, sgrads, min_area_px) if faint_cuts and whole else None
+        if parts is None:
+            kept.append((poly, es, sup, a))
+            continue
+        cut = (-5000 - len(kept), -5000 - len(kept))
+        image_cuts.add(cut)
+        kept += [_part(q, es, cut, g.vertices, dist) for q in map(_outline, parts)]
+    cands = _join_on_graph_edges(kept, g.vertices, dist, image_cuts)
     n_traced = len(cands)
     cands += _thin_cands(cands, segs, dist, min_area_px)
     cands = _join_thin_to_traced(cands, n_traced, dist)
@@ -168,6 +183,16 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     t3 = time.perf_counter()
     timings = {"edges": (t1 - t0) * 1e3, "segments": (t2 - t1) * 1e3, "faces": (t3 - t2) * 1e3}
     return RGBResult(faces, ordered, adjacency, timings, dist)
+
+
+def _part(q: np.ndarray, edges: frozenset, cut: tuple[int, int], vertices: np.ndarray, dist: np.ndarray) -> tuple:
+    """A part ``q`` of a cut traced face as a candidate (polygon, graph edges, edge support, area): it keeps the
+    face's ``edges`` whose midpoints lie on or within 2 px of it, and the made-up key ``cut`` it shares with the
+    other parts."""
+    qc = q.astype(np.float32).reshape(-1, 1, 2)
+    own = frozenset(e for e in edges if cv2.pointPolygonTest(
+        qc, tuple(float(x) for x in 0.5 * (vertices[e[0]] + vertices[e[1]])), True) >= -2.0)
+    return (q, own | {cut}, edge_support(q, dist), area(q))
 
 
 def _join_on_graph_edges(cands: list, vertices: np.ndarray, dist: np.ndarray,
