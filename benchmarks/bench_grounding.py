@@ -8,8 +8,9 @@
 Per preset (rgbd perception of the target object): median vertex error (px) of faces whose side count is
 right and median interior-dihedral error (deg) of truly adjacent faces, without and with refinement;
 expected calibration error (ECE, 10 bins) of every emitted fact type against the predicate evaluated on
-the ground truth (a fact on a face that matches no true face is false), and a reliability diagram
-(PNG under --out); the model-error floor each quantity would need (docs/grounding.md). Then speed:
+the ground truth (a fact on a face that matches no true face is false), beside the ECE a perfectly calibrated
+type shows by chance (facts drawn one by one) and a 95% interval of the ECE over scenes drawn with replacement
+(a scene's facts are not independent), and a reliability diagram (PNG under --out); the model-error floor each quantity would need (docs/grounding.md). Then speed:
 refinement + facts per 640x480 frame on one core after warm-up (median over --speed-runs processes, each
 timing --speed-frames - 1 frames twice), and the first call in each new process with a warm compilation
 cache. Targets from the issue are printed beside the figures.
@@ -31,7 +32,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.calibration_error import chance_ece, ece, reliability_bins  # noqa: E402
+from benchmarks.calibration_error import chance_ece, ece, reliability_bins, scene_interval  # noqa: E402
 from benchmarks.grounding_truth import match_faces, truth_labels, truth_quantities, truth_scene  # noqa: E402
 from lv3d.describe import MIN_CONF, ground  # noqa: E402
 from lv3d.perception import perceive  # noqa: E402
@@ -92,7 +93,7 @@ def run_preset(preset: str, per_class: int, seed0: int, source: str = "perceived
                     labels = truth_labels(cands, results, faces_mask, truth, frame.intrinsics)
                     for (pred, args, p, value), y in zip(cands, labels):
                         if y is not None and p >= MIN_CONF and pred in _modal_preds("rgbd"):
-                            stats["facts"][pred].append((min(p, 1.0), float(y)))
+                            stats["facts"][pred].append((min(p, 1.0), float(y), seed))
                             if DEBUG and abs(p - y) > 0.7:
                                 print(f"    miss {cls} {seed} {pred}{args} p={p:.2f} value={value} truth={y}")
     return stats
@@ -131,7 +132,7 @@ def reliability_png(facts: dict, path: Path, title: str) -> None:
     for pred, rows in sorted(facts.items()):
         if len(rows) < 5:
             continue
-        p, y = np.array(rows).T
+        p, y, _ = np.array(rows).T
         edges = np.linspace(0, 1, 11)
         idx = np.minimum((p * 10).astype(int), 9)
         xs = [p[idx == b].mean() for b in range(10) if np.any(idx == b)]
@@ -215,15 +216,17 @@ def main(argv=None) -> int:
                   f"(n={len(st[key][True])}), cut {cut:.1%}{tgt}")
         allp = [r for rows in st["facts"].values() for r in rows]
         for pred, rows in sorted(st["facts"].items()):
-            p, y = np.array(rows).T
+            p, y, scenes = np.array(rows).T
             e = ece(p, y)
+            lo, hi = scene_interval(p, y, scenes)
             tgt = f"  (target <= {ECE_TARGET}: {'met' if e <= ECE_TARGET else 'NOT met'})" if preset == "realsense" else ""
-            print(f"  ECE {pred:14s} {e:.3f}  n={len(p):4d}  chance {chance_ece(p):.3f}  mean conf {p.mean():.2f}  true {y.mean():.2f}{tgt}")
+            print(f"  ECE {pred:14s} {e:.3f}  n={len(p):4d}  chance {chance_ece(p):.3f}  scenes 95% {lo:.3f}-{hi:.3f}  "
+                  f"mean conf {p.mean():.2f}  true {y.mean():.2f}{tgt}")
             if pred in a.bins.split(","):
                 for lo, n, conf, true in reliability_bins(p, y):
                     print(f"      [{lo:.1f}, {lo + 0.1:.1f})  n={n:4d}  conf {conf:.2f}  true {true:.2f}")
         if allp:
-            p, y = np.array(allp).T
+            p, y, _ = np.array(allp).T
             print(f"  ECE all facts      {ece(p, y):.3f}  n={len(p)}")
         png = a.out / f"reliability_{preset}_{source}.png"
         reliability_png(st["facts"], png, f"grounding calibration, {preset}, {source} scenes, rgbd")

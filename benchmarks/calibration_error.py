@@ -31,3 +31,23 @@ def chance_ece(p: np.ndarray, bins: int = 10, draws: int = 400, seed: int = 0) -
         return float("nan")
     rng = np.random.default_rng(seed)
     return float(np.mean([ece(p, rng.random(len(p)) < p, bins) for _ in range(draws)]))
+
+
+def scene_interval(p: np.ndarray, y: np.ndarray, scenes: np.ndarray, bins: int = 10, level: float = 0.95,
+                   draws: int = 1000, seed: int = 0) -> tuple[float, float]:
+    """Percentile interval of :func:`ece` over sets of facts made by drawing whole scenes with replacement
+    (``scenes`` (n,): the scene of each fact). A scene's facts share its view and its perception errors, so they
+    are not independent draws: this interval, unlike :func:`chance_ece`, carries that. An interval wholly above a
+    target says the type misses it on scenes like these, not only on this sample."""
+    p, y, scenes = np.asarray(p, float), np.asarray(y, float), np.asarray(scenes)
+    if len(p) == 0:
+        return float("nan"), float("nan")
+    ids, idx = np.unique(scenes, return_inverse=True)
+    members = [np.flatnonzero(idx == k) for k in range(len(ids))]
+    rng = np.random.default_rng(seed)
+    vals = []
+    for _ in range(draws):
+        take = np.concatenate([members[k] for k in rng.integers(0, len(ids), len(ids))])
+        vals.append(ece(p[take], y[take], bins))
+    lo, hi = np.quantile(vals, [(1 - level) / 2, (1 + level) / 2])
+    return float(lo), float(hi)

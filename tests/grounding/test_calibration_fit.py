@@ -30,3 +30,19 @@ def test_cross_validation_keeps_every_fact_of_a_scene_in_one_fold():
     assert set(fold) == set(seeds.tolist()) and set(fold.values()) <= set(range(5))
     assert len(set(fold.values())) == 5                      # 7 scenes cover all 5 folds
     assert _scene_fold_of(seeds[::-1].tolist(), 0) == fold   # the order of the rows does not matter
+
+
+def test_scene_interval_widens_when_a_scene_s_facts_go_together():
+    from benchmarks.calibration_error import ece, scene_interval
+
+    rng = np.random.default_rng(1)
+    n_scenes, per = 60, 8
+    p = np.full(n_scenes * per, 0.7)
+    own = (rng.random(n_scenes * per) < p).astype(float)                         # each fact on its own
+    shared = np.repeat((rng.random(n_scenes) < 0.7).astype(float), per)         # a scene's facts all true or all false
+    apart, together = np.arange(n_scenes * per), np.repeat(np.arange(n_scenes), per)
+    lo_a, hi_a = scene_interval(p, own, apart)
+    lo_t, hi_t = scene_interval(p, shared, together)
+    assert lo_a <= ece(p, own) <= hi_a and lo_t <= ece(p, shared) <= hi_t
+    assert hi_t - lo_t > 2 * (hi_a - lo_a)      # 60 independent draws, not 480
+    assert scene_interval(p, shared, together) == (lo_t, hi_t)                  # seeded
