@@ -66,7 +66,20 @@ def summarise(out: Path, cfg: dict) -> tuple[dict, list[dict]]:
         if common:
             t = paired([cells[a][c] for c in common], [cells[b][c] for c in common])
             summary["tests"].append({"a": a, "b": b, "cells": len(common), **t})
+    summary["against_best_cnn"] = _against_best_cnn(summary)
     return summary, rows
+
+
+def _against_best_cnn(summary: dict) -> dict | None:
+    """The paired test of the best-seeing lv3d system against the CNN with the highest mean binary accuracy (the
+    issue's margin: lv3d at least 20 points above the CNN), or None when the study has no such test."""
+    logic = [s for s in LOGIC_SYSTEMS if s in summary["systems"]]
+    cnns = [s for s, per in summary["systems"].items() if s.startswith("cnn-") and not math.isnan(per["mean"]["mean"])]
+    if not logic or not cnns:
+        return None
+    best = max(cnns, key=lambda s: summary["systems"][s]["mean"]["mean"])
+    test = next((t for t in summary["tests"] if (t["a"], t["b"]) == (logic[-1], best)), None)
+    return None if test is None else {**test, "cnn_mean": summary["systems"][best]["mean"]["mean"]}
 
 
 def _pct(x: dict) -> str:
@@ -97,6 +110,11 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
                 lines.append(f"| {t['a']} | {t['b']} | {t['cells']} | {100 * t['mean_diff']:+.1f} | "
                              f"{100 * lo:+.1f} to {100 * hi:+.1f} | {sg['wins']} | "
                              f"{sg['losses']} | {sg['ties']} | {sg['p']:.4g} | {t['wilcoxon']['p']:.4g} |")
+        best = summ.get("against_best_cnn")
+        if best:
+            lo, hi = best["ci95"]
+            lines += ["", f"{best['a']} against the best CNN here ({best['b']}, {100 * best['cnn_mean']:.1f}): "
+                      f"{100 * best['mean_diff']:+.1f} points, 95% interval {100 * lo:+.1f} to {100 * hi:+.1f}."]
         lines.append("")
     versions = sorted({v for summ in summaries.values() for per in summ["systems"].values() for v in per.get("code", [])})
     if versions:

@@ -33,6 +33,9 @@ def test_run_writes_folds_report_and_programs(tmp_path, tiny_config, fake_world)
     assert "| lv3d-rgbd | 100.0 ± 0.0" in md and "tree-rgbd" in md and "sign p" in md
     summary = json.loads((out / "results.json").read_text())["conditions"]["base"]
     assert [t["a"] for t in summary["tests"]][:1] == ["lv3d-rgbd"]
+    # the margin: the best-seeing lv3d system against the best CNN (the only one here)
+    best = summary["against_best_cnn"]
+    assert (best["a"], best["b"]) == ("lv3d-rgbd", "cnn-rgb") and "lv3d-rgbd against the best CNN here (cnn-rgb" in md
 
 
 def test_rerun_skips_finished_folds(tmp_path, tiny_config, fake_world):
