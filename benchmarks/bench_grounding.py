@@ -10,7 +10,8 @@ right and median interior-dihedral error (deg) of truly adjacent faces, without 
 expected calibration error (ECE, 10 bins) of every emitted fact type against the predicate evaluated on
 the ground truth (a fact on a face that matches no true face is false), beside the ECE a perfectly calibrated
 type shows by chance (facts drawn one by one) and a 95% interval of the ECE over scenes drawn with replacement
-(a scene's facts are not independent), and a reliability diagram (PNG under --out); the model-error floor each quantity would need (docs/grounding.md). Then speed:
+(a scene's facts are not independent), and a reliability diagram (PNG under --out); the model-error floor each
+quantity would need (docs/grounding.md). Then speed:
 refinement + facts per 640x480 frame on one core after warm-up (median over --speed-runs processes, each
 timing --speed-frames - 1 frames twice), and the first call in each new process with a warm compilation
 cache. Targets from the issue are printed beside the figures.
