@@ -26,12 +26,18 @@ def _load(out: Path, cond: str, system: str, folds: int) -> list[dict]:
     return recs
 
 
+def _best_seeing(systems) -> str | None:
+    """lv3d-rgbd, or the lv3d system of ``systems`` that sees most (LOGIC_SYSTEMS is ordered rgb, depth, rgbd)."""
+    logic = [s for s in LOGIC_SYSTEMS if s in systems]
+    return logic[-1] if logic else None
+
+
 def default_pairs(systems: list[str]) -> list[list[str]]:
     """Every pair of lv3d systems, then lv3d-rgbd (or the best-seeing lv3d system) against each baseline."""
     logic = [s for s in LOGIC_SYSTEMS if s in systems]
     pairs = [[a, b] for i, a in enumerate(logic[::-1]) for b in logic[::-1][i + 1:]]
     if logic:
-        pairs += [[logic[-1], s] for s in systems if s not in LOGIC_SYSTEMS]
+        pairs += [[_best_seeing(systems), s] for s in systems if s not in LOGIC_SYSTEMS]
     return pairs
 
 
@@ -73,12 +79,12 @@ def summarise(out: Path, cfg: dict) -> tuple[dict, list[dict]]:
 def _against_best_cnn(summary: dict) -> dict | None:
     """The paired test of the best-seeing lv3d system against the CNN with the highest mean binary accuracy (the
     issue's margin: lv3d at least 20 points above the CNN), or None when the study has no such test."""
-    logic = [s for s in LOGIC_SYSTEMS if s in summary["systems"]]
+    lv3d = _best_seeing(summary["systems"])
     cnns = [s for s, per in summary["systems"].items() if s.startswith("cnn-") and not math.isnan(per["mean"]["mean"])]
-    if not logic or not cnns:
+    if lv3d is None or not cnns:
         return None
     best = max(cnns, key=lambda s: summary["systems"][s]["mean"]["mean"])
-    test = next((t for t in summary["tests"] if (t["a"], t["b"]) == (logic[-1], best)), None)
+    test = next((t for t in summary["tests"] if (t["a"], t["b"]) == (lv3d, best)), None)
     return None if test is None else {**test, "cnn_mean": summary["systems"][best]["mean"]["mean"]}
 
 
