@@ -3,12 +3,13 @@ plus the thin faces beside them that the graph cannot trace (thin.py), grouped i
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
 
-from .edges import channels, edge_distance, edge_support, edges_and_gradient
+from .edges import channel_edges, channels, edge_distance, edge_support
 from .faces import bounded_faces, build_graph
 from .polygons import (area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
                        sample_boundary, simplify)
@@ -107,9 +108,9 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     u0, v0, u1, v1 = box if box is not None else (0, 0, w, h)
     crop = np.ascontiguousarray(color[v0:v1, u0:u1])
     chans = channels(crop)
-    per_channel = [edges_and_gradient(c) for c in chans]
-    edges = np.maximum.reduce([e for e, _ in per_channel])
-    grad = np.maximum.reduce([g for _, g in per_channel])  # for cutting merged faces (split.py)
+    per_channel = [channel_edges(c) for c in chans]
+    edges = np.maximum.reduce([c.edges for c in per_channel])
+    grad = np.maximum.reduce([c.magnitude for c in per_channel])  # for cutting merged faces (split.py)
     dist = edge_distance(edges)
     t1 = time.perf_counter()
     segs = detect_color_segments(chans)
@@ -118,10 +119,13 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     cw, ch = u1 - u0, v1 - v0
     frame = (0, 0, cw - 1, ch - 1)
     cands = []
-    image_cuts = set()  # made-up keys of cuts along an image edge (split_by_diagonal): never joined back
+    # made-up edge keys (k, k), k < 0: a cut the graph lacks, shared by the parts either side of it (so that they
+    # count as neighbours), or a thin face's contact with the faces beside it (_thin_cands)
+    made_up = itertools.count(-1, -1)
+    image_cuts = set()  # made-up keys of cuts along an image edge (split_by_diagonal, step_cut): never joined back
     for f in bounded_faces(g):
-        a = area(f.polygon)
-        if a < min_area_px or a > max_area_frac * w * h:
+        traced_area = area(f.polygon)
+        if traced_area < min_area_px or traced_area > max_area_frac * w * h:
             continue
         poly = _outline(f.polygon)
         a = area(poly) if len(poly) >= 3 else 0.0
@@ -140,7 +144,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
             cands.append((poly, f.edges, sup, a, True))
             continue
         # the cut is an edge the graph lacks: a shared made-up edge key makes the parts neighbours
-        cut = (-1 - len(cands), -1 - len(cands))
+        k = next(made_up)
+        cut = (k, k)
         if by_gradient:
             image_cuts.add(cut)
         # split_by_diagonal may cut a non-convex outline across a notch: the part cut off lies outside the traced
@@ -153,23 +158,27 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
             q = bent if bent is not None and not reflex_corners(bent) else _outline(q)
             cands.append(_part(q, f.edges, cut, g.vertices, dist) + (False,))
     # a face that contains another kept face is a region around it (table, wall), not an object face
-    keep = [not any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
-                    for j in range(len(cands))) for i in range(len(cands))]
-    sgrads = smoothed_gradients(chans) if faint_cuts else None
+    region = [any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
+                  for j in range(len(cands))) for i in range(len(cands))]
+    sgrads = None  # the colour's smoothed derivatives (step_edge), taken when a whole traced face is first kept
     kept = []
-    for (poly, es, sup, a, whole), k in zip(cands, keep):
-        if not k:
+    for (poly, es, sup, a, whole), around in zip(cands, region):
+        if around:
             continue
-        parts = step_cut(poly, sgrads, min_area_px) if faint_cuts and whole else None
+        parts = None
+        if faint_cuts and whole:
+            sgrads = smoothed_gradients(chans) if sgrads is None else sgrads
+            parts = step_cut(poly, sgrads, min_area_px)
         if parts is None:
             kept.append((poly, es, sup, a))
             continue
-        cut = (-5000 - len(kept), -5000 - len(kept))
+        k = next(made_up)
+        cut = (k, k)
         image_cuts.add(cut)
         kept += [_part(q, es, cut, g.vertices, dist) for q in map(_outline, parts)]
     cands = _join_on_graph_edges(kept, g.vertices, dist, image_cuts)
     n_traced = len(cands)
-    cands += _thin_cands(cands, segs, dist, min_area_px)
+    cands += _thin_cands(cands, segs, dist, min_area_px, made_up)
     cands = _join_thin_to_traced(cands, n_traced, dist)
     faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for p, e, s, a in cands]
     faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
@@ -274,13 +283,15 @@ def _touch_length(a: np.ndarray, b: np.ndarray, tol_px: float) -> float:
     return float(np.count_nonzero(d <= tol_px))
 
 
-def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: float,
+def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: float, made_up,
                 touch_px: float = 2.5) -> list:
-    """Thin faces (thin.py) beside the kept candidates, as candidates: each shares a made-up edge key with every
-    candidate whose outline runs within ``touch_px`` of its own, so that they group and count as neighbours."""
+    """Thin faces (thin.py) beside the kept candidates, as candidates: each shares a made-up edge key (the next of
+    ``made_up``) with every candidate whose outline runs within ``touch_px`` of its own, so that they group and
+    count as neighbours."""
     out = []
-    for k, q in enumerate(thin_faces(segs, dist, [c[0] for c in cands], min_area_px)):
-        key = (-10_000 - k, -10_000 - k)
+    for q in thin_faces(segs, dist, [c[0] for c in cands], min_area_px):
+        k = next(made_up)
+        key = (k, k)
         pts = sample_boundary(q, 1.0)
         for n, c in enumerate(cands):
             if np.mean(outline_distance(pts, c[0]) <= touch_px) >= 0.15:

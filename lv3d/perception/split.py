@@ -16,15 +16,6 @@ import numpy as np
 from .polygons import area, outline_distance, pixel_values, signed_area
 
 
-def gradient_magnitude(channels: list[np.ndarray]) -> np.ndarray:
-    """Largest Sobel gradient magnitude (H, W) float32 over the given grey channels (H, W) uint8."""
-    out = None
-    for c in channels:
-        m = cv2.magnitude(cv2.Sobel(c, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(c, cv2.CV_32F, 0, 1, ksize=3))
-        out = m if out is None else np.maximum(out, m)
-    return out
-
-
 def reflex_corners(poly: np.ndarray, tol_deg: float = 4.0) -> list[int]:
     """Indices of the corners of ``poly`` (n, 2) where it turns against its orientation by more than
     ``tol_deg`` degrees."""

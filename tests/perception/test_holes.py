@@ -1,7 +1,7 @@
 import cv2
 import numpy as np
 
-from lv3d.perception.edges import channels, edge_distance, edges_and_gradient
+from lv3d.perception.edges import channel_edges, channels, edge_distance
 from lv3d.perception.holes import hole_faces
 from lv3d.perception.polygons import rasterize
 
@@ -16,7 +16,7 @@ def _dist(strip_colour=(60, 20, 20)) -> np.ndarray:
     cv2.fillPoly(img, [OBJECT.astype(np.int32)], (160, 60, 60))
     cv2.fillPoly(img, [STRIP.astype(np.int32)], strip_colour)
     img = np.clip(img + np.random.default_rng(0).normal(0.0, 2.0, img.shape), 0, 255).astype(np.uint8)
-    return edge_distance(np.maximum.reduce([edges_and_gradient(c)[0] for c in channels(img)]))
+    return edge_distance(np.maximum.reduce([channel_edges(c).edges for c in channels(img)]))
 
 
 def _iou(a: np.ndarray, b: np.ndarray) -> float:

@@ -2,8 +2,14 @@ import cv2
 import numpy as np
 
 from lv3d.perception.polygons import area, drop_short_sides
-from lv3d.perception.split import (_diagonal_samples, _mean_clear_of_outline, gradient_magnitude, reflex_corners,
-                                   split_by_diagonal, split_concave)
+from lv3d.perception.edges import channel_edges
+from lv3d.perception.split import (_diagonal_samples, _mean_clear_of_outline, reflex_corners, split_by_diagonal,
+                                   split_concave)
+
+
+def gradient_magnitude(chans: list[np.ndarray]) -> np.ndarray:
+    """The colour path's gradient for split.py (rgb.rgb_faces): the largest Sobel magnitude over the channels."""
+    return np.maximum.reduce([channel_edges(c).magnitude for c in chans])
 
 
 def _image(polys_colours, shape=(200, 200), background=90):

@@ -1,7 +1,7 @@
 import cv2
 import numpy as np
 
-from lv3d.perception.edges import channels, edge_distance, edges_and_gradient
+from lv3d.perception.edges import channel_edges, channels, edge_distance
 from lv3d.perception.polygons import rasterize
 from lv3d.perception.thin import thin_faces
 
@@ -21,7 +21,7 @@ def _image(with_sliver: bool = True) -> np.ndarray:
 
 
 def _dist(img: np.ndarray) -> np.ndarray:
-    return edge_distance(np.maximum.reduce([edges_and_gradient(c)[0] for c in channels(img)]))
+    return edge_distance(np.maximum.reduce([channel_edges(c).edges for c in channels(img)]))
 
 
 def test_sliver_beside_found_faces_is_closed_from_their_corners():

@@ -1,0 +1,87 @@
+"""Restore a study's baseline fold files from its committed ``results.csv``, so that rerunning the study
+after a change to lv3d's code retrains only the lv3d systems (the baselines' fold results do not depend
+on lv3d's code: ``lv3d/experiment/code_version.py``).
+
+    .venv/bin/python scripts/restore_baselines.py experiments/seed_protocol.yaml \\
+        experiments/results/seed_protocol/results.csv --out runs/seed_protocol
+    .venv/bin/lv3d experiment run experiments/seed_protocol.yaml --out runs/seed_protocol
+
+Each restored fold file carries the key the runner computes for that system and fold under the
+config as it is now, so the runner skips it; it holds what the report reads (per task: accuracy,
+balanced accuracy, test size, seconds), not the predictions, and says it was restored. Pass the
+same ``--set`` overrides as the run. A config whose conditions, systems or folds do not match the
+CSV stops with an error naming both files.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from lv3d.errors import InputError  # noqa: E402
+from lv3d.experiment.config import conditions, load_config  # noqa: E402
+from lv3d.experiment.runner import _write_json, fold_path, result_key  # noqa: E402
+from lv3d.experiment.config import LOGIC_SYSTEMS  # noqa: E402
+
+
+def read_rows(path: Path) -> dict[tuple[str, str, int], dict[str, dict]]:
+    """(condition, system, fold) -> task -> the task's scores, for the baseline rows of a results.csv."""
+    if not path.is_file():
+        raise InputError(path, "results file not found")
+    cells: dict[tuple[str, str, int], dict[str, dict]] = defaultdict(dict)
+    with path.open(newline="") as f:
+        for row in csv.DictReader(f):
+            if row["system"] in LOGIC_SYSTEMS:
+                continue
+            bal = row["balanced_accuracy"]
+            cells[(row["condition"], row["system"], int(row["fold"]))][row["task"]] = {
+                "accuracy": float(row["accuracy"]), "balanced_accuracy": float(bal) if bal else None,
+                "n": int(row["n"]), "seconds": float(row["seconds"])}
+    return cells
+
+
+def restore(config: Path, results: Path, out: Path, overrides: list[str] = ()) -> int:
+    """Write the baseline fold files of ``config``'s run into ``out`` from ``results``; returns how many."""
+    cfg = load_config(config, list(overrides))
+    cells = read_rows(results)
+    written = 0
+    for cname, ccfg in conditions(cfg, config).items():
+        for s in ccfg["systems"]:
+            if s in LOGIC_SYSTEMS:
+                continue
+            for k in range(ccfg["folds"]):
+                tasks = cells.get((cname, s, k))
+                if not tasks:
+                    raise InputError(results, f"no rows for condition {cname!r}, system {s!r}, fold {k} of {config}")
+                tasks = {t: {n: v for n, v in sc.items() if v is not None} for t, sc in tasks.items()}
+                _write_json(fold_path(out, cname, s, k), {
+                    "key": result_key(ccfg, s, k), "condition": cname, "system": s, "fold": k, "tasks": tasks,
+                    "seconds": round(sum(sc["seconds"] for sc in tasks.values()), 3), "pipeline_errors": {},
+                    "code": None, "restored_from": str(results)})
+                written += 1
+    return written
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("config", type=Path)
+    ap.add_argument("results", type=Path, help="the study's committed results.csv")
+    ap.add_argument("--out", type=Path, required=True, help="the run folder the study will be run into")
+    ap.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
+    args = ap.parse_args(argv)
+    try:
+        n = restore(args.config, args.results, args.out, args.overrides)
+    except InputError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    print(f"restored {n} baseline fold files into {args.out / 'folds'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
