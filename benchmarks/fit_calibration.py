@@ -11,7 +11,8 @@ For each (modality, predicate) four maps compete by scene-grouped 5-fold cross-v
 the raw probability unchanged, a shift in logit space, Platt scaling (bias + slope on logit p), and Platt
 plus a few face measurements (``FEATURES``) and, for predicates with a tolerance, the measured value in
 tolerances (``tol_frac``); for facts about two faces (``PAIR_PREDS``) also that map plus the length of the side
-the two faces share (``PAIR_FEATURES``). The winner is refitted on all rows (L2-regularised logistic regression,
+the two faces share (``PAIR_FEATURES``), and for parallel (``PLANE_GAP_PREDS``) that map plus how far the two faces
+are from one plane (``PLANE_GAP_FEATURES``). The winner is refitted on all rows (L2-regularised logistic regression,
 measurements standardised, the standardisation folded into the coefficients). A map whose slope on
 logit p comes out negative is not used (confidence must grow with the measured probability). Then the
 final map (``FINAL``) of out-of-fold confidences: per modality one isotonic map of every type pooled, one of
@@ -52,6 +53,10 @@ SUPPORT_PREDS = ("face_of", "adjacent", "object")
 # touching at the apex); not parallel: ~60 fit rows, and out of sample it made parallel's log loss worse
 PAIR_PREDS = ("adjacent", "acute", "obtuse", "perpendicular")
 PAIR_FEATURES = ["shared_side_px"]
+# facts about two planes whose map may also read how far the two faces are from one plane: parallel facts that
+# hold are mostly two pieces of one face, a few mm apart (docs/grounding.md, session 14)
+PLANE_GAP_PREDS = ("parallel",)
+PLANE_GAP_FEATURES = ["plane_gap_mm"]
 # facts about one face: their final maps are chosen on their rows alone (fit_final)
 FACE_PREDS = tuple(p for p, (arity, _) in PREDICATES.items() if arity == 1 and p != "object")
 
@@ -130,6 +135,8 @@ def fit_one(rows: list[dict], seed: int = 0):
     cands = {"raw": "raw", "shift": None, "platt": ["logit_p"], "platt+measures": ["logit_p"] + FEATURES + tol}
     if rows[0]["pred"] in PAIR_PREDS:
         cands["platt+measures+shared"] = ["logit_p"] + FEATURES + PAIR_FEATURES + tol
+    if rows[0]["pred"] in PLANE_GAP_PREDS:
+        cands["platt+measures+gap"] = ["logit_p"] + FEATURES + PLANE_GAP_FEATURES + tol
     if rows[0]["pred"] in SUPPORT_PREDS:  # p is edge support, not a geometric probability: may be ignored
         cands["const"] = []
     losses, oof = {}, {}

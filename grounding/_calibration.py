@@ -41,9 +41,9 @@ def logit(p: float) -> float:
 
 
 # measurements on tame scales: a corner's turn in spreads clipped (a 40-spread corner is no surer than a
-# 20-spread one), the shortest side as a log; absent measurements (e.g. of `object`) read as 0
+# 20-spread one), lengths as logs; absent measurements (e.g. of `object`) read as 0
 _SCALE = {"min_turn_z": lambda v: min(max(v, -5.0), 20.0), "min_side_px": lambda v: math.log(max(v, 1.0)),
-          "shared_side_px": lambda v: math.log(max(v, 1.0))}
+          "shared_side_px": lambda v: math.log(max(v, 1.0)), "plane_gap_mm": lambda v: math.log(max(v, 1.0))}
 
 # "tol_frac": the fact's measured value (describe's candidate value) as a fraction of its predicate's
 # tolerance, 1 at the boundary, below 1 inside it. The Gaussian probability reads the same value in units of

@@ -334,13 +334,24 @@ def shared_side_px(a: np.ndarray, b: np.ndarray) -> float:
     return best
 
 
+def plane_gap_mm(a: FaceResult, b: FaceResult) -> float | None:
+    """How far two faces are from lying on one plane: the larger of the distances (mm) of each face's depth
+    points' centroid from the other's refined plane; None unless both have a plane. Two pieces of one face (a face
+    perception split) lie a few mm apart, two faces of a solid centimetres."""
+    if a.plane is None or b.plane is None:
+        return None
+    ca, cb = a.face.points.mean(axis=0), b.face.points.mean(axis=0)
+    return 1e3 * max(abs(float(ca @ b.plane[:3] + b.plane[3])), abs(float(cb @ a.plane[:3] + a.plane[3])))
+
+
 def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]:
     """Per candidate the face measurements its calibration may read (:func:`_face_features`); for a fact
-    about two faces, the weaker of each (smaller value) and the length of the side they share
-    (``shared_side_px``, :func:`shared_side_px`), for ``object`` the object's best face; and, for a
-    candidate with a measured value, that value as ``value``."""
+    about two faces, the weaker of each (smaller value), the length of the side they share
+    (``shared_side_px``, :func:`shared_side_px`) and, where both have planes, how far they are from one plane
+    (``plane_gap_mm``, :func:`plane_gap_mm`); for ``object`` the object's best face; and, for a candidate with a
+    measured value, that value as ``value``."""
     by_face = {fr.face.id: fr.features for res in results for fr in res.faces}
-    by_poly = {fr.face.id: fr.polygon for res in results for fr in res.faces}
+    by_result = {fr.face.id: fr for res in results for fr in res.faces}
     by_obj = {res.obj.id: [fr.features for fr in res.faces] for res in results}
     weaker: dict[tuple[str, ...], dict] = {}  # by faces: a pair has up to six facts, each in both orders
 
@@ -349,8 +360,12 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
         if key not in weaker:
             fs = [by_face[a] for a in key if a in by_face]
             weaker[key] = {k: min(f[k] for f in fs) for k in fs[0]} if fs else {}
-            if len(key) == 2 and key[0] in by_poly and key[1] in by_poly:
-                weaker[key]["shared_side_px"] = shared_side_px(by_poly[key[0]], by_poly[key[1]])
+            if len(key) == 2 and key[0] in by_result and key[1] in by_result:
+                a, b = by_result[key[0]], by_result[key[1]]
+                weaker[key]["shared_side_px"] = shared_side_px(a.polygon, b.polygon)
+                gap = plane_gap_mm(a, b)
+                if gap is not None:
+                    weaker[key]["plane_gap_mm"] = gap
         return weaker[key]
 
     out = []

@@ -81,6 +81,29 @@ def test_calibration_features_give_a_pair_its_shared_side():
     feats = calibration_features([("acute", ("f1", "f2"), 1.0, 60.0), ("acute", ("f2", "f1"), 1.0, 60.0),
                                   ("square", ("f1",), 0.9, 1.05)], [res])
     assert feats[0]["shared_side_px"] == feats[1]["shared_side_px"] == 40.0 and "shared_side_px" not in feats[2]
+    assert "plane_gap_mm" not in feats[0]  # no planes: nothing to measure
+
+
+def test_plane_gap_tells_two_pieces_of_one_face_from_two_faces():
+    from lv3d.describe import FaceResult, plane_gap_mm
+
+    rng = np.random.default_rng(0)
+
+    def face(normal, offset, centre):  # points scattered on the plane n . x + d = 0 around centre
+        n = np.asarray(normal, float) / np.linalg.norm(normal)
+        u = np.cross(n, [1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.cross(n, [0.0, 1.0, 0.0])
+        u /= np.linalg.norm(u)
+        pts = np.asarray(centre, float) + rng.uniform(-0.02, 0.02, (200, 1)) * u + rng.uniform(-0.02, 0.02, (200, 1)) * np.cross(n, u)
+        pts -= np.outer(pts @ n + offset, n)  # onto the plane
+        return FaceResult(SimpleNamespace(id="f", points=pts), np.zeros((4, 2)), np.r_[n, offset], np.zeros(4))
+
+    top_left, top_right = face([0, -1, 0], 0.3, [-0.03, 0.3, 1.0]), face([0, -1, 0], 0.3, [0.03, 0.3, 1.0])
+    lower = face([0, -1, 0], 0.35, [0.0, 0.35, 1.0])                  # parallel, 5 cm further down
+    side = face([1, 0, 0], -0.05, [0.05, 0.33, 1.0])                   # perpendicular
+    assert plane_gap_mm(top_left, top_right) < 1e-6
+    assert abs(plane_gap_mm(top_left, lower) - 50.0) < 1e-6 and plane_gap_mm(lower, top_left) == plane_gap_mm(top_left, lower)
+    assert plane_gap_mm(top_left, side) > 20.0
+    assert plane_gap_mm(top_left, FaceResult(SimpleNamespace(id="g", points=None), np.zeros((3, 2)), None, np.zeros(3))) is None
 
 
 def test_calibrate_is_calibrate_with_the_shipped_table():
