@@ -10,7 +10,8 @@ right and median interior-dihedral error (deg) of truly adjacent faces, without 
 expected calibration error (ECE, 10 bins) of every emitted fact type against the predicate evaluated on
 the ground truth (a fact on a face that matches no true face is false), beside the ECE a perfectly calibrated
 type shows by chance (facts drawn one by one) and a 95% interval of the ECE over scenes drawn with replacement
-(a scene's facts are not independent), and a reliability diagram (PNG under --out); the model-error floor each
+(a scene's facts are not independent), each type's log loss over every labelled candidate (dropped ones included:
+a proper score, steadier than a rare type's ECE), and a reliability diagram (PNG under --out); the model-error floor each
 quantity would need (docs/grounding.md). Then speed:
 refinement + facts per 640x480 frame on one core after warm-up (median over --speed-runs processes, each
 timing --speed-frames - 1 frames twice), and the first call in each new process with a warm compilation
@@ -57,7 +58,7 @@ def run_preset(preset: str, per_class: int, seed0: int, source: str = "perceived
     lv3d.perception (end to end: perception's gross errors count against the facts); 'truth' scenes are
     true polygons with 1.5 px vertex noise and planes fitted to the noisy depth (grounding alone)."""
     stats = {"vertex": {False: [], True: []}, "dihedral": {False: [], True: []}, "facts": defaultdict(list),
-             "z": defaultdict(list), "frames": 0}
+             "candidates": defaultdict(list), "z": defaultdict(list), "frames": 0}
     for ci, cls in enumerate(CLASSES):
         for s in range(per_class):
             seed = seed0 + 1000 * ci + s
@@ -93,6 +94,8 @@ def run_preset(preset: str, per_class: int, seed0: int, source: str = "perceived
                 if refine:
                     labels = truth_labels(cands, results, faces_mask, truth, frame.intrinsics)
                     for (pred, args, p, value), y in zip(cands, labels):
+                        if y is not None and pred in _modal_preds("rgbd"):
+                            stats["candidates"][pred].append((min(p, 1.0), float(y)))
                         if y is not None and p >= MIN_CONF and pred in _modal_preds("rgbd"):
                             stats["facts"][pred].append((min(p, 1.0), float(y), seed))
                             if DEBUG and abs(p - y) > 0.7:
@@ -104,6 +107,16 @@ def _modal_preds(modality):
     from lv3d.facts import PREDICATES
 
     return {p for p, (_, mods) in PREDICATES.items() if modality in mods}
+
+
+def log_loss(rows: list[tuple[float, float]]) -> float:
+    """Mean log loss of (confidence, truth) pairs, confidences clipped to [1e-6, 1 - 1e-6]. Over every candidate
+    with a truth label, dropped ones (below the emission threshold) included: a proper score of the confidences,
+    steadier than a rare type's ECE, which sees only the few facts emitted."""
+    if not rows:
+        return float("nan")
+    p, y = np.clip(np.array(rows, float).T, [[1e-6], [0.0]], [[1 - 1e-6], [1.0]])
+    return float(-np.mean(y * np.log(p) + (1 - y) * np.log(1 - p)))
 
 
 def suggested_floor(z: list[tuple[float, float]]) -> float:
@@ -222,13 +235,14 @@ def main(argv=None) -> int:
             lo, hi = scene_interval(p, y, scenes)
             tgt = f"  (target <= {ECE_TARGET}: {'met' if e <= ECE_TARGET else 'NOT met'})" if preset == "realsense" else ""
             print(f"  ECE {pred:14s} {e:.3f}  n={len(p):4d}  chance {chance_ece(p):.3f}  scenes 95% {lo:.3f}-{hi:.3f}  "
-                  f"mean conf {p.mean():.2f}  true {y.mean():.2f}{tgt}")
+                  f"mean conf {p.mean():.2f}  true {y.mean():.2f}  log loss {log_loss(st['candidates'][pred]):.4f}{tgt}")
             if pred in a.bins.split(","):
                 for lo, n, conf, true in reliability_bins(p, y):
                     print(f"      [{lo:.1f}, {lo + 0.1:.1f})  n={n:4d}  conf {conf:.2f}  true {true:.2f}")
         if allp:
             p, y, _ = np.array(allp).T
-            print(f"  ECE all facts      {ece(p, y):.3f}  n={len(p)}")
+            every = [r for rows in st["candidates"].values() for r in rows]
+            print(f"  ECE all facts      {ece(p, y):.3f}  n={len(p)}  log loss {log_loss(every):.4f} (n={len(every)})")
         png = a.out / f"reliability_{preset}_{source}.png"
         reliability_png(st["facts"], png, f"grounding calibration, {preset}, {source} scenes, rgbd")
         print(f"  reliability diagram: {png}")

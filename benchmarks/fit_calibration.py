@@ -19,6 +19,8 @@ final map (``FINAL``) of out-of-fold confidences: per modality one isotonic map 
 the per-face types (``FACE_PREDS``) pooled, and per type the best by scene-grouped 5-fold CV log loss of
 none, its group's pooled map (per-face types: the per-face one, so the pair types' inputs cannot move their
 choice) and the type's own isotonic map (``fit_final``).
+``--modalities rgbd`` refits one modality and keeps the other's maps from the table in the tree (session 14 refitted
+rgbd alone: a depth refit on fresh rows scored worse on held-out dev scenes, docs/grounding.md).
 ``--check`` prints per-type ECE on another dev set (rows with confidence >= 0.05, as facts are emitted)
 for the raw probabilities, the table in the tree and the new one, and each modality's ECE and log loss
 over all facts. Rows come from dev seeds only, never the study's data.
@@ -265,13 +267,21 @@ def main(argv=None) -> int:
     ap.add_argument("--check", type=Path, help="another dev set to report ECE on")
     ap.add_argument("--out", type=Path, default=ROOT / "grounding" / "_calibration_table.py")
     ap.add_argument("--dry-run", action="store_true")
+    ap.add_argument("--modalities", default=",".join(MODALITIES),
+                    help="refit these; the other modalities' maps are kept from the table in the tree")
     a = ap.parse_args(argv)
+    refit = a.modalities.split(",")
+    if not set(refit) <= set(MODALITIES):
+        ap.error(f"--modalities: choose from {', '.join(MODALITIES)}")
     rows = [r for path in a.data for r in pickle.loads(path.read_bytes())["rows"]]
     by = defaultdict(list)
     for r in rows:
-        if r["modality"] in MODALITIES and r["p"] > 0:
+        if r["modality"] in refit and r["p"] > 0:
             by[(r["modality"], r["pred"])].append(r)
-    table: dict = {}
+    from grounding._calibration_table import FINAL, TABLE
+
+    kept = [m for m in MODALITIES if m not in refit]
+    table: dict = {m: TABLE[m] for m in kept if m in TABLE}
     oof = defaultdict(dict)  # per modality, per predicate: out-of-fold confidences, truth, scene seeds
     for key in sorted(by):
         entry, losses, conf = fit_one(by[key])
@@ -280,7 +290,7 @@ def main(argv=None) -> int:
               + "  ".join(f"{k} {v:.4f}" for k, v in losses.items()) + f"  -> {'raw' if entry is None else entry['map'] + ' ' + ','.join(entry['features'])}")
         if entry is not None:
             table.setdefault(key[0], {})[key[1]] = entry
-    final = {}
+    final = {m: FINAL[m] for m in kept if m in FINAL}
     print("final map per type, scene-grouped 5-fold CV log loss:")
     for mod in sorted(oof):
         final[mod], losses = fit_final(oof[mod])
@@ -288,12 +298,12 @@ def main(argv=None) -> int:
             print(f"  {mod:5s} {pred:14s} " + "  ".join(f"{k} {v:.4f}" for k, v in ls.items()) + f"  -> {min(ls, key=ls.get)}")
     report(rows, (table, final), f"fit rows ({', '.join(map(str, a.data))})")
     if a.check:
-        from grounding._calibration_table import FINAL, TABLE
-
         report(pickle.loads(a.check.read_bytes())["rows"], (table, final), f"check rows ({a.check})", (TABLE, FINAL))
     if not a.dry_run:
-        a.out.write_text('"""Calibration maps (see _calibration.py), written by benchmarks/fit_calibration.py from\n'
-                         f'{", ".join(p.name for p in a.data)} (perceived realsense dev scenes). Do not edit by hand."""\n\n'
+        keep_note = f"; {', '.join(kept)} kept from the table before" if kept else ""
+        a.out.write_text('"""Calibration maps (see _calibration.py), written by benchmarks/fit_calibration.py: '
+                         f'{", ".join(refit)} from\n{", ".join(p.name for p in a.data)} (perceived realsense dev scenes)'
+                         f'{keep_note}. Do not edit by hand."""\n\n'
                          f"TABLE: dict = {pprint.pformat(table, width=110, sort_dicts=True)}\n\n"
                          f"FINAL: dict = {pprint.pformat(final, width=110, compact=True)}\n")
         print(f"wrote {a.out}")

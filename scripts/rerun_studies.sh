@@ -8,7 +8,8 @@
 #   bash scripts/rerun_studies.sh [RUNS_DIR]     # default: runs/rerun
 #
 # Then copy each run's results.{csv,md} and plots into experiments/results/<study>/ (the script prints the
-# commands) and update the tables in experiments/README.md. Resumable: rerunning skips finished folds.
+# commands), rewrite the tables of experiments/README.md (scripts/readme_tables.py --write) and its text.
+# Resumable: rerunning skips finished folds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 RUNS=${1:-runs/rerun}
@@ -21,7 +22,7 @@ study() {  # study NAME [--set ...]: restore the baselines, run, log to RUNS/NAM
     $PY scripts/restore_baselines.py "experiments/$name.yaml" "experiments/results/$name/results.csv" \
         --out "$RUNS/$name" "$@" > "$RUNS/$name.log" 2>&1
     OMP_NUM_THREADS=1 $LV3D experiment run "experiments/$name.yaml" --out "$RUNS/$name" "$@" >> "$RUNS/$name.log" 2>&1
-    echo "$(date +%T) $name: $(tail -c 300 "$RUNS/$name.log" | tr '\r' '\n' | tail -1)"
+    echo "$(date +%T) $name: $(grep -a 'fold results computed' "$RUNS/$name.log" | tail -1)"
 }
 
 CACHE=(--set "data.cache=$RUNS/cache")

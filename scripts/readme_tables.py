@@ -1,0 +1,140 @@
+"""Rewrite the figures in experiments/README.md's study tables from the committed reports
+(experiments/results/<study>/results.csv), so that the tables are never typed by hand.
+
+    .venv/bin/python scripts/readme_tables.py            # print what would change
+    .venv/bin/python scripts/readme_tables.py --write    # rewrite experiments/README.md
+
+Each study's section (its ``### heading``) holds one table, whose layout is kept: row and column labels stay
+as written; only the figures are recomputed, as the runner's report computes them (lv3d/experiment/report.py:
+per fold the mean binary accuracy over the class tasks, then the mean over folds; multi-class likewise).
+- The seed protocol's table has a row per system and columns ``<condition>: mean`` / ``<condition>: multi``
+  (``mean ± std``).
+- Every other table has a row per condition, in the study's order, and a column per system
+  (``mean / multi``). Column labels are system names, optionally followed by words in parentheses.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import re
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+README = ROOT / "experiments" / "README.md"
+# section heading -> (study, its table's first header cell)
+SECTIONS = {
+    "### Seed protocol": ("seed_protocol", "system"),
+    "### Learning curve": ("learning_curve", "positives"),
+    "### Few-shot": ("few_shot", "positives"),
+    "### Ablations": ("ablations", "condition"),
+}
+NOISE = {"k": "noise_depth", "p": "noise_occlusion", "colour sigma": "noise_color",
+         "clutter objects": "noise_clutter", "exposure": "noise_lighting"}
+
+
+def summary(study: str) -> dict[str, dict[str, tuple[float, float, float, float]]]:
+    """condition -> system -> (mean binary %, its std over folds, multi-class %, its std), conditions in file order."""
+    path = ROOT / "experiments" / "results" / study / "results.csv"
+    if not path.is_file():
+        raise SystemExit(f"error: {path}: not found")
+    acc: dict = defaultdict(lambda: defaultdict(lambda: defaultdict(dict)))
+    with path.open(newline="") as f:
+        for r in csv.DictReader(f):
+            acc[r["condition"]][r["system"]][int(r["fold"])][r["task"]] = float(r["accuracy"])
+    out: dict = {}
+    for cond, systems in acc.items():
+        out[cond] = {}
+        for s, folds in systems.items():
+            binary = [np.mean([v for t, v in tasks.items() if t != "multiclass"]) for tasks in folds.values()]
+            multi = [tasks["multiclass"] for tasks in folds.values() if "multiclass" in tasks]
+            sd = lambda xs: float(np.std(xs, ddof=1)) if len(xs) > 1 else 0.0  # noqa: E731 - sample std, as report.py
+            out[cond][s] = (100 * float(np.mean(binary)), 100 * sd(binary), 100 * float(np.mean(multi)), 100 * sd(multi))
+    return out
+
+
+def _cells(line: str) -> list[str]:
+    return [c.strip() for c in line.strip().strip("|").split("|")]
+
+
+def _system(label: str) -> str:
+    return re.sub(r"\s*\(.*\)$", "", label.replace("*", "")).strip()
+
+
+def _pm(mean: float, std: float) -> str:
+    return f"{mean:.1f} ± {std:.1f}"
+
+
+def rewrite_table(lines: list[str], study: str) -> list[str]:
+    """The table ``lines`` (header, rule, rows) with its figures recomputed from ``study``'s results."""
+    s = summary(study)
+    header = _cells(lines[0])
+    out = lines[:2]
+    if study == "seed_protocol":
+        for line in lines[2:]:
+            cells = _cells(line)
+            bold = cells[0].startswith("**")
+            row = [cells[0]]
+            for col in header[1:]:
+                cond, kind = (x.strip() for x in col.split(":"))
+                m, sd, mm, msd = s[f"noise={cond}"][_system(cells[0])]
+                v = _pm(m, sd) if kind == "mean" else _pm(mm, msd)
+                row.append(f"**{v}**" if bold else v)
+            out.append("| " + " | ".join(row) + " |")
+        return out
+    conds = list(s)
+    if len(lines) - 2 != len(conds):
+        raise SystemExit(f"error: {README}: the {study} table has {len(lines) - 2} rows, its results {len(conds)} conditions")
+    for line, cond in zip(lines[2:], conds):
+        label = _cells(line)[0]
+        row = [label] + [f"{s[cond][_system(c)][0]:.1f} / {s[cond][_system(c)][2]:.1f}" for c in header[1:]]
+        out.append("| " + " | ".join(row) + " |")
+    return out
+
+
+def rewrite(text: str) -> str:
+    lines = text.split("\n")
+    section = None
+    i = 0
+    while i < len(lines):
+        line = lines[i]
+        if line.startswith("### "):
+            section = line.strip()
+        if line.startswith("| ") and i + 1 < len(lines) and lines[i + 1].startswith("|---"):
+            first = _cells(line)[0]
+            study = None
+            if section in SECTIONS and SECTIONS[section][1] == first:
+                study = SECTIONS[section][0]
+            elif section == "### Noise sweeps" and first in NOISE:
+                study = NOISE[first]
+            j = i + 2
+            while j < len(lines) and lines[j].startswith("|"):
+                j += 1
+            if study is not None:
+                lines[i:j] = rewrite_table(lines[i:j], study)
+            i = j
+            continue
+        i += 1
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--write", action="store_true", help="rewrite experiments/README.md (default: print a diff)")
+    a = ap.parse_args(argv)
+    old = README.read_text()
+    new = rewrite(old)
+    if a.write:
+        README.write_text(new)
+    import difflib
+
+    sys.stdout.writelines(difflib.unified_diff(old.splitlines(True), new.splitlines(True), "README.md", "rewritten"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
