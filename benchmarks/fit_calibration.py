@@ -1,11 +1,15 @@
 """Fit the per-(modality, predicate) confidence calibration maps and write grounding/_calibration_table.py.
 
-The refit (docs/grounding.md, "Calibration on perceived scenes"; session 12: ~5.5 min for the two 1050-scene
-fit sets in parallel on 2 cores, ~1.5 min for the 420-scene check set, ~2 min for the fit):
+The table in the tree (docs/grounding.md, "Calibration on perceived scenes"): depth's maps are session 12's (the same
+recipe without --modalities, on rgbd,depth rows of seeds 30000 / 40000); rgbd's were fitted in session 14 on 3500
+scenes (~6.5 min per 1050-scene set on one core; the 420-scene check set ~2 min; the fit ~2 min):
 
-    for a in "30000 150 a150" "40000 150 b150" "50000 60 c60"; do set -- $a; .venv/bin/python benchmarks/calibration_data.py \
-        --fresh --seed $1 --per-class $2 --modalities rgbd,depth --out out/calib/$3.pkl & done; wait
-    .venv/bin/python benchmarks/fit_calibration.py out/calib/a150.pkl out/calib/b150.pkl --check out/calib/c60.pkl
+    for a in "30000 150 a150" "40000 150 b150" "60000 100 d60000" "70000 100 d70000"; do set -- $a
+        .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class $2 --modalities rgbd \
+            --out out/calib/s14_$3.pkl; done
+    .venv/bin/python benchmarks/calibration_data.py --fresh --seed 50000 --per-class 60 --modalities rgbd,depth --out out/calib/s14_c60.pkl
+    .venv/bin/python benchmarks/fit_calibration.py out/calib/s14_{a150,b150,d60000,d70000}.pkl --modalities rgbd \
+        --check out/calib/s14_c60.pkl
 
 For each (modality, predicate) four maps compete by scene-grouped 5-fold cross-validated log loss on the dev rows:
 the raw probability unchanged, a shift in logit space, Platt scaling (bias + slope on logit p), and Platt
