@@ -34,7 +34,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.calibration_error import chance_ece, ece, reliability_bins, scene_interval  # noqa: E402
+from benchmarks.calibration_error import chance_ece, ece, log_loss, reliability_bins, scene_interval  # noqa: E402
 from benchmarks.grounding_truth import match_faces, truth_labels, truth_quantities, truth_scene  # noqa: E402
 from lv3d.describe import MIN_CONF, ground  # noqa: E402
 from lv3d.perception import perceive  # noqa: E402
@@ -59,6 +59,7 @@ def run_preset(preset: str, per_class: int, seed0: int, source: str = "perceived
     true polygons with 1.5 px vertex noise and planes fitted to the noisy depth (grounding alone)."""
     stats = {"vertex": {False: [], True: []}, "dihedral": {False: [], True: []}, "facts": defaultdict(list),
              "candidates": defaultdict(list), "z": defaultdict(list), "frames": 0}
+    rgbd_preds = _modal_preds("rgbd")
     for ci, cls in enumerate(CLASSES):
         for s in range(per_class):
             seed = seed0 + 1000 * ci + s
@@ -94,9 +95,10 @@ def run_preset(preset: str, per_class: int, seed0: int, source: str = "perceived
                 if refine:
                     labels = truth_labels(cands, results, faces_mask, truth, frame.intrinsics)
                     for (pred, args, p, value), y in zip(cands, labels):
-                        if y is not None and pred in _modal_preds("rgbd"):
-                            stats["candidates"][pred].append((min(p, 1.0), float(y)))
-                        if y is not None and p >= MIN_CONF and pred in _modal_preds("rgbd"):
+                        if y is None or pred not in rgbd_preds:
+                            continue
+                        stats["candidates"][pred].append((min(p, 1.0), float(y)))
+                        if p >= MIN_CONF:
                             stats["facts"][pred].append((min(p, 1.0), float(y), seed))
                             if DEBUG and abs(p - y) > 0.7:
                                 print(f"    miss {cls} {seed} {pred}{args} p={p:.2f} value={value} truth={y}")
@@ -109,14 +111,11 @@ def _modal_preds(modality):
     return {p for p, (_, mods) in PREDICATES.items() if modality in mods}
 
 
-def log_loss(rows: list[tuple[float, float]]) -> float:
-    """Mean log loss of (confidence, truth) pairs, confidences clipped to [1e-6, 1 - 1e-6]. Over every candidate
-    with a truth label, dropped ones (below the emission threshold) included: a proper score of the confidences,
-    steadier than a rare type's ECE, which sees only the few facts emitted."""
-    if not rows:
-        return float("nan")
-    p, y = np.clip(np.array(rows, float).T, [[1e-6], [0.0]], [[1 - 1e-6], [1.0]])
-    return float(-np.mean(y * np.log(p) + (1 - y) * np.log(1 - p)))
+def candidates_log_loss(rows: list[tuple[float, float]]) -> float:
+    """Log loss of (confidence, truth) pairs: over every candidate with a truth label, dropped ones (below the
+    emission threshold) included, a proper score of the confidences, steadier than a rare type's ECE, which sees
+    only the few facts emitted."""
+    return log_loss(*np.array(rows, float).reshape(-1, 2).T) if rows else float("nan")
 
 
 def suggested_floor(z: list[tuple[float, float]]) -> float:
@@ -235,14 +234,14 @@ def main(argv=None) -> int:
             lo, hi = scene_interval(p, y, scenes)
             tgt = f"  (target <= {ECE_TARGET}: {'met' if e <= ECE_TARGET else 'NOT met'})" if preset == "realsense" else ""
             print(f"  ECE {pred:14s} {e:.3f}  n={len(p):4d}  chance {chance_ece(p):.3f}  scenes 95% {lo:.3f}-{hi:.3f}  "
-                  f"mean conf {p.mean():.2f}  true {y.mean():.2f}  log loss {log_loss(st['candidates'][pred]):.4f}{tgt}")
+                  f"mean conf {p.mean():.2f}  true {y.mean():.2f}  log loss {candidates_log_loss(st['candidates'][pred]):.4f}{tgt}")
             if pred in a.bins.split(","):
                 for lo, n, conf, true in reliability_bins(p, y):
                     print(f"      [{lo:.1f}, {lo + 0.1:.1f})  n={n:4d}  conf {conf:.2f}  true {true:.2f}")
         if allp:
             p, y, _ = np.array(allp).T
             every = [r for rows in st["candidates"].values() for r in rows]
-            print(f"  ECE all facts      {ece(p, y):.3f}  n={len(p)}  log loss {log_loss(every):.4f} (n={len(every)})")
+            print(f"  ECE all facts      {ece(p, y):.3f}  n={len(p)}  log loss {candidates_log_loss(every):.4f} (n={len(every)})")
         png = a.out / f"reliability_{preset}_{source}.png"
         reliability_png(st["facts"], png, f"grounding calibration, {preset}, {source} scenes, rgbd")
         print(f"  reliability diagram: {png}")

@@ -6,6 +6,13 @@ from __future__ import annotations
 import numpy as np
 
 
+def log_loss(p: np.ndarray, y: np.ndarray) -> float:
+    """Mean log loss of confidences ``p`` (n,) against truth ``y`` (n,), confidences clipped to [1e-6, 1 - 1e-6]."""
+    p = np.clip(np.asarray(p, float), 1e-6, 1 - 1e-6)
+    y = np.asarray(y, float)
+    return float(-np.mean(y * np.log(p) + (1 - y) * np.log(1 - p)))
+
+
 def ece(p: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
     """Expected calibration error: sum over equal-width confidence bins of |mean confidence - share true| *
     share of facts in the bin. ``p`` (n,) confidences in [0, 1]; ``y`` (n,) truth as 0/1 or bool."""

@@ -44,7 +44,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.calibration_error import chance_ece, ece  # noqa: E402
+from benchmarks.calibration_error import chance_ece, ece, log_loss  # noqa: E402
 from grounding._calibration import TOL_FRAC_PREDS, inputs  # noqa: E402
 from lv3d.facts import PREDICATES  # noqa: E402
 
@@ -65,11 +65,6 @@ PLANE_GAP_PREDS = ("parallel",)
 PLANE_GAP_FEATURES = ["plane_gap_mm"]
 # facts about one face: their final maps are chosen on their rows alone (fit_final)
 FACE_PREDS = tuple(p for p, (arity, _) in PREDICATES.items() if arity == 1 and p != "object")
-
-
-def _logloss(p, y):
-    p = np.clip(p, 1e-6, 1 - 1e-6)
-    return float(-np.mean(y * np.log(p) + (1 - y) * np.log(1 - p)))
 
 
 def _fit(x: np.ndarray, y: np.ndarray):
@@ -100,7 +95,7 @@ def _fit_shift(rows: list[dict]):
     y = np.array([r["y"] for r in rows], float)
 
     def loss(b):  # log loss plus the two half pseudo-observations at logit 0
-        return len(y) * _logloss(_predict(b, np.ones(1), z[:, None]), y) + 0.5 * (np.logaddexp(0, -b) + np.logaddexp(0, b))
+        return len(y) * log_loss(_predict(b, np.ones(1), z[:, None]), y) + 0.5 * (np.logaddexp(0, -b) + np.logaddexp(0, b))
 
     return float(minimize_scalar(loss, bounds=(-15, 15), method="bounded").x), np.ones(1), ["logit_p"]
 
@@ -157,7 +152,7 @@ def fit_one(rows: list[dict], seed: int = 0):
             b, c, f = _fit_monotone(trows, feats)
             x = np.array([inputs(r["pred"], r["p"], r, f) for r, t in zip(rows, te) if t]).reshape(int(te.sum()), len(f))
             pred[te] = _predict(b, c, x)
-        losses[name], oof[name] = _logloss(pred, y), pred
+        losses[name], oof[name] = log_loss(pred, y), pred
     name = min(losses, key=losses.get)
     if cands[name] == "raw":
         return None, losses, oof[name]
@@ -200,7 +195,7 @@ def _choose_final(oof: dict, pool: list[str], members: list[str], seed: int) -> 
             cands["pooled"][te] = pooled[k].predict(c[te])
             if "own" in cands:
                 cands["own"][te] = _isotonic(c[~te], t[~te]).predict(c[te])
-        losses[pred] = {name: _logloss(v, t) for name, v in cands.items()}
+        losses[pred] = {name: log_loss(v, t) for name, v in cands.items()}
         best = min(losses[pred], key=losses[pred].get)
         choice[pred] = best if best == "pooled" else None if best == "none" else _knots(_isotonic(c, t))
     return _knots(_isotonic(conf, y)), choice, losses
@@ -261,7 +256,7 @@ def report(rows: list[dict], table: tuple, title: str, shipped: tuple | None = N
             if tab is None:
                 continue
             c = np.array([calibrate_with(tab[0], mod, r["pred"], r["p"], r, tab[1]) for r in rs])
-            line += f"  {name} ECE {ece(c[c >= MIN_CONF], y[c >= MIN_CONF]):.3f} (n={int((c >= MIN_CONF).sum())}) log loss {_logloss(c, y):.4f}"
+            line += f"  {name} ECE {ece(c[c >= MIN_CONF], y[c >= MIN_CONF]):.3f} (n={int((c >= MIN_CONF).sum())}) log loss {log_loss(c, y):.4f}"
         print(line)
 
 

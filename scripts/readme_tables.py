@@ -24,6 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from lv3d.experiment.stats import mean_std  # noqa: E402
+
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "experiments" / "README.md"
 # section heading -> (study, its table's first header cell)
@@ -50,10 +54,9 @@ def summary(study: str) -> dict[str, dict[str, tuple[float, float, float, float]
     for cond, systems in acc.items():
         out[cond] = {}
         for s, folds in systems.items():
-            binary = [np.mean([v for t, v in tasks.items() if t != "multiclass"]) for tasks in folds.values()]
-            multi = [tasks["multiclass"] for tasks in folds.values() if "multiclass" in tasks]
-            sd = lambda xs: float(np.std(xs, ddof=1)) if len(xs) > 1 else 0.0  # noqa: E731 - sample std, as report.py
-            out[cond][s] = (100 * float(np.mean(binary)), 100 * sd(binary), 100 * float(np.mean(multi)), 100 * sd(multi))
+            binary = mean_std([np.mean([v for t, v in tasks.items() if t != "multiclass"]) for tasks in folds.values()])
+            multi = mean_std([tasks["multiclass"] for tasks in folds.values() if "multiclass" in tasks])
+            out[cond][s] = tuple(100 * v for v in binary + multi)
     return out
 
 

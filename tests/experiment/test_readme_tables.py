@@ -1,26 +1,19 @@
 """experiments/README.md's study tables hold the figures of the committed reports (scripts/readme_tables.py)."""
 
-import importlib.util
-from pathlib import Path
-
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "readme_tables.py"
+import pytest
 
 
-def _module():
-    spec = importlib.util.spec_from_file_location("readme_tables", SCRIPT)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+@pytest.fixture(scope="module")
+def mod(load_script):
+    return load_script("readme_tables")
 
 
-def test_every_study_table_matches_its_results():
-    mod = _module()
+def test_every_study_table_matches_its_results(mod):
     text = mod.README.read_text()
     assert mod.rewrite(text) == text, "stale tables: run scripts/readme_tables.py --write"
 
 
-def test_a_changed_figure_is_rewritten_and_labels_are_kept():
-    mod = _module()
+def test_a_changed_figure_is_rewritten_and_labels_are_kept(mod):
     text = mod.README.read_text()
     lines = text.split("\n")
     i = next(k for k, line in enumerate(lines) if line.startswith("| 0.016 |"))  # the depth sweep's last row

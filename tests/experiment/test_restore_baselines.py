@@ -1,23 +1,15 @@
 """scripts/restore_baselines.py: a study rerun after a change to lv3d's code retrains only the lv3d systems."""
 
-import importlib.util
 import json
-from pathlib import Path
 
 import pytest
 
 from lv3d.errors import InputError
 from lv3d.experiment.runner import run_study
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "restore_baselines.py"
-
-
 @pytest.fixture(scope="module")
-def restore_mod():
-    spec = importlib.util.spec_from_file_location("restore_baselines", SCRIPT)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+def restore_mod(load_script):
+    return load_script("restore_baselines")
 
 
 def test_restored_baselines_are_skipped_and_report_the_same(tmp_path, tiny_config, fake_world, restore_mod):
