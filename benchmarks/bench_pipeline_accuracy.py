@@ -13,6 +13,7 @@ instead (the learner's ceiling). ``--explain`` prints the programs learned and t
 from __future__ import annotations
 
 import argparse
+import json
 import pickle
 import sys
 from pathlib import Path
@@ -72,9 +73,9 @@ def main() -> None:
     import ast
     settings = {k: ast.literal_eval(v) for k, v in (s.split("=", 1) for s in a.set)}
     for dev in a.dev:
-        preset = "realsense" if "realsense" in dev.name else "clean"
-        target = TARGETS[preset]
-        print(f"== {dev} ({preset}; facts: {a.facts}; target rgbd mean >= {target:.2f}, rgbd >= rgb, depth)")
+        preset = json.loads((dev / "manifest.json").read_text())["noise"]  # the preset dev_facts rendered
+        target = f"rgbd mean >= {TARGETS[preset]:.2f}, " if preset in TARGETS else ""
+        print(f"== {dev} ({preset}; facts: {a.facts}; target {target}rgbd >= rgb, depth)")
         rows = {}
         for mod in a.modalities.split(","):
             raw = pickle.loads((dev / f"facts_{mod}.pkl").read_bytes())

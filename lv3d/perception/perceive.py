@@ -76,7 +76,7 @@ def _colour_objects(frame: RGBD, scene_id: str, timings: dict[str, float],
                     box: tuple[int, int, int, int] | None = None) -> list[SceneObject]:
     """The colour path on the whole frame (or in ``box`` = (u0, v0, u1, v1) pixels): its faces grouped into
     objects; its stage times added to ``timings``."""
-    res = rgb_faces(frame.color, box=box, faint_cuts=True)
+    res = rgb_faces(frame.color, box=box, colour_alone=True)
     for key, v in res.timings_ms.items():
         timings[key] = timings.get(key, 0.0) + v
     return _rgb_objects(scene_id, res.faces, res.groups, res.adjacency)

@@ -11,6 +11,7 @@ import numpy as np
 
 from .edges import channel_edges, channels, edge_distance, edge_support
 from .faces import bounded_faces, build_graph
+from .gaps import close_gaps
 from .polygons import (area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
                        sample_boundary, simplify)
 from .segments import detect_color_segments, union_find_labels
@@ -91,16 +92,18 @@ def _contains(outer: np.ndarray, inner: np.ndarray) -> bool:
 
 
 def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, min_area_px: float = 150.0,
-              max_area_frac: float = 0.35, min_support: float = 0.55, faint_cuts: bool = False) -> RGBResult:
+              max_area_frac: float = 0.35, min_support: float = 0.55, colour_alone: bool = False) -> RGBResult:
     """Faces in the colour image (H, W, 3) uint8 RGB, or only inside ``box`` = (u0, v0, u1, v1) pixels
     (a crop around an object found in depth). Faces smaller than ``min_area_px``, larger than ``max_area_frac``
     of the searched area, hugging its frame, non-simple, poorly supported by edges (< ``min_support`` of the
-    perimeter), or containing another face (a background region around an object) are dropped. With
-    ``faint_cuts`` (colour alone, no depth to part faces), a kept face whose outline the graph traced whole is cut
+    perimeter), or containing another face (a background region around an object) are dropped.
+
+    With ``colour_alone`` (no depth to find or part faces), segments are carried on across gaps in their edges
+    where the colour still steps (gaps.close_gaps), and a kept face whose outline the graph traced whole is cut
     along a faint straight edge from one of its corners (step_edge.step_cut): most colour-only misses on noisy
-    renders are two faces of one colour traced as one. With depth (rgbd), the planes part such faces; cut there
-    too, the colour part that keeps a thin neighbour's strip outvotes that neighbour's plane (realsense rgbd
-    recall fell by one face on dev seeds 1000 and 2000)."""
+    renders are corners the segments stop short of and two faces of one colour traced as one. With depth (rgbd),
+    the planes find and part such faces; cut there too, the colour part that keeps a thin neighbour's strip
+    outvotes that neighbour's plane (realsense rgbd recall fell by one face on dev seeds 1000 and 2000)."""
     import time
 
     t0 = time.perf_counter()
@@ -114,6 +117,10 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     dist = edge_distance(edges)
     t1 = time.perf_counter()
     segs = detect_color_segments(chans)
+    sgrads = None  # the colour's smoothed derivatives (step_edge), taken when first needed
+    if colour_alone:
+        sgrads = smoothed_gradients(chans)
+        segs = close_gaps(segs, sgrads)
     t2 = time.perf_counter()
     g = build_graph(segs, edge_dist=dist)
     cw, ch = u1 - u0, v1 - v0
@@ -121,7 +128,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     cands = []
     # made-up edge keys (k, k), k < 0: a cut the graph lacks, shared by the parts either side of it (so that they
     # count as neighbours), or a thin face's contact with the faces beside it (_thin_cands)
-    made_up = itertools.count(-1, -1)
+    made_up = ((k, k) for k in itertools.count(-1, -1))
     image_cuts = set()  # made-up keys of cuts along an image edge (split_by_diagonal, step_cut): never joined back
     for f in bounded_faces(g):
         traced_area = area(f.polygon)
@@ -144,8 +151,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
             cands.append((poly, f.edges, sup, a, True))
             continue
         # the cut is an edge the graph lacks: a shared made-up edge key makes the parts neighbours
-        k = next(made_up)
-        cut = (k, k)
+        cut = next(made_up)
         if by_gradient:
             image_cuts.add(cut)
         # split_by_diagonal may cut a non-convex outline across a notch: the part cut off lies outside the traced
@@ -160,20 +166,18 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     # a face that contains another kept face is a region around it (table, wall), not an object face
     region = [any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
                   for j in range(len(cands))) for i in range(len(cands))]
-    sgrads = None  # the colour's smoothed derivatives (step_edge), taken when a whole traced face is first kept
     kept = []
     for (poly, es, sup, a, whole), around in zip(cands, region):
         if around:
             continue
         parts = None
-        if faint_cuts and whole:
+        if colour_alone and whole:
             sgrads = smoothed_gradients(chans) if sgrads is None else sgrads
             parts = step_cut(poly, sgrads, min_area_px)
         if parts is None:
             kept.append((poly, es, sup, a))
             continue
-        k = next(made_up)
-        cut = (k, k)
+        cut = next(made_up)
         image_cuts.add(cut)
         kept += [_part(q, es, cut, g.vertices, dist) for q in map(_outline, parts)]
     cands = _join_on_graph_edges(kept, g.vertices, dist, image_cuts)
@@ -290,8 +294,7 @@ def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: fl
     count as neighbours."""
     out = []
     for q in thin_faces(segs, dist, [c[0] for c in cands], min_area_px):
-        k = next(made_up)
-        key = (k, k)
+        key = next(made_up)
         pts = sample_boundary(q, 1.0)
         for n, c in enumerate(cands):
             if np.mean(outline_distance(pts, c[0]) <= touch_px) >= 0.15:
