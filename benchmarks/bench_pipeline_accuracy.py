@@ -74,8 +74,9 @@ def main() -> None:
     settings = {k: ast.literal_eval(v) for k, v in (s.split("=", 1) for s in a.set)}
     for dev in a.dev:
         preset = json.loads((dev / "manifest.json").read_text())["noise"]  # the preset dev_facts rendered
-        target = f"rgbd mean >= {TARGETS[preset]:.2f}, " if preset in TARGETS else ""
-        print(f"== {dev} ({preset}; facts: {a.facts}; target {target}rgbd >= rgb, depth)")
+        target = TARGETS.get(preset)
+        goal = f"rgbd mean >= {target:.2f}, " if target is not None else ""
+        print(f"== {dev} ({preset}; facts: {a.facts}; target {goal}rgbd >= rgb, depth)")
         rows = {}
         for mod in a.modalities.split(","):
             raw = pickle.loads((dev / f"facts_{mod}.pkl").read_bytes())
@@ -88,7 +89,8 @@ def main() -> None:
         print(f"{'modality':9s}" + "".join(f"{t[:16]:>18s}" for t in tasks) + f"{'mean':>8s}")
         for mod, r in rows.items():
             means = [float(np.mean(r[t])) for t in tasks]
-            flag = "" if mod != "rgbd" else ("  ok" if np.mean(means) >= target else f"  < target {target}")
+            flag = "" if mod != "rgbd" or target is None else \
+                ("  ok" if np.mean(means) >= target else f"  < target {target}")
             print(f"{mod:9s}" + "".join(f"{m:10.3f} [{min(r[t]):.2f}-{max(r[t]):.2f}]" for m, t in zip(means, tasks))
                   + f"{np.mean(means):8.3f}{flag}")
 

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .background import background_faces
 from .edges import channel_edges, channels, edge_distance, edge_support
 from .faces import bounded_faces, build_graph
 from .gaps import close_gaps
@@ -101,7 +102,9 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     With ``colour_alone`` (no depth to find or part faces), segments are carried on across gaps in their edges
     where the colour still steps (gaps.close_gaps), and a kept face whose outline the graph traced whole is cut
     along a faint straight edge from one of its corners (step_edge.step_cut): most colour-only misses on noisy
-    renders are corners the segments stop short of and two faces of one colour traced as one. With depth (rgbd),
+    renders are corners the segments stop short of and two faces of one colour traced as one. Faces of the
+    colour of the image's border (floor texture, shadows, painted lines) are then dropped
+    (background.background_faces): most false colour-only faces on noisy renders are such. With depth (rgbd),
     the planes find and part such faces; cut there too, the colour part that keeps a thin neighbour's strip
     outvotes that neighbour's plane (realsense rgbd recall fell by one face on dev seeds 1000 and 2000)."""
     import time
@@ -184,6 +187,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     n_traced = len(cands)
     cands += _thin_cands(cands, segs, dist, min_area_px, made_up)
     cands = _join_thin_to_traced(cands, n_traced, dist)
+    if colour_alone and cands:
+        cands = [c for c, bg in zip(cands, background_faces([c[0] for c in cands], crop)) if not bg]
     faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for p, e, s, a in cands]
     faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))

@@ -64,12 +64,13 @@ def test_short_segments_and_empty_input_pass_through():
 
 
 def test_colour_alone_closes_a_square_whose_side_fades_into_the_background():
-    # the lower part of the square's right side borders a background band of nearly its colour: LSD finds the
-    # side only down to the band, so without gap closing the graph has no cycle around the square
-    for seed, band in [(0, 150.0), (1, 152.0), (2, 154.0)]:
-        img = np.full((200, 200, 3), 100.0)
-        img[50:150, 50:150] = 160.0
-        img[95:150, 150:] = band
+    # the lower part of the green square's right side borders a band of nearly its colour on a bluish floor: LSD
+    # finds the side only down to the band, so without gap closing the graph has no cycle around the square
+    square = np.array([150.0, 190.0, 110.0])
+    for seed, darker in [(0, 8.0), (1, 10.0), (2, 12.0)]:
+        img = np.tile(np.array([110.0, 100.0, 150.0]), (200, 200, 1))
+        img[50:150, 50:150] = square
+        img[95:150, 150:] = square - darker
         img = np.clip(img + np.random.default_rng(seed).normal(0.0, 3.0, img.shape), 0, 255).astype(np.uint8)
         assert rgb_faces(img).faces == []
         faces = rgb_faces(img, colour_alone=True).faces

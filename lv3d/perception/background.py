@@ -1,0 +1,54 @@
+"""Faces of the background, told by their colour: a colour-only face whose chromaticity is the chromaticity of the
+image's border (the floor, the wall, their texture and the shadows cast on them) is not a face of the object.
+
+Without depth, a textured floor closes cycles of its own against the object's outline (strips between the
+silhouette and a ripple of the texture, a shadow, a painted line), and they group with the object's faces. Their
+chromaticity (each channel over the sum of the three) is the floor's, whatever their shading: a shadow darkens the
+floor but keeps its hue. The object's own faces, whatever their shading, keep the object's.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+
+def chromaticity(color: np.ndarray) -> np.ndarray:
+    """(H, W, 2) float32: the red and green share of each pixel of ``color`` (H, W, 3) uint8 RGB in its sum."""
+    c = color.astype(np.float32)
+    return c[..., :2] / np.maximum(c.sum(axis=2, keepdims=True), 1.0)
+
+
+def border_chromaticity(chroma: np.ndarray, band_px: int = 8, stride: int = 2) -> np.ndarray:
+    """(n, 2): the chromaticity of every ``stride``-th pixel in the band ``band_px`` wide along the image's border."""
+    b = band_px
+    parts = [chroma[:b], chroma[-b:], chroma[b:-b, :b], chroma[b:-b, -b:]]
+    return np.concatenate([p[::stride, ::stride].reshape(-1, 2) for p in parts])
+
+
+def face_chromaticity(poly: np.ndarray, chroma: np.ndarray, erode_px: int = 2, min_px: int = 20) -> np.ndarray:
+    """(2,): the median chromaticity of the pixels inside ``poly`` (n, 2) pixels, ``erode_px`` clear of its outline
+    (blur mixes the neighbours' colours in there), or of all its pixels where fewer than ``min_px`` are clear."""
+    h, w = chroma.shape[:2]
+    lo = np.maximum(np.floor(poly.min(axis=0)).astype(int) - 1, 0)
+    hi = np.minimum(np.ceil(poly.max(axis=0)).astype(int) + 2, [w, h])
+    mask = np.zeros((hi[1] - lo[1], hi[0] - lo[0]), np.uint8)
+    cv2.fillPoly(mask, [np.round(poly - lo).astype(np.int32)], 1)
+    inner = cv2.erode(mask, np.ones((2 * erode_px + 1, 2 * erode_px + 1), np.uint8))
+    pick = inner if np.count_nonzero(inner) >= min_px else mask
+    pixels = chroma[lo[1]:hi[1], lo[0]:hi[0]][pick.astype(bool)]
+    return np.median(pixels, axis=0) if len(pixels) else np.full(2, np.nan)
+
+
+def background_faces(polys: list[np.ndarray], color: np.ndarray, radius: float = 0.01,
+                     min_share: float = 0.1) -> list[bool]:
+    """For each polygon (n, 2, pixels of ``color`` (H, W, 3) uint8 RGB): whether it is background, its median
+    chromaticity within ``radius`` of at least ``min_share`` of the border's pixels (border_chromaticity)."""
+    chroma = chromaticity(color)
+    border = border_chromaticity(chroma)
+    out = []
+    for p in polys:
+        c = face_chromaticity(np.asarray(p, np.float64), chroma)
+        near = np.hypot(border[:, 0] - c[0], border[:, 1] - c[1]) <= radius
+        out.append(bool(np.isfinite(c).all() and np.mean(near) >= min_share))
+    return out
