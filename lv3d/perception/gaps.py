@@ -15,6 +15,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .segments import merge_collinear
+from .step_edge import line_steps
 
 
 def _steps(a: np.ndarray, b: np.ndarray, grads: np.ndarray, shift_px: float, sample_px: float = 1.0,
@@ -30,18 +31,8 @@ def _steps(a: np.ndarray, b: np.ndarray, grads: np.ndarray, shift_px: float, sam
     owner = np.repeat(np.arange(len(a)), count)
     t = trim_px + sample_px * (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))
     pts = a[owner] + t[:, None] * u[owner]
-    _, _, h, w = grads.shape
-    out = []
-    for offset in (0.0, -shift_px, shift_px):
-        c = pts + offset * nrm[owner]
-        uu = np.clip(np.round(c[:, 0]).astype(int), 0, w - 1)
-        vv = np.clip(np.round(c[:, 1]).astype(int), 0, h - 1)
-        g = grads[:, :, vv, uu]                                      # (C, 2, k)
-        across = g[:, 0] * nrm[owner, 0] + g[:, 1] * nrm[owner, 1]    # (C, k)
-        out.append(np.stack([np.bincount(owner, weights=x, minlength=len(a)) for x in across], axis=1)
-                   / np.maximum(count, 1)[:, None])
-    control = np.maximum(np.abs(out[1]).max(axis=1), np.abs(out[2]).max(axis=1))
-    return out[0], control, count
+    step, control = line_steps(pts, owner, nrm, count, grads, shift_px)
+    return step, control, count
 
 
 def close_gaps(segs: np.ndarray, grads: np.ndarray, min_len_px: float = 10.0, max_gap_px: float = 60.0,

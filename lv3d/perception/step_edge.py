@@ -21,6 +21,25 @@ def smoothed_gradients(chans: list[np.ndarray], sigma_px: float = 1.0) -> np.nda
     return np.asarray(out)
 
 
+def line_steps(pts: np.ndarray, owner: np.ndarray, nrm: np.ndarray, samples: np.ndarray, grads: np.ndarray,
+               shift_px: float) -> tuple[np.ndarray, np.ndarray]:
+    """How the colour steps across lines, from their samples ``pts`` (m, 2) pixels, ``owner`` (m,) the line each
+    belongs to, ``nrm`` (n, 2) each line's unit normal and ``samples`` (n,) each line's sample count:
+    per line and channel the mean derivative across it, (n, C) (``grads``: :func:`smoothed_gradients`), and the
+    largest such step over the channels on the lines shifted ``shift_px`` to either side, (n,)."""
+    _, _, h, w = grads.shape
+    steps = []  # per offset: (lines, channels) mean derivative across the line
+    for offset in (0.0, -shift_px, shift_px):
+        c = pts + offset * nrm[owner]
+        uu = np.clip(np.round(c[:, 0]).astype(int), 0, w - 1)
+        vv = np.clip(np.round(c[:, 1]).astype(int), 0, h - 1)
+        g = grads[:, :, vv, uu]                                    # (C, 2, m)
+        across = g[:, 0] * nrm[owner, 0] + g[:, 1] * nrm[owner, 1]  # (C, m)
+        steps.append(np.stack([np.bincount(owner, weights=x, minlength=len(nrm)) for x in across], axis=1)
+                     / np.maximum(samples, 1)[:, None])
+    return steps[0], np.maximum(np.abs(steps[1]).max(axis=1), np.abs(steps[2]).max(axis=1))
+
+
 def _outline_points(p: np.ndarray, step_px: float) -> tuple[np.ndarray, np.ndarray]:
     """Points (m, 2) every ``step_px`` along each side of ``p`` (n, 2), corners left out, and the side (m,)
     each lies on (side k runs from corner k to corner k + 1)."""
@@ -89,18 +108,8 @@ def step_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: 
     samples = np.bincount(owner, minlength=len(a))
     if not len(pts):
         return None
-    _, _, h, w = grads.shape
-    steps = []  # per offset: (lines, channels) mean derivative across the line
-    for offset in (0.0, -shift_px, shift_px):
-        c = pts + offset * nrm[owner]
-        uu = np.clip(np.round(c[:, 0]).astype(int), 0, w - 1)
-        vv = np.clip(np.round(c[:, 1]).astype(int), 0, h - 1)
-        g = grads[:, :, vv, uu]                                    # (C, 2, m)
-        across = g[:, 0] * nrm[owner, 0] + g[:, 1] * nrm[owner, 1]  # (C, m)
-        steps.append(np.stack([np.bincount(owner, weights=x, minlength=len(a)) for x in across], axis=1)
-                     / np.maximum(samples, 1)[:, None])
-    peak = np.abs(steps[0]).max(axis=1)
-    control = np.maximum(np.abs(steps[1]).max(axis=1), np.abs(steps[2]).max(axis=1))
+    step, control = line_steps(pts, owner, nrm, samples, grads, shift_px)
+    peak = np.abs(step).max(axis=1)
     passes = (samples >= min_samples) & (peak >= min_step) & (peak >= rel_step * control)
     score = peak - rel_step * control
     for k in sorted(np.nonzero(passes)[0], key=lambda k: (-score[k], k)):
