@@ -15,7 +15,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .segments import merge_collinear
-from .step_edge import line_steps
+from .step_edge import line_samples, line_steps
 
 
 def _steps(a: np.ndarray, b: np.ndarray, grads: np.ndarray, shift_px: float, sample_px: float = 1.0,
@@ -23,14 +23,7 @@ def _steps(a: np.ndarray, b: np.ndarray, grads: np.ndarray, shift_px: float, sam
     """For lines from ``a`` (m, 2) to ``b`` (m, 2): per channel, the mean derivative across each line over its
     samples (every ``sample_px``, ``trim_px`` left out at each end), (m, C); the largest such step on the lines
     shifted ``shift_px`` to either side, (m,); and each line's sample count (m,)."""
-    d = b - a
-    length = np.hypot(d[:, 0], d[:, 1])
-    u = d / np.maximum(length, 1e-9)[:, None]
-    nrm = np.stack([-u[:, 1], u[:, 0]], axis=1)
-    count = np.maximum(((length - 2 * trim_px) // sample_px).astype(int) + 1, 0)
-    owner = np.repeat(np.arange(len(a)), count)
-    t = trim_px + sample_px * (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))
-    pts = a[owner] + t[:, None] * u[owner]
+    pts, owner, count, nrm = line_samples(a, b, sample_px, trim_px)
     step, control = line_steps(pts, owner, nrm, count, grads, shift_px)
     return step, control, count
 
@@ -103,12 +96,12 @@ def close_gaps(segs: np.ndarray, grads: np.ndarray, min_len_px: float = 10.0, ma
     first = order[np.r_[True, (np.diff(i[order]) != 0) | (np.diff(e[order]) != 0)]]
     i, e, origin = i[first], e[first], origin[first]
     target = origin + g[first, None] * ahead[first]
-    own, _, _ = _steps(p0, p1, grads, shift_px)
+    own, _, _ = _steps(p0[i], p1[i], grads, shift_px)  # how each end's segment itself steps
     step, control, samples = _steps(origin, target, grads, shift_px)
     # the way there is read in the direction the segment runs: an end carried back from p0 runs against it
     sign = np.where(e == 0, -1.0, 1.0)
     peak = np.abs(step).max(axis=1)
-    agree = np.sum(sign[:, None] * step * own[i], axis=1) > 0
+    agree = np.sum(sign[:, None] * step * own, axis=1) > 0
     ok = (samples >= min_samples) & (peak >= min_step) & (peak >= rel_step * control) & agree
     for k in np.nonzero(ok)[0]:
         out[idx[i[k]], 2 * e[k]:2 * e[k] + 2] = target[k]

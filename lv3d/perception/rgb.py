@@ -120,9 +120,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     dist = edge_distance(edges)
     t1 = time.perf_counter()
     segs = detect_color_segments(chans)
-    sgrads = None  # the colour's smoothed derivatives (step_edge), taken when first needed
+    sgrads = smoothed_gradients(chans) if colour_alone else None  # for close_gaps and step_cut
     if colour_alone:
-        sgrads = smoothed_gradients(chans)
         segs = close_gaps(segs, sgrads)
     t2 = time.perf_counter()
     g = build_graph(segs, edge_dist=dist)
@@ -175,7 +174,6 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
             continue
         parts = None
         if colour_alone and whole:
-            sgrads = smoothed_gradients(chans) if sgrads is None else sgrads
             parts = step_cut(poly, sgrads, min_area_px)
         if parts is None:
             kept.append((poly, es, sup, a))

@@ -21,6 +21,19 @@ def smoothed_gradients(chans: list[np.ndarray], sigma_px: float = 1.0) -> np.nda
     return np.asarray(out)
 
 
+def line_samples(a: np.ndarray, b: np.ndarray, sample_px: float, trim_px: float
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Points every ``sample_px`` along the lines from ``a`` (n, 2) to ``b`` (n, 2), ``trim_px`` left out at each
+    end: the points (m, 2), the line each belongs to (m,), each line's count (n,) and unit normal (n, 2)."""
+    d = b - a
+    length = np.hypot(d[:, 0], d[:, 1])
+    u = d / np.maximum(length, 1e-9)[:, None]
+    count = np.maximum(((length - 2 * trim_px) // sample_px).astype(int) + 1, 0)
+    owner = np.repeat(np.arange(len(a)), count)
+    t = trim_px + sample_px * (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))
+    return a[owner] + t[:, None] * u[owner], owner, count, np.stack([-u[:, 1], u[:, 0]], axis=1)
+
+
 def line_steps(pts: np.ndarray, owner: np.ndarray, nrm: np.ndarray, samples: np.ndarray, grads: np.ndarray,
                shift_px: float) -> tuple[np.ndarray, np.ndarray]:
     """How the colour steps across lines, from their samples ``pts`` (m, 2) pixels, ``owner`` (m,) the line each
@@ -97,12 +110,7 @@ def step_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: 
     corner, point, a, b, length = corner[long], point[long], a[long], b[long], length[long]
     if not len(a):
         return None
-    u = (b - a) / length[:, None]
-    nrm = np.stack([-u[:, 1], u[:, 0]], axis=1)
-    count = ((length - 2 * trim_px) // sample_px).astype(int) + 1
-    owner = np.repeat(np.arange(len(a)), count)
-    t = trim_px + sample_px * (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))
-    pts = a[owner] + t[:, None] * u[owner]
+    pts, owner, _, nrm = line_samples(a, b, sample_px, trim_px)
     clear = _depth_inside(p, pts) >= shift_px + 2 * sigma_px + 1.0
     owner, pts = owner[clear], pts[clear]
     samples = np.bincount(owner, minlength=len(a))
