@@ -18,7 +18,8 @@ from ..errors import InputError
 @click.argument("color", type=click.Path(path_type=Path))
 @click.option("--depth", type=click.Path(path_type=Path), default=None, help="16-bit depth image (PNG or TIFF).")
 @click.option("--intrinsics", type=click.Path(path_type=Path), default=None,
-              help="Intrinsics JSON (plain, a data set's meta.json, or the real-data layout with 'frames').")
+              help="Intrinsics JSON (plain, a data set's meta.json, or the real-data layout with 'frames'); needed "
+              "with depth only: colour alone works in pixels.")
 @click.option("--depth-scale", type=float, default=None, help="Metres per depth unit (default: from the intrinsics "
               "file, else 0.001).")
 @click.option("--modality", type=click.Choice(["rgb", "depth", "rgbd"]), default="rgbd", show_default=True)
@@ -28,19 +29,24 @@ from ..errors import InputError
 def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scale: float | None, modality: str,
             scene_id: str, out_dir: Path, facts: bool) -> None:
     """Find objects, faces and planes in one frame COLOR; write OUT/scene.json and OUT/overlay.png."""
-    from ..rgbd import load_frame, read_intrinsics
+    from ..camera import Intrinsics
+    from ..rgbd import load_frame, read_color, read_intrinsics
     from .overlay import draw_overlay
     from .perceive import perceive
 
     if modality in ("depth", "rgbd") and depth is None:
         raise InputError("--depth", f"modality {modality!r} needs a depth image")
-    if intrinsics is None:
-        raise InputError("--intrinsics", "an intrinsics JSON file is required")
+    if intrinsics is None and modality != "rgb":
+        raise InputError("--intrinsics", f"modality {modality!r} needs an intrinsics JSON file")
     for image in (color, depth if modality != "rgb" else None):
         if image is not None and not Path(image).is_file():
             raise InputError(image, "image not found")
     frame_name = Path(color).stem.removesuffix("_rgb")
-    k, scale = read_intrinsics(intrinsics, frame_name)
+    if intrinsics is not None:
+        k, scale = read_intrinsics(intrinsics, frame_name)
+    else:  # colour alone reads no depth: nominal intrinsics (a 60-degree-wide view) only fill the frame's slot
+        h, w = read_color(color).shape[:2]
+        k, scale = Intrinsics(w * 0.866, w * 0.866, (w - 1) / 2, (h - 1) / 2, w, h), 0.001
     frame = load_frame(color, depth if modality != "rgb" else None, k,
                        depth_scale if depth_scale is not None else scale, name=frame_name)
     scene = perceive(frame, modality, scene_id=scene_id)

@@ -16,6 +16,7 @@ from .gaps import close_gaps
 from .polygons import (area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
                        sample_boundary, simplify)
 from .segments import detect_color_segments, union_find_labels
+from .silhouette import foreground, regions_of, silhouette_segments
 from .split import reflex_corners, split_by_diagonal, split_concave
 from .step_edge import smoothed_gradients, step_cut
 from .thin import thin_faces
@@ -99,8 +100,10 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     of the searched area, hugging its frame, non-simple, poorly supported by edges (< ``min_support`` of the
     perimeter), or containing another face (a background region around an object) are dropped.
 
-    With ``colour_alone`` (no depth to find or part faces), segments are carried on across gaps in their edges
-    where the colour still steps (gaps.close_gaps), and a kept face whose outline the graph traced whole is cut
+    With ``colour_alone`` (no depth to find or part faces), the sides of the solids' silhouettes, told from the
+    floor by chromaticity, join the segments (silhouette.py), segments are carried on across gaps in their edges
+    where the colour still steps (gaps.close_gaps), faces on two separate silhouettes are never neighbours (the
+    graph joins solids that nearly touch), and a kept face whose outline the graph traced whole is cut
     along a faint straight edge from one of its corners (step_edge.step_cut): most colour-only misses on noisy
     renders are corners the segments stop short of and two faces of one colour traced as one. Faces of the
     colour of the image's border (floor texture, shadows, painted lines) are then dropped
@@ -121,8 +124,9 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     t1 = time.perf_counter()
     segs = detect_color_segments(chans)
     sgrads = smoothed_gradients(chans) if colour_alone else None  # for close_gaps and step_cut
+    solids = foreground(crop) if colour_alone else None  # regions not of the border's chromaticity
     if colour_alone:
-        segs = close_gaps(segs, sgrads)
+        segs = close_gaps(np.concatenate([segs, silhouette_segments(solids, grad)]), sgrads)
     t2 = time.perf_counter()
     g = build_graph(segs, edge_dist=dist)
     cw, ch = u1 - u0, v1 - v0
@@ -189,8 +193,10 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         cands = [c for c, bg in zip(cands, background_faces([c[0] for c in cands], crop)) if not bg]
     faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for p, e, s, a in cands]
     faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
+    # under colour alone, faces on two separate solids' regions are not neighbours, whatever edges they share
+    region = regions_of([f.polygon - np.array([u0, v0], float) for f in faces], solids) if colour_alone else None
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
-                 if faces[i].edges & faces[j].edges]
+                 if faces[i].edges & faces[j].edges and (region is None or region[i] == region[j])]
     lab = union_find_labels(len(faces), np.array(adjacency, int).reshape(-1, 2))
     groups: dict[int, list[int]] = {}
     for i, l in enumerate(lab):

@@ -37,6 +37,23 @@ def test_extract_needs_depth_for_depth_modality(tmp_path, box_frame, capsys):
     assert not out.exists()
 
 
+def test_extract_needs_no_intrinsics_for_colour_alone(tmp_path, box_frame):
+    c, _, _ = _write_frame(tmp_path, box_frame[0])
+    out = tmp_path / "out"
+    rc = main(["extract", str(c), "--modality", "rgb", "--out", str(out), "--facts"])
+    assert rc == 0
+    scene = json.loads((out / "scene.json").read_text())
+    assert scene["modality"] == "rgb" and len(scene["objects"][0]["faces"]) == 3
+    assert (out / "facts.pl").read_text().count("quadrilateral(") >= 3
+
+
+def test_extract_needs_intrinsics_with_depth(tmp_path, box_frame, capsys):
+    c, d, _ = _write_frame(tmp_path, box_frame[0])
+    rc = main(["extract", str(c), "--depth", str(d), "--modality", "rgbd", "--out", str(tmp_path / "o")])
+    assert rc == 2
+    assert "--intrinsics" in capsys.readouterr().err and not (tmp_path / "o").exists()
+
+
 def test_extract_rejects_a_missing_image(tmp_path, box_frame, capsys):
     _, d, k = _write_frame(tmp_path, box_frame[0])
     rc = main(["extract", str(tmp_path / "nope.png"), "--depth", str(d), "--intrinsics", str(k),
