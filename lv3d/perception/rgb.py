@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .background import background_faces
+from .background import background_faces, chromaticity, face_chromaticity
 from .edges import channel_edges, channels, edge_distance, edge_support
 from .faces import bounded_faces, build_graph
 from .gaps import close_gaps
@@ -102,8 +102,9 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
 
     With ``colour_alone`` (no depth to find or part faces), the sides of the solids' silhouettes, told from the
     floor by chromaticity, join the segments (silhouette.py), segments are carried on across gaps in their edges
-    where the colour still steps (gaps.close_gaps), faces on two separate silhouettes are never neighbours (the
-    graph joins solids that nearly touch), and a kept face whose outline the graph traced whole is cut
+    where the colour still steps (gaps.close_gaps), faces on two separate silhouettes or of two chromaticities are
+    never neighbours (the graph joins solids that nearly touch or overlap; a solid is taken to be of one colour, so
+    a printed carton comes out as one object per colour: _same_solid), and a kept face whose outline the graph traced whole is cut
     along a faint straight edge from one of its corners (step_edge.step_cut): most colour-only misses on noisy
     renders are corners the segments stop short of and two faces of one colour traced as one. Faces of the
     colour of the image's border (floor texture, shadows, painted lines) are then dropped
@@ -193,10 +194,10 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         cands = [c for c, bg in zip(cands, background_faces([c[0] for c in cands], crop)) if not bg]
     faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for p, e, s, a in cands]
     faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
-    # under colour alone, faces on two separate solids' regions are not neighbours, whatever edges they share
-    region = regions_of([f.polygon - np.array([u0, v0], float) for f in faces], solids) if colour_alone else None
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
-                 if faces[i].edges & faces[j].edges and (region is None or region[i] == region[j])]
+                 if faces[i].edges & faces[j].edges]
+    if colour_alone:
+        adjacency = _same_solid(adjacency, [f.polygon - np.array([u0, v0], float) for f in faces], crop, solids)
     lab = union_find_labels(len(faces), np.array(adjacency, int).reshape(-1, 2))
     groups: dict[int, list[int]] = {}
     for i, l in enumerate(lab):
@@ -205,6 +206,18 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     t3 = time.perf_counter()
     timings = {"edges": (t1 - t0) * 1e3, "segments": (t2 - t1) * 1e3, "faces": (t3 - t2) * 1e3}
     return RGBResult(faces, ordered, adjacency, timings, dist)
+
+
+def _same_solid(pairs: list[tuple[int, int]], polys: list[np.ndarray], color: np.ndarray, solids: np.ndarray,
+                max_chroma: float = 0.1) -> list[tuple[int, int]]:
+    """The pairs of neighbouring faces (polygons ``polys`` in ``color``'s pixels) that can be faces of one solid:
+    on one region of ``solids`` (silhouette.foreground), and of median chromaticities within ``max_chroma`` (a
+    solid's faces share its colour, whatever their shading). The graph joins solids that nearly touch or overlap
+    in the image; without depth this is what parts them."""
+    region = regions_of(polys, solids)
+    chroma = chromaticity(color)
+    hue = [face_chromaticity(p, chroma) for p in polys]
+    return [(i, j) for i, j in pairs if region[i] == region[j] and np.hypot(*(hue[i] - hue[j])) <= max_chroma]
 
 
 def _part(q: np.ndarray, edges: frozenset, cut: tuple[int, int], vertices: np.ndarray, dist: np.ndarray) -> tuple:

@@ -10,7 +10,7 @@ from lv3d.rgbd import RGBD
 
 def box_on_table(width=320, height=240, half=(0.05, 0.05), top=0.1, yaw_deg=30.0, noise_m=0.0, seed=0):
     """A box of half extents ``half`` (metres) and height ``top`` standing on a table (world z = 0), seen from
-    0.6 m away and 40 deg above. Returns an RGBD frame (each box face its own colour) and the faces' outward
+    0.6 m away and 40 deg above. Returns an RGBD frame (each box face its own shade of one colour) and the faces' outward
     normals in the camera frame as {name: (3,)} for the visible ones (top, and the sides that face the camera)."""
     k = Intrinsics(fx=300.0 * width / 320, fy=300.0 * width / 320, cx=(width - 1) / 2, cy=(height - 1) / 2,
                    width=width, height=height)
@@ -43,8 +43,10 @@ def box_on_table(width=320, height=240, half=(0.05, 0.05), top=0.1, yaw_deg=30.0
     pts_b = o + tmin[:, None] * d
     sign = np.where(np.take_along_axis(pts_b, axis[:, None], 1)[:, 0] > (lo + hi)[axis] / 2, 1, 0)
     face_code = axis * 2 + sign  # 0..5
-    palette = np.array([[200, 60, 60], [60, 200, 60], [60, 60, 200], [200, 200, 60], [150, 80, 30], [40, 180, 200]],
-                       np.uint8)
+    # one hue, each face its own shade: a solid of one colour, as the renders' (colour alone takes faces of two
+    # chromaticities for two solids)
+    palette = np.round(np.array([200, 110, 60])[None] * np.array([1.2, 0.55, 0.8, 0.4, 1.0, 0.65])[:, None]
+                       ).clip(0, 255).astype(np.uint8)
     color = np.full((height * width, 3), 128, np.uint8)
     color[hit_box] = palette[face_code[hit_box]]
     color = color.reshape(height, width, 3)
