@@ -1,8 +1,8 @@
-"""Rewrite the figures in experiments/README.md's study tables from the committed reports
-(experiments/results/<study>/results.csv), so that the tables are never typed by hand.
+"""Rewrite the figures in experiments/README.md's study tables, and in the top-level README's seed-protocol table,
+from the committed reports (experiments/results/<study>/results.csv), so that the tables are never typed by hand.
 
     .venv/bin/python scripts/readme_tables.py            # print what would change
-    .venv/bin/python scripts/readme_tables.py --write    # rewrite experiments/README.md
+    .venv/bin/python scripts/readme_tables.py --write    # rewrite both READMEs
 
 Each study's section (its ``### heading``) holds one table, whose layout is kept: row and column labels stay
 as written; only the figures are recomputed, as the runner's report computes them (lv3d/experiment/report.py:
@@ -11,6 +11,9 @@ per fold the mean binary accuracy over the class tasks, then the mean over folds
   (``mean ± std``).
 - Every other table has a row per condition, in the study's order, and a column per system
   (``mean / multi``). Column labels are system names, optionally followed by words in parentheses.
+- The top-level README's seed-protocol table (header ``| system | clean | realsense noise |``) has a row per lv3d
+  system and the best CNN and the best decision tree of each condition (highest mean binary accuracy), each cell
+  ``mean / multi``, the best baseline's modality in parentheses.
 """
 
 from __future__ import annotations
@@ -30,6 +33,9 @@ from lv3d.experiment.stats import mean_std  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "experiments" / "README.md"
+TOP_README = ROOT / "README.md"
+TOP_HEADER = "| system | clean | realsense noise |"
+BEST = {"best CNN": "cnn-", "best decision tree": "tree-"}  # row label prefix -> the systems it picks among
 # section heading -> (study, its table's first header cell)
 SECTIONS = {
     "### Seed protocol": ("seed_protocol", "system"),
@@ -125,17 +131,47 @@ def rewrite(text: str) -> str:
     return "\n".join(lines)
 
 
+def rewrite_top(text: str) -> str:
+    """The top-level README ``text`` with its seed-protocol table's figures recomputed."""
+    lines = text.split("\n")
+    if TOP_HEADER not in lines:
+        raise SystemExit(f"error: {TOP_README}: no table with the header {TOP_HEADER!r}")
+    i = lines.index(TOP_HEADER)
+    s = summary("seed_protocol")
+    conds = [f"noise={c.split()[0]}" for c in _cells(TOP_HEADER)[1:]]
+    j = i + 2
+    while j < len(lines) and lines[j].startswith("|"):
+        cells = _cells(lines[j])
+        label = cells[0]
+        bold = label.startswith("**")
+        row = [label]
+        for cond in conds:
+            prefix = next((p for k, p in BEST.items() if label.startswith(k)), None)
+            if prefix is None:
+                m, _, mm, _ = s[cond][_system(label)]
+                v = f"{m:.1f} / {mm:.1f}"
+            else:
+                best = max((x for x in s[cond] if x.startswith(prefix)), key=lambda x: (s[cond][x][0], x))
+                v = f"{s[cond][best][0]:.1f} / {s[cond][best][2]:.1f} ({best[len(prefix):]})"
+            row.append(f"**{v}**" if bold else v)
+        lines[j] = "| " + " | ".join(row) + " |"
+        j += 1
+    return "\n".join(lines)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--write", action="store_true", help="rewrite experiments/README.md (default: print a diff)")
+    ap.add_argument("--write", action="store_true", help="rewrite both READMEs (default: print a diff)")
     a = ap.parse_args(argv)
-    old = README.read_text()
-    new = rewrite(old)
-    if a.write:
-        README.write_text(new)
     import difflib
 
-    sys.stdout.writelines(difflib.unified_diff(old.splitlines(True), new.splitlines(True), "README.md", "rewritten"))
+    for path, fn in ((README, rewrite), (TOP_README, rewrite_top)):
+        old = path.read_text()
+        new = fn(old)
+        if a.write:
+            path.write_text(new)
+        name = str(path.relative_to(ROOT))
+        sys.stdout.writelines(difflib.unified_diff(old.splitlines(True), new.splitlines(True), name, "rewritten"))
     return 0
 
 
