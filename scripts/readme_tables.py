@@ -145,8 +145,8 @@ def rewrite_top(text: str) -> str:
         label = cells[0]
         bold = label.startswith("**")
         row = [label]
+        prefix = next((p for k, p in BEST.items() if label.startswith(k)), None)  # None: an lv3d system's row
         for cond in conds:
-            prefix = next((p for k, p in BEST.items() if label.startswith(k)), None)
             if prefix is None:
                 m, _, mm, _ = s[cond][_system(label)]
                 v = f"{m:.1f} / {mm:.1f}"

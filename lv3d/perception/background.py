@@ -40,11 +40,11 @@ def face_chromaticity(poly: np.ndarray, chroma: np.ndarray, erode_px: int = 2, m
     return np.median(pixels, axis=0) if len(pixels) else np.full(2, np.nan)
 
 
-def background_faces(polys: list[np.ndarray], color: np.ndarray, radius: float = 0.01,
+def background_faces(polys: list[np.ndarray], chroma: np.ndarray, radius: float = 0.01,
                      min_share: float = 0.1) -> list[bool]:
-    """For each polygon (n, 2, pixels of ``color`` (H, W, 3) uint8 RGB): whether it is background, its median
-    chromaticity within ``radius`` of at least ``min_share`` of the border's pixels (border_chromaticity)."""
-    chroma = chromaticity(color)
+    """For each polygon (n, 2, pixels of the image whose ``chromaticity`` is ``chroma`` (H, W, 2)): whether it is
+    background, its median chromaticity within ``radius`` of at least ``min_share`` of the border's pixels
+    (border_chromaticity)."""
     border = border_chromaticity(chroma)
     out = []
     for p in polys:

@@ -104,13 +104,13 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     floor by chromaticity, join the segments (silhouette.py), segments are carried on across gaps in their edges
     where the colour still steps (gaps.close_gaps), faces on two separate silhouettes or of two chromaticities are
     never neighbours (the graph joins solids that nearly touch or overlap; a solid is taken to be of one colour, so
-    a printed carton comes out as one object per colour: _same_solid), and a kept face whose outline the graph traced whole is cut
-    along a faint straight edge from one of its corners (step_edge.step_cut): most colour-only misses on noisy
-    renders are corners the segments stop short of and two faces of one colour traced as one. Faces of the
-    colour of the image's border (floor texture, shadows, painted lines) are then dropped
-    (background.background_faces): most false colour-only faces on noisy renders are such. With depth (rgbd),
-    the planes find and part such faces; cut there too, the colour part that keeps a thin neighbour's strip
-    outvotes that neighbour's plane (realsense rgbd recall fell by one face on dev seeds 1000 and 2000)."""
+    a printed carton comes out as one object per colour: _same_solid), and a kept face whose outline the graph
+    traced whole is cut along a faint straight edge from one of its corners (step_edge.step_cut): most colour-only
+    misses on noisy renders are corners the segments stop short of and two faces of one colour traced as one. Faces
+    of the colour of the image's border (floor texture, shadows, painted lines) are then dropped
+    (background.background_faces): most false colour-only faces on noisy renders are such. With depth (rgbd), the
+    planes find and part such faces; cut there too, the colour part that keeps a thin neighbour's strip outvotes
+    that neighbour's plane (realsense rgbd recall fell by one face on dev seeds 1000 and 2000)."""
     import time
 
     t0 = time.perf_counter()
@@ -124,9 +124,11 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     dist = edge_distance(edges)
     t1 = time.perf_counter()
     segs = detect_color_segments(chans)
-    sgrads = smoothed_gradients(chans) if colour_alone else None  # for close_gaps and step_cut
-    solids = foreground(crop) if colour_alone else None  # regions not of the border's chromaticity
+    sgrads = solids = chroma = None
     if colour_alone:
+        sgrads = smoothed_gradients(chans)  # for close_gaps and step_cut
+        solids = foreground(crop)  # regions not of the border's chromaticity
+        chroma = chromaticity(crop)  # for background_faces and _same_solid
         segs = close_gaps(np.concatenate([segs, silhouette_segments(solids, grad)]), sgrads)
     t2 = time.perf_counter()
     g = build_graph(segs, edge_dist=dist)
@@ -191,13 +193,13 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     cands += _thin_cands(cands, segs, dist, min_area_px, made_up)
     cands = _join_thin_to_traced(cands, n_traced, dist)
     if colour_alone and cands:
-        cands = [c for c, bg in zip(cands, background_faces([c[0] for c in cands], crop)) if not bg]
+        cands = [c for c, bg in zip(cands, background_faces([c[0] for c in cands], chroma)) if not bg]
     faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for p, e, s, a in cands]
     faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
                  if faces[i].edges & faces[j].edges]
     if colour_alone:
-        adjacency = _same_solid(adjacency, [f.polygon - np.array([u0, v0], float) for f in faces], crop, solids)
+        adjacency = _same_solid(adjacency, [f.polygon - np.array([u0, v0], float) for f in faces], chroma, solids)
     lab = union_find_labels(len(faces), np.array(adjacency, int).reshape(-1, 2))
     groups: dict[int, list[int]] = {}
     for i, l in enumerate(lab):
@@ -208,14 +210,14 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     return RGBResult(faces, ordered, adjacency, timings, dist)
 
 
-def _same_solid(pairs: list[tuple[int, int]], polys: list[np.ndarray], color: np.ndarray, solids: np.ndarray,
+def _same_solid(pairs: list[tuple[int, int]], polys: list[np.ndarray], chroma: np.ndarray, solids: np.ndarray,
                 max_chroma: float = 0.1) -> list[tuple[int, int]]:
-    """The pairs of neighbouring faces (polygons ``polys`` in ``color``'s pixels) that can be faces of one solid:
+    """The pairs of neighbouring faces (polygons ``polys`` in the pixels of the image whose chromaticity is
+    ``chroma``, background.chromaticity) that can be faces of one solid:
     on one region of ``solids`` (silhouette.foreground), and of median chromaticities within ``max_chroma`` (a
     solid's faces share its colour, whatever their shading). The graph joins solids that nearly touch or overlap
     in the image; without depth this is what parts them."""
     region = regions_of(polys, solids)
-    chroma = chromaticity(color)
     hue = [face_chromaticity(p, chroma) for p in polys]
     return [(i, j) for i, j in pairs if region[i] == region[j] and np.hypot(*(hue[i] - hue[j])) <= max_chroma]
 

@@ -85,16 +85,16 @@ def step_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: 
     """The two parts of ``poly`` (n, 2, pixels) cut along the line from a corner to a point of a side not at that
     corner, where the colour steps across it, or None. ``grads``: :func:`smoothed_gradients` (blurred by
     ``sigma_px``) in the polygon's pixel frame. A line's step is, per channel, the mean derivative across it over
-    its samples (every ``sample_px``, ``trim_px`` left out at each end) lying ``shift_px`` + 2 ``sigma_px`` + 1
-    px or more inside the outline, so that the outline's own edge and the shifted lines stay out; its control is
-    the largest such step on the line shifted ``shift_px`` to either side. A cut needs at least ``min_samples`` clear samples, a step (largest over
-    the channels) of at least ``min_step`` grey levels per pixel and ``rel_step`` times its control, and parts of
-    at least ``min_area_px``. Of the lines that pass, the one whose step exceeds ``rel_step`` times its control
-    by most is taken. On realsense renders (dev seeds 1000-1004, true outlines), the colour difference 2 px to
-    either side of the faint edge between two faces of one colour was about 4 times that 6 px off where the
-    edge could be seen at all (cube 1004's top and front, 8.6 grey levels; a pentagonal prism's top and side,
-    10); of nine such edges, five stood out 2.2 times or less. Clean renders gain too (a thin top face whose
-    edge is faint)."""
+    its samples (every ``sample_px``, ``trim_px`` left out at each end) lying ``shift_px`` + 2 ``sigma_px`` + 1 px
+    or more inside the outline, so that the outline's own edge and the shifted lines stay out; its control is the
+    largest such step on the line shifted ``shift_px`` to either side. A cut needs at least ``min_samples`` clear
+    samples, a step (largest over the channels) of at least ``min_step`` grey levels per pixel and ``rel_step``
+    times its control, and parts of at least ``min_area_px``. Of the lines that pass, the one whose step exceeds
+    ``rel_step`` times its control by most is taken. On realsense renders (dev seeds 1000-1004, true outlines), the
+    colour difference 2 px to either side of the faint edge between two faces of one colour was about 4 times that 6
+    px off where the edge could be seen at all (cube 1004's top and front, 8.6 grey levels; a pentagonal prism's top
+    and side, 10); of nine such edges, five stood out 2.2 times or less. Clean renders gain too (a thin top face
+    whose edge is faint)."""
     p = np.asarray(poly, np.float64)
     n = len(p)
     q, side = _outline_points(p, step_px)

@@ -31,7 +31,7 @@ def test_chromaticity_ignores_brightness():
 
 def test_a_shadow_and_a_floor_strip_are_background_the_object_is_not():
     strip = np.array([[20.0, 150.0], [120.0, 150.0], [120.0, 160.0], [20.0, 160.0]])
-    assert background_faces([SQUARE, SHADOW, strip], _scene()) == [False, True, True]
+    assert background_faces([SQUARE, SHADOW, strip], chromaticity(_scene())) == [False, True, True]
 
 
 def test_colour_alone_drops_the_shadow_beside_a_solid():
