@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from grounding._confidence import (ACUTE_BELOW_DEG, EQUAL_CORNERS_DEG, EQUAL_SIDES_RATIO, OBTUSE_ABOVE_DEG,
-                                   PARALLEL_SIDES_DEG, PLANE_ANGLE_DEG, RIGHT_ANGLE_DEG)
+                                   PARALLEL_SIDES_DEG, PERPENDICULAR_DEG, PLANE_ANGLE_DEG, RIGHT_ANGLE_DEG)
 from lv3d.perception.polygons import rasterize
 
 NGONS = {"triangle": 3, "quadrilateral": 4, "pentagon": 5, "hexagon": 6}
@@ -114,7 +114,7 @@ def truth_labels(cands, results, faces_mask, truth, k) -> list:
         if pred == "adjacent":
             labels.append(key in adj)
         elif pred == "perpendicular":
-            labels.append(abs(dih - 90) < RIGHT_ANGLE_DEG and ga["id"] != gb["id"])
+            labels.append(abs(dih - 90) < PERPENDICULAR_DEG and ga["id"] != gb["id"])
         elif pred == "parallel":
             labels.append(min(between, 180 - between) < PLANE_ANGLE_DEG)
         elif pred == "acute":

@@ -30,7 +30,7 @@ import math
 
 from ._calibration_table import FINAL, TABLE
 from ._confidence import (ACUTE_BELOW_DEG, EQUAL_SIDES_RATIO, OBTUSE_ABOVE_DEG, PARALLEL_SIDES_DEG, PLANE_ANGLE_DEG,
-                          RIGHT_ANGLE_DEG)
+                          PERPENDICULAR_DEG, RIGHT_ANGLE_DEG)
 
 P_CLIP = 1e-4  # logit(p) is taken of p clipped to [P_CLIP, 1 - P_CLIP]: saturated probabilities stay finite
 
@@ -54,9 +54,9 @@ _TOL_FRACTION = {
     "regular": lambda v: math.log(max(v, 1.0)) / math.log(EQUAL_SIDES_RATIO),
     "rectangle": lambda v: v / RIGHT_ANGLE_DEG,                               # v: largest |corner - 90| deg
     "parallelogram": lambda v: v / PARALLEL_SIDES_DEG,                        # v: opposite sides' angle deg
-    "perpendicular": lambda v: abs(v - 90.0) / RIGHT_ANGLE_DEG,               # v: interior dihedral deg
-    "acute": lambda v: 1.0 + (v - ACUTE_BELOW_DEG) / RIGHT_ANGLE_DEG,
-    "obtuse": lambda v: 1.0 + (OBTUSE_ABOVE_DEG - v) / RIGHT_ANGLE_DEG,
+    "perpendicular": lambda v: abs(v - 90.0) / PERPENDICULAR_DEG,               # v: interior dihedral deg
+    "acute": lambda v: 1.0 + (v - ACUTE_BELOW_DEG) / PERPENDICULAR_DEG,
+    "obtuse": lambda v: 1.0 + (OBTUSE_ABOVE_DEG - v) / PERPENDICULAR_DEG,
     "parallel": lambda v: v / PLANE_ANGLE_DEG,                                # v: angle between the planes deg
     "horizontal": lambda v: v / PLANE_ANGLE_DEG,                              # v: tilt to the support deg
     "vertical": lambda v: abs(90.0 - v) / PLANE_ANGLE_DEG,

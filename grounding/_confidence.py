@@ -26,12 +26,13 @@ from ._uncertainty import Quantities
 # tolerances (degrees, or a ratio)
 CORNER_TURN_MIN_DEG = 15.0   # a vertex is a corner when the outline turns by more than this
 PARALLEL_SIDES_DEG = 8.0     # parallelogram: opposite image sides parallel within this
-RIGHT_ANGLE_DEG = 10.0       # square / rectangle corners, perpendicular planes: 90 +- this
+RIGHT_ANGLE_DEG = 10.0       # square / rectangle corners: 90 +- this
+PERPENDICULAR_DEG = 7.0      # perpendicular planes: interior dihedral 90 +- this
 EQUAL_SIDES_RATIO = 1.12     # square / regular: longest side / shortest side at most this
 EQUAL_CORNERS_DEG = 10.0     # regular: largest corner - smallest corner at most this
 PLANE_ANGLE_DEG = 10.0       # horizontal, vertical, parallel: within this of the ideal
-ACUTE_BELOW_DEG = 80.0       # acute: interior dihedral below this
-OBTUSE_ABOVE_DEG = 100.0     # obtuse: interior dihedral above this
+ACUTE_BELOW_DEG = 83.0       # acute: interior dihedral below this
+OBTUSE_ABOVE_DEG = 97.0     # obtuse: interior dihedral above this
 SUPPORT_FULL = 0.75          # side-count facts: edge support at or above this costs no confidence
 MC_DRAWS = 256
 
@@ -57,6 +58,7 @@ class Confidences(eqx.Module):
 
     sides: Int[Array, " F"]
     p_sides: Float[Array, " F"]            # P(the polygon has exactly `sides` sides)
+    p_fewer: Float[Array, " F"]            # P(exactly one of its vertices is no corner: `sides` - 1 sides)
     p_parallelogram: Float[Array, " F"]
     p_rectangle: Float[Array, " F"]
     p_square: Float[Array, " F"]
@@ -132,7 +134,13 @@ def confidences(q: Quantities, std: Quantities, jq, cov, face_vmask, face_mask, 
     sides = jnp.sum(face_vmask, axis=1)
     turn = 180.0 - q.corner_deg
     p_corner = ndtr((turn - CORNER_TURN_MIN_DEG) / sd.corner_deg)
-    p_sides = jnp.prod(jnp.where(face_vmask, p_corner, 1.0), axis=1) * jnp.clip(edge_support / SUPPORT_FULL, 0.0, 1.0)
+    support = jnp.clip(edge_support / SUPPORT_FULL, 0.0, 1.0)
+    p_real = jnp.where(face_vmask, p_corner, 1.0)
+    p_sides = jnp.prod(p_real, axis=1) * support
+    # exactly one vertex is a point on a straight side: sum over i of (1 - p_i) * prod_{j != i} p_j
+    one_out = jnp.eye(p_real.shape[1], dtype=bool)[None]                                      # (1, i, j)
+    each = jnp.prod(jnp.where(one_out, 1.0 - p_real[:, None, :], p_real[:, None, :]), -1)    # (F, i)
+    p_fewer = jnp.sum(jnp.where(face_vmask, each, 0.0), -1) * support
 
     mc = draws(q, jq, cov, floors)
     m = face_vmask[None]
@@ -157,7 +165,7 @@ def confidences(q: Quantities, std: Quantities, jq, cov, face_vmask, face_mask, 
 
     pair = planar[:, None] & planar[None, :] & ~jnp.eye(planar.shape[0], dtype=bool)
     adj = adjacency & pair
-    p_perp = interval(q.dihedral_deg, sd.dihedral_deg, 90.0 - RIGHT_ANGLE_DEG, 90.0 + RIGHT_ANGLE_DEG) * pair
+    p_perp = interval(q.dihedral_deg, sd.dihedral_deg, 90.0 - PERPENDICULAR_DEG, 90.0 + PERPENDICULAR_DEG) * pair
     p_par = interval(q.parallel_deg, sd.parallel_deg, -PLANE_ANGLE_DEG, PLANE_ANGLE_DEG) * pair
     p_acute = ndtr((ACUTE_BELOW_DEG - q.dihedral_deg) / sd.dihedral_deg) * adj
     p_obtuse = ndtr((q.dihedral_deg - OBTUSE_ABOVE_DEG) / sd.dihedral_deg) * adj
@@ -168,6 +176,6 @@ def confidences(q: Quantities, std: Quantities, jq, cov, face_vmask, face_mask, 
     c3 = q.corner3d_deg
     corner_spread = jnp.max(jnp.where(mf, c3, -big), -1) - jnp.min(jnp.where(mf, c3, big), -1)
     right_dev = jnp.max(jnp.where(mf, jnp.abs(c3 - 90.0), 0.0), -1)
-    return Confidences(sides, p_sides * face_mask, p_para * face_mask, p_rect, p_square, p_regular, p_h, p_v,
+    return Confidences(sides, p_sides * face_mask, p_fewer * face_mask, p_para * face_mask, p_rect, p_square, p_regular, p_h, p_v,
                        p_perp, p_par, p_acute, p_obtuse, edge_support, side_ratio, corner_spread, right_dev,
                        jnp.max(q.para_dev_deg, -1))

@@ -23,6 +23,7 @@ from .scene import Face, Scene, SceneObject
 MIN_CONF = 0.05
 CAP_PX = 30.0  # edge fields are clipped to +-this many pixels
 SIDE_NAMES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
+_SIDE_PREDS = frozenset(SIDE_NAMES.values())
 
 
 @dataclass
@@ -236,6 +237,8 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 cands.append(("face_of", (obj.id, f.id), support_term, None))
                 if n in SIDE_NAMES:
                     cands.append((SIDE_NAMES[n], (f.id,), c["p_sides"][i], float(n)))
+                if n - 1 in SIDE_NAMES:  # one vertex may be a point on a straight side
+                    cands.append((SIDE_NAMES[n - 1], (f.id,), c["p_fewer"][i], float(n - 1)))
                 if n == 4:
                     cands.append(("parallelogram", (f.id,), c["p_parallelogram"][i], c["para_dev_deg"][i]))
                 if has_plane[i]:
@@ -302,17 +305,27 @@ def _face_features(g: dict, index: np.ndarray, ns: list[int]) -> list[dict]:
     # float32, as per face before; the minimum over each face's real corners (padding reads +inf)
     turn = 180.0 - g["quantities"]["corner_deg"][:nf, :index.shape[1]]
     sd = np.hypot(g["std"]["corner_deg"][:nf, :index.shape[1]], 1.2)
-    min_turn = np.where(real, turn, np.inf).min(1).tolist()
-    min_z = np.where(real, (turn - 15.0) / sd, np.inf).min(1).tolist()
+    turn = np.where(real, turn, np.inf)
+    z = np.where(real, (turn - 15.0) / sd, np.inf)
+    weakest = np.argmin(z, axis=1)
     support = g["conf"]["edge_support"][:nf].tolist()
     out = []
     for i, n in enumerate(ns):
         poly = g["vertices"][index[i, :n]]
-        out.append({"sides": n, "min_turn_deg": min_turn[i], "min_turn_z": min_z[i], "support": support[i],
-                    "log_area_px": float(np.log(max(area(poly), 1.0))),
-                    "min_side_px": float(np.linalg.norm(np.diff(poly, axis=0, append=poly[:1]), axis=1).min()),
-                    "faces": nf})
+        f = {"sides": n, "min_turn_deg": float(turn[i].min()), "min_turn_z": float(z[i].min()),
+             "support": support[i], "log_area_px": float(np.log(max(area(poly), 1.0))),
+             "min_side_px": _min_side(poly), "faces": nf}
+        if n > 3:
+            # the same measurements of the polygon without its weakest corner: what a (sides - 1) fact reads
+            k = weakest[i]
+            f["fewer"] = {**f, "sides": n - 1, "min_turn_deg": float(np.delete(turn[i], k).min()),
+                          "min_turn_z": float(np.delete(z[i], k).min()), "min_side_px": _min_side(np.delete(poly, k, 0))}
+        out.append(f)
     return out
+
+
+def _min_side(poly: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(poly, axis=0, append=poly[:1]), axis=1).min())
 
 
 def shared_side_px(a: np.ndarray, b: np.ndarray) -> float:
@@ -359,7 +372,7 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
         key = args if len(args) < 2 or args[0] <= args[1] else args[::-1]  # (a, b) and (b, a) share one
         if key not in weaker:
             fs = [by_face[a] for a in key if a in by_face]
-            weaker[key] = {k: min(f[k] for f in fs) for k in fs[0]} if fs else {}
+            weaker[key] = {k: min(f[k] for f in fs) for k in fs[0] if k != "fewer"} if fs else {}
             if len(key) == 2 and key[0] in by_result and key[1] in by_result:
                 a, b = by_result[key[0]], by_result[key[1]]
                 weaker[key]["shared_side_px"] = shared_side_px(a.polygon, b.polygon)
@@ -374,7 +387,11 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
             fs = by_obj.get(args[0], [])
             out.append(max(fs, key=lambda f: f["support"]) if fs else {})
         else:
-            out.append(combined(args) if value is None else {**combined(args), "value": value})
+            f = combined(args)
+            fewer = by_face.get(args[0], {}).get("fewer")
+            if pred in _SIDE_PREDS and fewer is not None and value == fewer["sides"]:
+                f = fewer  # the (sides - 1) fact: the polygon without its weakest corner
+            out.append(f if value is None else {**f, "value": value})
     return out
 
 

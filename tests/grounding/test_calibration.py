@@ -11,7 +11,7 @@ import numpy as np
 
 import grounding
 from grounding._calibration import FINAL, TABLE, calibrate_with
-from grounding._confidence import EQUAL_SIDES_RATIO, RIGHT_ANGLE_DEG
+from grounding._confidence import ACUTE_BELOW_DEG, EQUAL_SIDES_RATIO, PERPENDICULAR_DEG
 from grounding._problem import SIZES
 from lv3d.describe import calibration_features, shared_side_px
 
@@ -49,8 +49,9 @@ def test_tol_frac_is_the_value_in_units_of_the_tolerance_clipped():
 
     assert abs(conf("square", EQUAL_SIDES_RATIO) - 1.0) < 1e-9        # at the boundary: 1
     assert abs(conf("square", EQUAL_SIDES_RATIO ** 2) - 2.0) < 1e-9
-    assert abs(conf("perpendicular", 90.0 + RIGHT_ANGLE_DEG / 2) - 0.5) < 1e-9
-    assert abs(conf("acute", 60.0) - -1.0) < 1e-9                     # 20 deg inside the 80 deg limit
+    assert abs(conf("perpendicular", 90.0 + PERPENDICULAR_DEG / 2) - 0.5) < 1e-9
+    # two tolerances inside the acute limit: 1 - 2
+    assert abs(conf("acute", ACUTE_BELOW_DEG - 2 * PERPENDICULAR_DEG) - -1.0) < 1e-9
     assert abs(conf("square", 50.0) - 3.0) < 1e-9                     # clipped: 3 tolerances out at most
 
 

@@ -101,4 +101,11 @@ def test_face_features_equal_the_per_face_computation():
                 "support": float(g["conf"]["edge_support"][i]), "log_area_px": float(np.log(max(area(poly), 1.0))),
                 "min_side_px": float(np.linalg.norm(np.diff(poly, axis=0, append=poly[:1]), axis=1).min()),
                 "faces": len(ns)}
+        if n > 3:  # the polygon without its weakest corner (smallest turn in spreads)
+            z = (turn - 15.0) / sd
+            k = int(np.argmin(z))
+            rest = np.delete(poly, k, 0)
+            want["fewer"] = {**want, "sides": n - 1, "min_turn_deg": float(np.delete(turn, k).min()),
+                             "min_turn_z": float(np.delete(z, k).min()),
+                             "min_side_px": float(np.linalg.norm(np.diff(rest, axis=0, append=rest[:1]), axis=1).min())}
         assert got[i] == want

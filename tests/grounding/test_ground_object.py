@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import grounding
+from grounding._confidence import ACUTE_BELOW_DEG
 
 from grounding_synth import INTR, plane_through, project, render_polygons, sample_face, wedge
 
@@ -54,11 +55,11 @@ def test_joint_refinement_recovers_a_right_angled_wedge():
 
 def test_an_angle_at_the_edge_of_its_tolerance_is_uncertain():
     rng = np.random.default_rng(4)
-    prob, _, field, _, _ = _problem(80.0, rng)
+    prob, _, field, _, _ = _problem(ACUTE_BELOW_DEG, rng)
     g = grounding.ground_object(prob, field, True)
     p = float(g.conf.p_perpendicular[0, 1])
     assert 0.15 < p < 0.85
-    assert abs(p + float(g.conf.p_acute[0, 1]) - 1.0) < 0.05  # the two share the boundary at 80 degrees
+    assert abs(p + float(g.conf.p_acute[0, 1]) - 1.0) < 0.05  # the two share the boundary
 
 
 def test_refinement_reduces_vertex_error_and_unrefined_still_has_confidences():
@@ -99,7 +100,11 @@ def test_side_count_confidence_falls_for_a_nearly_straight_corner(n):
     # the same outline with a spurious vertex in the middle of its first side
     extra = np.insert(poly, 1, (poly[0] + poly[1]) / 2 + np.array([0.3, 0.0]), axis=0)
     spurious, _ = grounding.pack_object([extra], intrinsics=INTR)
-    p_clean = float(grounding.ground_object(clean, field, True).conf.p_sides[0])
-    p_spur = float(grounding.ground_object(spurious, field, True).conf.p_sides[0])
-    assert p_clean > 0.9
-    assert p_spur < 0.2
+    c_clean = grounding.ground_object(clean, field, True).conf
+    c_spur = grounding.ground_object(spurious, field, True).conf
+    assert float(c_clean.p_sides[0]) > 0.9
+    assert float(c_spur.p_sides[0]) < 0.2
+    # the n-gon with one vertex too many: that exactly one vertex is no corner is likely, and of the clean
+    # outline (whose corners are all clear) it is not
+    assert float(c_spur.p_fewer[0]) > 0.8
+    assert float(c_clean.p_fewer[0]) < 0.05
