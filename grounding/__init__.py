@@ -4,6 +4,8 @@ uncertainty into the confidences of facts. Pure functions over arrays; knows not
 from ._cache import enable_cache as enable_cache
 from ._calibration import calibrate as calibrate
 from ._calibration import measures_used as measures_used
+from ._confidence import CORNER_TURN_MIN_DEG as CORNER_TURN_MIN_DEG
+from ._confidence import CORNER_TURN_MIN_PLANE_DEG as CORNER_TURN_MIN_PLANE_DEG
 from ._confidence import Confidences as Confidences
 from ._confidence import Floors as Floors
 from ._confidence import SUPPORT_FULL as SUPPORT_FULL

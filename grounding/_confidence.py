@@ -24,7 +24,8 @@ from jaxtyping import Array, Float, Int
 from ._uncertainty import Quantities
 
 # tolerances (degrees, or a ratio)
-CORNER_TURN_MIN_DEG = 15.0   # a vertex is a corner when the outline turns by more than this
+CORNER_TURN_MIN_DEG = 15.0   # a vertex is a corner when the image outline turns by more than this
+CORNER_TURN_MIN_PLANE_DEG = 35.0  # ... or, on a face with a plane, the outline on the plane turns by more than this
 PARALLEL_SIDES_DEG = 8.0     # parallelogram: opposite image sides parallel within this
 RIGHT_ANGLE_DEG = 10.0       # square / rectangle corners: 90 +- this
 PERPENDICULAR_DEG = 7.0      # perpendicular planes: interior dihedral 90 +- this
@@ -58,7 +59,7 @@ class Confidences(eqx.Module):
 
     sides: Int[Array, " F"]
     p_sides: Float[Array, " F"]            # P(the polygon has exactly `sides` sides)
-    p_fewer: Float[Array, " F"]            # P(exactly one of its vertices is no corner: `sides` - 1 sides)
+    p_fewer: Float[Array, " F"]            # P(exactly one of its vertices is no corner: `sides` - 1 sides); 0 without a plane
     p_parallelogram: Float[Array, " F"]
     p_rectangle: Float[Array, " F"]
     p_square: Float[Array, " F"]
@@ -132,15 +133,21 @@ def confidences(q: Quantities, std: Quantities, jq, cov, face_vmask, face_mask, 
                 adjacency, edge_support, floors: Floors) -> Confidences:
     sd = floored(std, floors)
     sides = jnp.sum(face_vmask, axis=1)
-    turn = 180.0 - q.corner_deg
-    p_corner = ndtr((turn - CORNER_TURN_MIN_DEG) / sd.corner_deg)
+    planar = has_plane & face_mask
+    # a corner: the outline turns there. On a plane the turn is free of foreshortening, so true corners (60 deg and
+    # more for the data set's solids) stand far from kinks of a traced outline (docs/grounding.md); without one, the
+    # image turn
+    p_image = ndtr((180.0 - q.corner_deg - CORNER_TURN_MIN_DEG) / sd.corner_deg)
+    p_plane = ndtr((180.0 - q.corner3d_deg - CORNER_TURN_MIN_PLANE_DEG) / sd.corner3d_deg)
+    p_corner = jnp.where(planar[:, None], p_plane, p_image)
     support = jnp.clip(edge_support / SUPPORT_FULL, 0.0, 1.0)
     p_real = jnp.where(face_vmask, p_corner, 1.0)
     p_sides = jnp.prod(p_real, axis=1) * support
-    # exactly one vertex is a point on a straight side: sum over i of (1 - p_i) * prod_{j != i} p_j
+    # exactly one vertex is a point on a straight side: sum over i of (1 - p_i) * prod_{j != i} p_j. Only on a plane:
+    # in the image a true corner seen obliquely turns little too, so there it would speak of true corners as often
     one_out = jnp.eye(p_real.shape[1], dtype=bool)[None]                                      # (1, i, j)
     each = jnp.prod(jnp.where(one_out, 1.0 - p_real[:, None, :], p_real[:, None, :]), -1)    # (F, i)
-    p_fewer = jnp.sum(jnp.where(face_vmask, each, 0.0), -1) * support
+    p_fewer = jnp.sum(jnp.where(face_vmask, each, 0.0), -1) * support * planar
 
     mc = draws(q, jq, cov, floors)
     m = face_vmask[None]
@@ -157,7 +164,6 @@ def confidences(q: Quantities, std: Quantities, jq, cov, face_vmask, face_mask, 
     p_regular = jnp.mean(equal & (spread(mc.corner3d_deg) < EQUAL_CORNERS_DEG), 0)
     p_para = jnp.mean(jnp.all(mc.para_dev_deg < PARALLEL_SIDES_DEG, -1), 0) * quad
 
-    planar = has_plane & face_mask
     p_rect, p_square, p_regular = (p * planar for p in (p_rect, p_square, p_regular))
     oriented = planar & has_support
     p_h = interval(q.tilt_deg, sd.tilt_deg, -PLANE_ANGLE_DEG, PLANE_ANGLE_DEG) * oriented

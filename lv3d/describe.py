@@ -226,7 +226,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
             support_l = np.clip(g["conf"]["edge_support"] / grounding.SUPPORT_FULL, 0.0, 1.0).tolist()
             vstd_all = _largest_std(g["vertex_cov"])
             ns = [len(p) for p in polys]
-            feats = _face_features(g, index, ns)
+            feats = _face_features(g, index, ns, has_plane)
             for i, f in enumerate(chunk):
                 n = ns[i]
                 ids_i = index[i, :n]
@@ -237,7 +237,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 cands.append(("face_of", (obj.id, f.id), support_term, None))
                 if n in SIDE_NAMES:
                     cands.append((SIDE_NAMES[n], (f.id,), c["p_sides"][i], float(n)))
-                if n - 1 in SIDE_NAMES:  # one vertex may be a point on a straight side
+                if n - 1 in SIDE_NAMES and has_plane[i]:  # one vertex may be a point on a straight side
                     cands.append((SIDE_NAMES[n - 1], (f.id,), c["p_fewer"][i], float(n - 1)))
                 if n == 4:
                     cands.append(("parallelogram", (f.id,), c["p_parallelogram"][i], c["para_dev_deg"][i]))
@@ -296,17 +296,26 @@ def _largest_std(cov: np.ndarray) -> np.ndarray:
     return np.sqrt(np.clip(0.5 * (a + c) + np.hypot(0.5 * (a - c), b), 0.0, None))
 
 
-def _face_features(g: dict, index: np.ndarray, ns: list[int]) -> list[dict]:
+def _face_features(g: dict, index: np.ndarray, ns: list[int], has_plane: list[bool] | None = None) -> list[dict]:
     """Measurements of each face of a grounding result that the calibration may read: the weakest corner's
-    turn in units of its spread (how sure the side count is), edge support, image area and shortest side.
-    ``index``: (faces, S) union vertex id of each polygon slot; ``ns``: each face's side count."""
+    turn in units of its spread (how sure the side count is; on the face's plane where it has one, as the
+    confidence reads it), edge support, image area and shortest side. ``index``: (faces, S) union vertex id of
+    each polygon slot; ``ns``: each face's side count; ``has_plane``: which faces have a plane (default none)."""
+    import grounding
+
     nf = len(ns)
     real = np.arange(index.shape[1])[None, :] < np.asarray(ns)[:, None]
+    planar = np.zeros(nf, bool) if has_plane is None else np.asarray(has_plane[:nf], bool)
+    floors = grounding.Floors()
     # float32, as per face before; the minimum over each face's real corners (padding reads +inf)
-    turn = 180.0 - g["quantities"]["corner_deg"][:nf, :index.shape[1]]
-    sd = np.hypot(g["std"]["corner_deg"][:nf, :index.shape[1]], 1.2)
-    turn = np.where(real, turn, np.inf)
-    z = np.where(real, (turn - 15.0) / sd, np.inf)
+    cols = slice(None, index.shape[1])
+    turn_img = 180.0 - g["quantities"]["corner_deg"][:nf, cols]
+    turn_pl = 180.0 - g["quantities"]["corner3d_deg"][:nf, cols]
+    z_img = (turn_img - grounding.CORNER_TURN_MIN_DEG) / np.hypot(g["std"]["corner_deg"][:nf, cols], floors.corner_deg)
+    z_pl = (turn_pl - grounding.CORNER_TURN_MIN_PLANE_DEG) / np.hypot(g["std"]["corner3d_deg"][:nf, cols],
+                                                                       floors.corner3d_deg)
+    turn = np.where(real, np.where(planar[:, None], turn_pl, turn_img), np.inf)
+    z = np.where(real, np.where(planar[:, None], z_pl, z_img), np.inf)
     weakest = np.argmin(z, axis=1)
     support = g["conf"]["edge_support"][:nf].tolist()
     out = []

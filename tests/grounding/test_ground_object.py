@@ -104,7 +104,6 @@ def test_side_count_confidence_falls_for_a_nearly_straight_corner(n):
     c_spur = grounding.ground_object(spurious, field, True).conf
     assert float(c_clean.p_sides[0]) > 0.9
     assert float(c_spur.p_sides[0]) < 0.2
-    # the n-gon with one vertex too many: that exactly one vertex is no corner is likely, and of the clean
-    # outline (whose corners are all clear) it is not
-    assert float(c_spur.p_fewer[0]) > 0.8
-    assert float(c_clean.p_fewer[0]) < 0.05
+    # without a plane no (n - 1)-gon: in the image a true corner seen obliquely turns little too (tests/test_describe.py
+    # has the face with a plane)
+    assert float(c_spur.p_fewer[0]) == 0.0 and float(c_clean.p_fewer[0]) == 0.0
