@@ -1,14 +1,15 @@
 """Fit the per-(modality, predicate) confidence calibration maps and write grounding/_calibration_table.py.
 
 The table in the tree (docs/grounding.md, "Calibration on perceived scenes") was fitted in session 17 for both
-modalities after the dihedral tolerance became 90 +- 7 deg (docs/facts.md): 3500 scenes, each 1050-scene set
-~3.5 min on one core with rgbd and depth, the 420-scene check set ~1.2 min, the fit ~20 s:
+modalities, after the dihedral tolerance became 90 +- 7 deg (docs/facts.md) and side counts moved onto the plane:
+3500 scenes, each 1050-scene set ~3.5 min on one core with rgbd and depth, the 420-scene check set ~1.2 min, the
+fit ~20 s:
 
     for a in "30000 150 a150" "40000 150 b150" "60000 100 d60000" "70000 100 d70000"; do set -- $a
         .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class $2 --modalities rgbd,depth \
-            --out out/calib/s17_$3.pkl; done
-    .venv/bin/python benchmarks/calibration_data.py --fresh --seed 50000 --per-class 60 --modalities rgbd,depth --out out/calib/s17_c60.pkl
-    .venv/bin/python benchmarks/fit_calibration.py out/calib/s17_{a150,b150,d60000,d70000}.pkl --check out/calib/s17_c60.pkl
+            --out out/calib/s17p_$3.pkl; done
+    .venv/bin/python benchmarks/calibration_data.py --fresh --seed 50000 --per-class 60 --modalities rgbd,depth --out out/calib/s17p_c60.pkl
+    .venv/bin/python benchmarks/fit_calibration.py out/calib/s17p_{a150,b150,d60000,d70000}.pkl --check out/calib/s17p_c60.pkl
 
 For each (modality, predicate) four maps compete by scene-grouped 5-fold cross-validated log loss on the dev rows:
 the raw probability unchanged, a shift in logit space, Platt scaling (bias + slope on logit p), and Platt
