@@ -64,7 +64,8 @@ def report(rows: list[dict]) -> None:
         rs = [r for r in rows if r["modality"] == mod]
         if not rs:
             continue
-        print(f"{mod}: {len(rs)} faces; polygon has the true side count {np.mean([r['n'] == r['true'] for r in rs]):.3f},"
+        right_n = np.mean([r["n"] == r["true"] for r in rs])
+        print(f"{mod}: {len(rs)} faces; polygon has the true side count {right_n:.3f},"
               f" one vertex too many {np.mean([r['n'] == r['true'] + 1 for r in rs]):.3f}")
         for where, limits in (("image", IMAGE_LIMITS), ("plane", PLANE_LIMITS)):
             print(f"  {where} turn > limit: side count right  "
@@ -73,7 +74,8 @@ def report(rows: list[dict]) -> None:
         right = [r for r in rs if r["n"] == r["true"]]
         for where in ("image", "plane"):
             if extra and right:
-                print(f"  weakest {where} turn: one too many, median {np.median([r[where].min() for r in extra]):.1f} deg"
+                median = np.median([r[where].min() for r in extra])
+                print(f"  weakest {where} turn: one too many, median {median:.1f} deg"
                       f" (n = {len(extra)}); right count, 5th percentile "
                       f"{np.percentile([r[where].min() for r in right], 5):.1f} deg (n = {len(right)})")
 
