@@ -22,7 +22,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.grounding_truth import _backproject, match_faces  # noqa: E402
+from benchmarks.grounding_truth import _backproject, _corners, match_faces  # noqa: E402
 
 CLASSES = ["cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
            "tetrahedron"]
@@ -31,10 +31,9 @@ PLANE_LIMITS = (15, 20, 25, 30, 35, 40)
 
 
 def turns_deg(p: np.ndarray) -> np.ndarray:
-    """How far a closed outline (n, 2 or 3) turns at each vertex, degrees (0: straight on)."""
-    a, b = p - np.roll(p, 1, 0), np.roll(p, -1, 0) - p
-    c = (a * b).sum(1) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
-    return np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
+    """How far a closed outline (n, 2 or 3) turns at each vertex, degrees (0: straight on): 180 minus its corners
+    (grounding_truth's, which the truth side counts use)."""
+    return 180.0 - _corners(p)
 
 
 def face_rows(cls: str, seed: int, preset: str) -> list[dict]:
