@@ -157,11 +157,17 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         # colour faces seen edge-on (edge_on.py): their points dropped as flying, or on a plane depth merged into a
         # neighbour's; kept however small
         edge_on: set[int] = set()
+        # colour faces that merged two faces across a low-contrast edge take their plane's depth outline first,
+        # so that the other faces' choices (below) see that outline, not the merged one
+        swallowing = {a: o.polygons[m] for a, m in match.items() if o.polygons[m] is not None
+                      and _swallows_plane(poly_px[mine[a]], m, o, plane_px)
+                      and fit_face_plane(res.faces[mine[a]].polygon, dres.grid, seed=k) is None}
         colour_px = np.zeros(shape, bool)
-        for i in mine:
-            colour_px |= poly_px[i]
-        matched_poly = {a: _matched_polygon(res.faces[mine[a]].polygon, m, o, poly_px[mine[a]], plane_px, off,
-                                            dres, colour_px, seed=k) for a, m in match.items()}
+        for a, i in enumerate(mine):
+            colour_px |= rasterize(swallowing[a] - off, shape) if a in swallowing else poly_px[i]
+        matched_poly = {a: swallowing[a] if a in swallowing else
+                        _matched_polygon(res.faces[mine[a]].polygon, m, o, poly_px[mine[a]], off, dres, colour_px,
+                                         seed=k) for a, m in match.items()}
         matched_px = np.zeros(shape, bool)  # the pixels that colour faces matched to a plane explain
         for a, poly in matched_poly.items():
             matched_px |= poly_px[mine[a]] if poly is res.faces[mine[a]].polygon else rasterize(poly - off, shape)
@@ -178,6 +184,8 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
                                  seed=k)
                 if own is None and on_plane[a] >= 0.5 and not on_unclaimed_plane(f, poly_px[i], plane_px, claimed):
                     continue  # a patch of print or shadow on a plane that depth already has: not a face
+                if own is None and _spans_planes(poly_px[i], o, plane_px):
+                    continue  # two faces of one shade traced as one: depth's planes give them (below)
                 if own is None:
                     face = Face("", f.polygon, "rgb", edge_support=f.edge_support)
                     # a sliver on such a plane (just tested), or one whose points were all dropped as flying
@@ -293,18 +301,15 @@ def _own_plane(poly: np.ndarray, o: DepthObjectResult, dres: DepthResult, obj_gr
     return fit, absorbed, False
 
 
-def _matched_polygon(colour: np.ndarray, j: int, o: DepthObjectResult, colour_px: np.ndarray,
-                     plane_px: list[np.ndarray], off: np.ndarray, dres: DepthResult, all_colour_px: np.ndarray,
-                     seed: int) -> np.ndarray:
-    """The polygon of a colour face matched to plane ``j``: see :func:`_pick_polygon`; the depth one when the
-    colour outline swallowed another plane (and the points inside it do not make one plane); the colour one
-    when the depth outline reaches over the other colour faces (``all_colour_px``: their pixels, with this
-    face's own ``colour_px``, over the crop)."""
+def _matched_polygon(colour: np.ndarray, j: int, o: DepthObjectResult, colour_px: np.ndarray, off: np.ndarray,
+                     dres: DepthResult, all_colour_px: np.ndarray, seed: int) -> np.ndarray:
+    """The polygon of a colour face matched to plane ``j`` (one that swallowed another plane takes the depth one
+    before this is asked): see :func:`_pick_polygon`; the colour one when the depth outline reaches over the
+    other colour faces (``all_colour_px``: their pixels, with this face's own ``colour_px``, over the crop;
+    the depth outline in place of a swallowing face's)."""
     depth = o.polygons[j]
     if depth is None:
         return colour
-    if _swallows_plane(colour_px, j, o, plane_px) and fit_face_plane(colour, dres.grid, seed=seed) is None:
-        return depth
     if len(depth) == len(colour):
         return colour
     dm = rasterize(depth - off, colour_px.shape)
@@ -323,10 +328,24 @@ def _matched_polygon(colour: np.ndarray, j: int, o: DepthObjectResult, colour_px
 
 
 def _swallows_plane(poly_px: np.ndarray, own: int, o: DepthObjectResult, plane_px: list[np.ndarray]) -> bool:
-    """True when a colour face matched to plane ``own`` also holds most of another plane that is turned away
-    from it: the colour outline merged two faces whose shared edge had too little contrast."""
+    """True when a colour face matched to plane ``own`` also holds a good part (``_SWALLOWED_FRACTION``) of another
+    plane that is turned away from it: the colour outline took in part of the next face across a shared edge
+    with too little contrast."""
     return any(j != own and angle_deg(q.plane, o.planes[own].plane) >= _DISTINCT_PLANE_DEG
-               and _inside(plane_px[j], poly_px) >= 0.5 for j, q in enumerate(o.planes))
+               and _inside(plane_px[j], poly_px) >= _SWALLOWED_FRACTION for j, q in enumerate(o.planes))
+
+
+# a colour outline that strays over an edge takes in a few per cent of the next plane's cells (up to ~15% on dev
+# seed 4343); one that went on across a faint edge, a third of it (a pentagonal prism's top taking in its end)
+_SWALLOWED_FRACTION = 0.25
+
+
+def _spans_planes(poly_px: np.ndarray, o: DepthObjectResult, plane_px: list[np.ndarray]) -> bool:
+    """True when a colour face holds most of two planes that are turned away from each other: its outline went
+    round two faces whose shared edge had too little contrast (two faces of one shade)."""
+    held = [j for j in range(len(o.planes)) if _inside(plane_px[j], poly_px) >= 0.5]
+    return any(angle_deg(o.planes[a].plane, o.planes[b].plane) >= _DISTINCT_PLANE_DEG
+               for n, a in enumerate(held) for b in held[n + 1:])
 
 
 _COPLANAR_DEG = 5.0
