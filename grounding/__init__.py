@@ -4,10 +4,13 @@ uncertainty into the confidences of facts. Pure functions over arrays; knows not
 from ._cache import enable_cache as enable_cache
 from ._calibration import calibrate as calibrate
 from ._calibration import measures_used as measures_used
+from ._confidence import ACUTE_BELOW_DEG as ACUTE_BELOW_DEG
 from ._confidence import CORNER_TURN_MIN_DEG as CORNER_TURN_MIN_DEG
 from ._confidence import CORNER_TURN_MIN_PLANE_DEG as CORNER_TURN_MIN_PLANE_DEG
 from ._confidence import Confidences as Confidences
 from ._confidence import Floors as Floors
+from ._confidence import OBTUSE_ABOVE_DEG as OBTUSE_ABOVE_DEG
+from ._confidence import PERPENDICULAR_DEG as PERPENDICULAR_DEG
 from ._confidence import SUPPORT_FULL as SUPPORT_FULL
 from ._confidence import interval as interval
 from ._field import edge_distance_field as edge_distance_field

@@ -59,7 +59,8 @@ class Confidences(eqx.Module):
 
     sides: Int[Array, " F"]
     p_sides: Float[Array, " F"]            # P(the polygon has exactly `sides` sides)
-    p_fewer: Float[Array, " F"]            # P(exactly one of its vertices is no corner: `sides` - 1 sides); 0 without a plane
+    # P(exactly one of its vertices is no corner: `sides` - 1 sides); 0 without a plane
+    p_fewer: Float[Array, " F"]
     p_parallelogram: Float[Array, " F"]
     p_rectangle: Float[Array, " F"]
     p_square: Float[Array, " F"]
@@ -182,6 +183,6 @@ def confidences(q: Quantities, std: Quantities, jq, cov, face_vmask, face_mask, 
     c3 = q.corner3d_deg
     corner_spread = jnp.max(jnp.where(mf, c3, -big), -1) - jnp.min(jnp.where(mf, c3, big), -1)
     right_dev = jnp.max(jnp.where(mf, jnp.abs(c3 - 90.0), 0.0), -1)
-    return Confidences(sides, p_sides * face_mask, p_fewer * face_mask, p_para * face_mask, p_rect, p_square, p_regular, p_h, p_v,
-                       p_perp, p_par, p_acute, p_obtuse, edge_support, side_ratio, corner_spread, right_dev,
-                       jnp.max(q.para_dev_deg, -1))
+    return Confidences(sides, p_sides * face_mask, p_fewer * face_mask, p_para * face_mask, p_rect, p_square,
+                       p_regular, p_h, p_v, p_perp, p_par, p_acute, p_obtuse, edge_support, side_ratio,
+                       corner_spread, right_dev, jnp.max(q.para_dev_deg, -1))

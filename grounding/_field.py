@@ -135,6 +135,7 @@ def normal_edge_field(depth: np.ndarray, intrinsics: tuple[float, float, float, 
     img = np.clip((n + 1.0) * 127.5, 0, 255)
     # depth steps: log depth, so a jump of a given ratio looks the same near and far
     logz = np.log(np.maximum(pts[..., 2], 1e-3))
-    img = np.concatenate([img, np.clip((logz - logz[valid].min()) * 400.0, 0, 255)[..., None]], -1) if valid.any() else img
+    if valid.any():
+        img = np.concatenate([img, np.clip((logz - logz[valid].min()) * 400.0, 0, 255)[..., None]], -1)
     img[~valid] = 0
     return edge_distance_field(img.astype(np.uint8), low=low, high=high, cap_px=cap_px, roi=roi)

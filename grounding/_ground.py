@@ -73,7 +73,8 @@ def _ground_object(prob: ObjectProblem, field: Float[Array, "H W"], refine: Bool
     verts, planes = geometry(params, prob)
     dist = edge_distances(verts, prob, field)
     m = edge_mask(prob)
-    near = jnp.sum((jnp.abs(dist) < settings.support_px) * m, axis=(1, 2)) / jnp.maximum(jnp.sum(m, axis=(1, 2)) * dist.shape[2], 1)
+    near = jnp.sum((jnp.abs(dist) < settings.support_px) * m, axis=(1, 2)) / \
+        jnp.maximum(jnp.sum(m, axis=(1, 2)) * dist.shape[2], 1)
     support = jnp.where(prob.use_edges, near, prob.edge_support_prior)
     conf = confidences(q, std, jq, cov, prob.face_vmask, prob.face_mask, prob.has_plane, prob.has_support,
                        prob.adjacency, support, floors)

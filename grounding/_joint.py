@@ -50,7 +50,8 @@ def face_vertices(verts: Float[Array, "U 2"], prob: ObjectProblem) -> Float[Arra
     return verts[prob.face_index]
 
 
-def edge_distances(verts: Float[Array, "U 2"], prob: ObjectProblem, field: Float[Array, "H W"]) -> Float[Array, "F S N"]:
+def edge_distances(verts: Float[Array, "U 2"], prob: ObjectProblem,
+                   field: Float[Array, "H W"]) -> Float[Array, "F S N"]:
     """Edge-field value (pixels to the nearest image edge) at the samples along every side."""
     fv = face_vertices(verts, prob)
     samples = jax.vmap(edge_samples, in_axes=(0, 0, None))(fv, prob.face_vmask, EDGE_SAMPLES)

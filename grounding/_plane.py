@@ -49,7 +49,8 @@ def pixel_rays(uv: Float[Array, "n 2"], intrinsics: Float[Array, " 4"]) -> Float
     return jnp.stack([(uv[:, 0] - cx) / fx, (uv[:, 1] - cy) / fy, jnp.ones(uv.shape[0])], axis=1)
 
 
-def backproject(uv: Float[Array, "n 2"], plane: Float[Array, " 4"], intrinsics: Float[Array, " 4"]) -> Float[Array, "n 3"]:
+def backproject(uv: Float[Array, "n 2"], plane: Float[Array, " 4"],
+                intrinsics: Float[Array, " 4"]) -> Float[Array, "n 3"]:
     """Where the rays through pixels ``uv`` meet ``plane``: camera-frame points (metres)."""
     r = pixel_rays(uv, intrinsics)
     nr = r @ plane[:3]

@@ -189,7 +189,8 @@ def _pack(polygons, *, intrinsics, planes, points, use_edges, edge_support, adja
                     k, dk = i, d
             if k < 0 or dk > merge_px or k in ids:
                 if len(verts) >= MAX_VERTICES:
-                    raise (_TooBig if strict else ValueError)(f"an object has more than {MAX_VERTICES} distinct vertices")
+                    raise (_TooBig if strict else ValueError)(
+                        f"an object has more than {MAX_VERTICES} distinct vertices")
                 verts.append([pu, pv])
                 guided.append(False)
                 k = len(verts) - 1
@@ -255,10 +256,12 @@ def _pack(polygons, *, intrinsics, planes, points, use_edges, edge_support, adja
     es[:nf] = [1.0 if s is None else float(s) for s in edge_support]
     sp = np.array([0.0, -1.0, 0.0, 1.0]) if support_plane is None else np.asarray(support_plane, np.float64)
     fields = dict(
-        vertices=np.asarray(vertices, np.float32), vertex_mask=np.asarray(vmask), vertex_sigma_px=np.asarray(vsig, np.float32),
+        vertices=np.asarray(vertices, np.float32), vertex_mask=np.asarray(vmask),
+        vertex_sigma_px=np.asarray(vsig, np.float32),
         face_index=np.asarray(face_index), face_vmask=np.asarray(face_vmask), face_mask=np.asarray(fmask),
         use_edges=np.asarray(ue), edge_support_prior=np.asarray(es, np.float32), has_plane=np.asarray(has_plane),
-        planes=np.asarray(plane_arr, np.float32), pivots=np.asarray(pivots, np.float32), points=np.asarray(pts, np.float32), point_weight=np.asarray(pw, np.float32),
+        planes=np.asarray(plane_arr, np.float32), pivots=np.asarray(pivots, np.float32),
+        points=np.asarray(pts, np.float32), point_weight=np.asarray(pw, np.float32),
         links=np.asarray(links), link_mask=np.asarray(lmask), adjacency=np.asarray(adj),
         support_plane=np.asarray(sp, np.float32), has_support=np.asarray(support_plane is not None),
         intrinsics=np.asarray(intrinsics, np.float32))

@@ -6,8 +6,8 @@ Jacobian of residual block ``b`` (edges, depth, links; already whitened by its a
 ``s_b^2 = chi2_b / dof_b`` rescales a block whose residuals are larger than its noise model says
 (never below ``MIN_SCALE2``). For edges, ``J`` is that of the point-to-line distance of each sample
 across its side (unit gradient along the side's normal, weighted by the sample's robust weight): an
-edge-distance field is flat at its minimum, so its own Jacobian vanishes exactly where the fit is best. A derived quantity ``q(theta)`` gets ``Cov(q) = J_q Cov(theta) J_q^T`` with
-``J_q`` from ``jax.jacfwd``.
+edge-distance field is flat at its minimum, so its own Jacobian vanishes exactly where the fit is best. A
+derived quantity ``q(theta)`` gets ``Cov(q) = J_q Cov(theta) J_q^T`` with ``J_q`` from ``jax.jacfwd``.
 """
 
 from __future__ import annotations

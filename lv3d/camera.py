@@ -28,6 +28,12 @@ class Intrinsics:
         return cls(fx=615.0 * s, fy=615.0 * s, cx=(width - 1) / 2, cy=(height - 1) / 2, width=width, height=height)
 
     @classmethod
+    def nominal(cls, width: int, height: int) -> "Intrinsics":
+        """A 60-degree-wide pinhole view centred on the image: fills a colour-only frame's slot (colour alone
+        works in pixels and reads no depth)."""
+        return cls(width * 0.866, width * 0.866, (width - 1) / 2, (height - 1) / 2, width, height)
+
+    @classmethod
     def from_dict(cls, d: dict, where: str = "intrinsics") -> "Intrinsics":
         """Build from a mapping with fx, fy, cx, cy, width, height; validate (InputError on absurd values)."""
         try:
@@ -49,9 +55,11 @@ class Intrinsics:
         if not (8 <= self.width <= 16384 and 8 <= self.height <= 16384):
             raise InputError(where, f"absurd image size {self.width}x{self.height}")
         if not (0.1 * self.width <= self.fx <= 20 * self.width and 0.1 * self.height <= self.fy <= 20 * self.height):
-            raise InputError(where, f"absurd focal length fx={self.fx}, fy={self.fy} for a {self.width}x{self.height} image")
+            raise InputError(where, f"absurd focal length fx={self.fx}, fy={self.fy} "
+                                    f"for a {self.width}x{self.height} image")
         if not (0 <= self.cx <= self.width and 0 <= self.cy <= self.height):
-            raise InputError(where, f"principal point ({self.cx}, {self.cy}) lies outside the {self.width}x{self.height} image")
+            raise InputError(where, f"principal point ({self.cx}, {self.cy}) lies outside the "
+                                    f"{self.width}x{self.height} image")
 
     def to_dict(self) -> dict:
         return asdict(self)

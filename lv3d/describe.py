@@ -34,7 +34,8 @@ class FaceResult:
     polygon: np.ndarray          # refined polygon (n, 2), pixels
     plane: np.ndarray | None     # refined plane (n, d), camera frame, metres
     vertex_std_px: np.ndarray    # (n,) largest standard deviation of each vertex, pixels
-    features: dict = dc_field(default_factory=dict)  # measurements the confidence calibration reads (calibration_features)
+    # measurements the confidence calibration reads (calibration_features)
+    features: dict = dc_field(default_factory=dict)
 
 
 @dataclass
@@ -306,7 +307,7 @@ def _face_features(g: dict, index: np.ndarray, ns: list[int], has_plane: list[bo
     nf = len(ns)
     real = np.arange(index.shape[1])[None, :] < np.asarray(ns)[:, None]
     planar = np.zeros(nf, bool) if has_plane is None else np.asarray(has_plane[:nf], bool)
-    floors = grounding.Floors()
+    floors = _floors()
     # float32, as per face before; the minimum over each face's real corners (padding reads +inf)
     cols = slice(None, index.shape[1])
     turn_img = 180.0 - g["quantities"]["corner_deg"][:nf, cols]
@@ -328,9 +329,18 @@ def _face_features(g: dict, index: np.ndarray, ns: list[int], has_plane: list[bo
             # the same measurements of the polygon without its weakest corner: what a (sides - 1) fact reads
             k = weakest[i]
             f["fewer"] = {**f, "sides": n - 1, "min_turn_deg": float(np.delete(turn[i], k).min()),
-                          "min_turn_z": float(np.delete(z[i], k).min()), "min_side_px": _min_side(np.delete(poly, k, 0))}
+                          "min_turn_z": float(np.delete(z[i], k).min()),
+                          "min_side_px": _min_side(np.delete(poly, k, 0))}
         out.append(f)
     return out
+
+
+@functools.lru_cache(maxsize=1)
+def _floors():
+    """grounding's default noise floors (built once: _face_features runs per object)."""
+    import grounding
+
+    return grounding.Floors()
 
 
 def _min_side(poly: np.ndarray) -> float:
@@ -397,9 +407,10 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
             out.append(max(fs, key=lambda f: f["support"]) if fs else {})
         else:
             f = combined(args)
-            fewer = by_face.get(args[0], {}).get("fewer")
-            if pred in _SIDE_PREDS and fewer is not None and value == fewer["sides"]:
-                f = fewer  # the (sides - 1) fact: the polygon without its weakest corner
+            if pred in _SIDE_PREDS:
+                fewer = by_face.get(args[0], {}).get("fewer")
+                if fewer is not None and value == fewer["sides"]:
+                    f = fewer  # the (sides - 1) fact: the polygon without its weakest corner
             out.append(f if value is None else {**f, "value": value})
     return out
 

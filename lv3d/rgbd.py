@@ -67,13 +67,17 @@ def read_depth(path: Path, depth_scale_m: float) -> np.ndarray:
 
 def load_frame(color_path: Path, depth_path: Path | None, intrinsics: Intrinsics | None,
                depth_scale_m: float = 0.001, name: str | None = None, meta: dict | None = None) -> RGBD:
-    """Load and validate one frame. Without ``depth_path`` the depth is all zeros (rgb-only use)."""
+    """Load and validate one frame. Without ``depth_path`` the depth is all zeros (rgb-only use) and, without
+    ``intrinsics`` too, the intrinsics are nominal (:meth:`Intrinsics.nominal`)."""
     color = read_color(color_path)
     h, w = color.shape[:2]
     if intrinsics is None:
-        raise InputError(color_path, "no intrinsics given for this frame")
+        if depth_path is not None:
+            raise InputError(depth_path, "no intrinsics given for this frame's depth")
+        intrinsics = Intrinsics.nominal(w, h)
     if (intrinsics.width, intrinsics.height) != (w, h):
-        raise InputError(color_path, f"image is {w}x{h} but the intrinsics are for {intrinsics.width}x{intrinsics.height}")
+        raise InputError(color_path, f"image is {w}x{h} but the intrinsics are for "
+                                     f"{intrinsics.width}x{intrinsics.height}")
     if not (1e-6 < depth_scale_m < 1.0):
         raise InputError(depth_path or color_path, f"absurd depth scale {depth_scale_m} m per unit")
     if depth_path is None:

@@ -12,12 +12,13 @@ import itertools
 
 import numpy as np
 
+from grounding import ACUTE_BELOW_DEG, OBTUSE_ABOVE_DEG, PERPENDICULAR_DEG
+
 from .errors import InputError
 from .facts import PREDICATES, Fact, SceneFacts, face_id, object_id
 
 SIDES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
 ANGLE_TOL_DEG = 10.0       # parallel, horizontal, vertical, corners
-PERPENDICULAR_TOL_DEG = 7.0  # perpendicular, and where acute and obtuse begin (90 -+ this)
 PARALLELOGRAM_TOL_DEG = 8.0
 EQUAL_SIDES_TOL = 0.12     # relative spread of side lengths for square and regular
 STRUCTURE = ("object", "face_of")  # never perturbed: without them there is no object to speak of
@@ -97,15 +98,15 @@ def _exact_facts(truth: dict, k: dict, scene_id: str) -> list[Fact]:
         d = float(a["dihedral_deg"])
         for x, y in ((names[i], names[j]), (names[j], names[i])):
             facts.append(Fact("adjacent", (x, y), 1.0))
-            if d < 90 - PERPENDICULAR_TOL_DEG:
+            if d < ACUTE_BELOW_DEG:
                 facts.append(Fact("acute", (x, y), 1.0, d))
-            elif d > 90 + PERPENDICULAR_TOL_DEG:
+            elif d > OBTUSE_ABOVE_DEG:
                 facts.append(Fact("obtuse", (x, y), 1.0, d))
     for i, j in itertools.combinations(sorted(names), 2):
         # visible faces of a convex solid face the camera, so plane normals are outward normals
         d = 180.0 - _angle_deg(normals[i], normals[j])
         for x, y in ((names[i], names[j]), (names[j], names[i])):
-            if abs(d - 90) <= PERPENDICULAR_TOL_DEG:
+            if abs(d - 90) <= PERPENDICULAR_DEG:
                 facts.append(Fact("perpendicular", (x, y), 1.0, d))
             if d <= ANGLE_TOL_DEG or d >= 180 - ANGLE_TOL_DEG:
                 facts.append(Fact("parallel", (x, y), 1.0, d))

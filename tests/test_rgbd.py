@@ -42,6 +42,8 @@ def test_bad_inputs_name_the_file(tmp_path):
         load_frame(c, d2, k)
     with pytest.raises(InputError, match="absurd focal"):
         Intrinsics(0.5, 0.5, 32, 24, 64, 48).validate()
+    with pytest.raises(InputError, match="d.png.*no intrinsics"):
+        load_frame(c, d, None)
     j = tmp_path / "k.json"
     j.write_text(json.dumps({"fx": 60, "fy": 60, "cx": 32}))
     with pytest.raises(InputError, match="k.json.*lack 'cy'"):
@@ -57,3 +59,11 @@ def test_real_kinect_frames_load(real_dir):
         assert f.color.shape == (480, 640, 3) and f.depth.shape == (480, 640)
         valid = f.depth[f.depth > 0]
         assert 0.3 < np.median(valid) < 6.0, name
+
+
+def test_colour_alone_takes_nominal_intrinsics(tmp_path):
+    c, _ = _write(tmp_path)
+    f = load_frame(c, None, None)
+    assert f.intrinsics == Intrinsics.nominal(64, 48)
+    assert (f.intrinsics.cx, f.intrinsics.cy) == (31.5, 23.5)
+    assert not f.depth.any()

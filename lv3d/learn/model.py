@@ -128,8 +128,8 @@ class Explanation:
             return f"{self.target}: unknown (no class's program proves it)"
         if self.missing:
             lines = [f"{self.target} is most likely a {self.label} (confidence {self.confidence:.3f}): no program "
-                     f"proves it, and this one misses by {len(self.missing)} of its {len(self.facts) + len(self.missing)} "
-                     f"fact(s), the least"]
+                     f"proves it, and this one misses by {len(self.missing)} of its "
+                     f"{len(self.facts) + len(self.missing)} fact(s), the least"]
         elif self.near:
             lines = [f"{self.target} is most likely a {self.label} (confidence {self.confidence:.3f}): no program "
                      f"proves it above its threshold, and this one comes nearest"]

@@ -29,8 +29,7 @@ from ..errors import InputError
 def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scale: float | None, modality: str,
             scene_id: str, out_dir: Path, facts: bool) -> None:
     """Find objects, faces and planes in one frame COLOR; write OUT/scene.json and OUT/overlay.png."""
-    from ..camera import Intrinsics
-    from ..rgbd import load_frame, read_color, read_intrinsics
+    from ..rgbd import load_frame, read_intrinsics
     from .overlay import draw_overlay
     from .perceive import perceive
 
@@ -42,11 +41,8 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
         if image is not None and not Path(image).is_file():
             raise InputError(image, "image not found")
     frame_name = Path(color).stem.removesuffix("_rgb")
-    if intrinsics is not None:
-        k, scale = read_intrinsics(intrinsics, frame_name)
-    else:  # colour alone reads no depth: nominal intrinsics (a 60-degree-wide view) only fill the frame's slot
-        h, w = read_color(color).shape[:2]
-        k, scale = Intrinsics(w * 0.866, w * 0.866, (w - 1) / 2, (h - 1) / 2, w, h), 0.001
+    # colour alone reads no depth: without a file, load_frame fills in nominal intrinsics
+    k, scale = read_intrinsics(intrinsics, frame_name) if intrinsics is not None else (None, 0.001)
     frame = load_frame(color, depth if modality != "rgb" else None, k,
                        depth_scale if depth_scale is not None else scale, name=frame_name)
     scene = perceive(frame, modality, scene_id=scene_id)

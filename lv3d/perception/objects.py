@@ -43,8 +43,8 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     ``max_border`` of their outline (walls, furniture, the floor beyond a table: scenery, not objects) are
     dropped. ``band_m``: the noise band (metres) above the support that counts as support; by default the
     noise expected of a consumer sensor at the scene's depth (see :func:`support_band`). Each piece then takes
-    back the foreground cells left out of every piece (depth jumps, the opening) within ``regrow`` cells of it. Without a support
-    plane every valid point counts as foreground."""
+    back the foreground cells left out of every piece (depth jumps, the opening) within ``regrow`` cells of it.
+    Without a support plane every valid point counts as foreground."""
     valid = grid.valid
     if support is not None:
         h_above = np.where(valid, grid.xyz @ support.n.astype(np.float32) + np.float32(support.offset), 0)
@@ -100,9 +100,10 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
 
 def support_band(grid: PointGrid, support: Plane, min_band_m: float = 0.004, k: float = 4.0) -> float:
     """The height (metres) above ``support`` within which points are the support itself: ``k`` times the noise (a
-    robust standard deviation of the distances to the plane of the grid points near it), between ``min_band_m`` and the default band. A fixed band
-    sized for the noisiest sensors cuts the bottom few centimetres off every object of a cleaner depth image;
-    the pixels lost there are the lower parts of the side faces, often all of a small face."""
+    robust standard deviation of the distances to the plane of the grid points near it), between ``min_band_m``
+    and the default band. A fixed band sized for the noisiest sensors cuts the bottom few centimetres off every
+    object of a cleaner depth image; the pixels lost there are the lower parts of the side faces, often all of a
+    small face."""
     valid = grid.valid[::4, ::4]  # a few thousand points measure the noise well enough
     pts = grid.xyz[::4, ::4][valid]
     if len(pts) < 50:
