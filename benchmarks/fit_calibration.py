@@ -1,9 +1,12 @@
 """Fit the per-(modality, predicate) confidence calibration maps and write grounding/_calibration_table.py.
 
-The table in the tree (docs/grounding.md, "Calibration on perceived scenes") was fitted in session 17 for both
-modalities, after the dihedral tolerance became 90 +- 7 deg (docs/facts.md) and side counts moved onto the plane:
-3500 scenes, each 1050-scene set ~3.5 min on one core with rgbd and depth, the 420-scene check set ~1.2 min, the
-fit ~20 s:
+The table in the tree (docs/grounding.md, "Calibration on perceived scenes"): rgbd refitted in session 18, after
+rgbd perception changed and (n - 1) side counts got maps of their own (``row_key``), on the same 3500 scene seeds
+and 420-scene check set as below with ``--modalities rgbd`` (each 1050-scene set ~3.3 min on one core; rows made
+before describe marked the (n - 1) rows were marked by inference, which matched the mark on all 1217 rows of a
+marked 35-scene set); depth is session 17's, fitted for both modalities after the dihedral tolerance became
+90 +- 7 deg (docs/facts.md) and side counts moved onto the plane: 3500 scenes, each 1050-scene set ~3.5 min on one
+core with rgbd and depth, the 420-scene check set ~1.2 min, the fit ~20 s:
 
     for a in "30000 150 a150" "40000 150 b150" "60000 100 d60000" "70000 100 d70000"; do set -- $a
         .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class $2 --modalities rgbd,depth \
@@ -45,7 +48,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.calibration_error import chance_ece, ece, log_loss  # noqa: E402
-from grounding._calibration import TOL_FRAC_PREDS, inputs  # noqa: E402
+from grounding._calibration import TOL_FRAC_PREDS, calibration_key, inputs  # noqa: E402
 from lv3d.facts import PREDICATES  # noqa: E402
 
 MODALITIES = ("rgbd", "depth")  # rgb is left raw: see docs/grounding.md (its labels need a look first)
@@ -63,8 +66,15 @@ PAIR_FEATURES = ["shared_side_px"]
 # hold are mostly two pieces of one face, a few mm apart (docs/grounding.md, session 14)
 PLANE_GAP_PREDS = ("parallel",)
 PLANE_GAP_FEATURES = ["plane_gap_mm"]
-# facts about one face: their final maps are chosen on their rows alone (fit_final)
+# facts about one face: their final maps are chosen on their rows alone (fit_final); with the (n - 1) side counts,
+# which have maps of their own (grounding.calibration_key)
 FACE_PREDS = tuple(p for p, (arity, _) in PREDICATES.items() if arity == 1 and p != "object")
+FACE_PREDS += tuple(calibration_key(p, True) for p in ("triangle", "quadrilateral", "pentagon", "hexagon"))
+
+
+def row_key(r: dict) -> str:
+    """The calibration key of a row (``lv3d.describe.calibration_features`` marks (n - 1) side counts)."""
+    return calibration_key(r["pred"], r.get("is_fewer", 0.0) > 0)
 
 
 def _fit(x: np.ndarray, y: np.ndarray):
@@ -219,7 +229,7 @@ def fit_final(oof: dict, seed: int = 0) -> tuple[dict, dict]:
         final["faces"], choice, face_losses = _choose_final(oof, faces, faces, seed)
         by_pred.update({p: "faces" if c == "pooled" else c for p, c in choice.items()})
         losses.update(face_losses)
-    return {**final, "by_pred": by_pred}, losses
+    return {**final, "by_pred": by_pred, "fewer_maps": True}, losses
 
 
 def report(rows: list[dict], table: tuple, title: str, shipped: tuple | None = None) -> None:
@@ -232,7 +242,7 @@ def report(rows: list[dict], table: tuple, title: str, shipped: tuple | None = N
           + ("shipped table -> " if shipped is not None else "") + "calibrated")
     by = defaultdict(list)
     for r in rows:
-        by[(r["modality"], r["pred"])].append(r)
+        by[(r["modality"], row_key(r))].append(r)
 
     def emitted(tab):
         return np.array([(c, r["y"]) for r in rs if (c := calibrate_with(tab[0], *key, r["p"], r, tab[1])) >= MIN_CONF],
@@ -255,7 +265,7 @@ def report(rows: list[dict], table: tuple, title: str, shipped: tuple | None = N
         for name, tab in (("shipped", shipped), ("calibrated", table)):
             if tab is None:
                 continue
-            c = np.array([calibrate_with(tab[0], mod, r["pred"], r["p"], r, tab[1]) for r in rs])
+            c = np.array([calibrate_with(tab[0], mod, row_key(r), r["p"], r, tab[1]) for r in rs])
             line += f"  {name} ECE {ece(c[c >= MIN_CONF], y[c >= MIN_CONF]):.3f} (n={int((c >= MIN_CONF).sum())}) log loss {log_loss(c, y):.4f}"
         print(line)
 
@@ -276,7 +286,7 @@ def main(argv=None) -> int:
     by = defaultdict(list)
     for r in rows:
         if r["modality"] in refit and r["p"] > 0:
-            by[(r["modality"], r["pred"])].append(r)
+            by[(r["modality"], row_key(r))].append(r)
     from grounding._calibration_table import FINAL, TABLE
 
     kept = [m for m in MODALITIES if m not in refit]

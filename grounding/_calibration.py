@@ -69,6 +69,25 @@ def _tol_fraction(pred: str):
     return lambda v: min(max(frac(v), -3.0), 3.0)  # 3 tolerances out is as false as it gets
 
 
+def calibration_key(pred: str, fewer: bool = False) -> str:
+    """The name a fact's maps are filed under: the predicate, or for a side count read as one side fewer than the
+    polygon has (a face's ``p_fewer`` fact: one vertex a point on a straight side) ``pred + "_fewer"``. The two
+    kinds of one predicate have different probabilities behind them (a pentagon face's own count and a hexagon's
+    count without its weakest corner) and came out calibrated in opposite directions on one map."""
+    return f"{pred}{_FEWER}" if fewer else pred
+
+
+_FEWER = "_fewer"
+
+
+def _filed_under(key: str, final: dict | None) -> str:
+    """``key`` itself, or for an (n - 1) key in a modality whose maps were fitted before such keys existed (its
+    ``FINAL`` entry lacks "fewer_maps") the predicate's own key: that modality's maps saw both kinds as one."""
+    if key.endswith(_FEWER) and not (final or {}).get("fewer_maps", False):
+        return key[: -len(_FEWER)]
+    return key
+
+
 def inputs(pred: str, p: float, x: dict, names: list[str]) -> list[float]:
     """The inputs of ``pred``'s calibration map: ``logit(p)`` then the named measurements of ``x``."""
     return [logit(p) if k is None else scale(float(x.get(k, 0.0))) for k, scale in _inputs(pred, names)]
@@ -76,13 +95,14 @@ def inputs(pred: str, p: float, x: dict, names: list[str]) -> list[float]:
 
 def measures_used(modality: str, pred: str) -> list[str]:
     """The face measurements the map of (modality, pred) reads (empty: it needs only p, or there is no map)."""
-    entry = TABLE.get(modality, {}).get(pred)
+    entry = TABLE.get(modality, {}).get(_filed_under(pred, FINAL.get(modality)))
     return [] if entry is None else [n for n in entry["features"] if n != "logit_p"]
 
 
 def calibrate(modality: str, pred: str, p: float, x: dict | None = None) -> float:
     """Calibrated probability of one candidate fact with raw probability ``p`` and face measurements ``x``
-    (keys as ``lv3d.describe.calibration_features`` gives them). ``p`` itself where nothing was fitted;
+    (keys as ``lv3d.describe.calibration_features`` gives them); ``pred``: its calibration key
+    (:func:`calibration_key`: the predicate, or an (n - 1) side count's own key). ``p`` itself where nothing was fitted;
     0 stays 0 (a predicate the geometry rules out is not revived). :func:`calibrate_with` on ``TABLE`` and
     ``FINAL``, with each map's inputs looked up once (a frame has ~150 candidates)."""
     return _apply(_compiled(modality, pred), p, x)
@@ -94,7 +114,9 @@ def calibrate_with(table: dict, modality: str, pred: str, p: float, x: dict | No
     (layout of ``FINAL``: per modality pooled knots {"x", "y"}, optionally "faces", the knots pooled over
     facts about one face, and "by_pred", {pred: knots of the type's own map, None for no final stage, or
     "faces"}; None: no final stage)."""
-    return _apply(_compile(pred, table.get(modality, {}).get(pred), (final or {}).get(modality)), p, x)
+    fin = (final or {}).get(modality)
+    pred = _filed_under(pred, fin)
+    return _apply(_compile(pred, table.get(modality, {}).get(pred), fin), p, x)
 
 
 def _inputs(pred: str, names: list[str]) -> list:
@@ -128,6 +150,7 @@ def _compile(pred: str, entry: dict | None, final: dict | None):
 @functools.cache
 def _compiled(modality: str, pred: str):
     """:func:`_compile` of TABLE's and FINAL's maps of (modality, pred)."""
+    pred = _filed_under(pred, FINAL.get(modality))
     return _compile(pred, TABLE.get(modality, {}).get(pred), FINAL.get(modality))
 
 

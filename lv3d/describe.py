@@ -180,6 +180,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         field = edge_field(frame, scene.modality, scene)
     support = None if scene.support_plane is None else _plane_row(scene.support_plane)
     cands: list[tuple[str, tuple[str, ...], float, float | None]] = []
+    fewer: set[int] = set()  # indices in cands of the (n - 1) side counts
     results: list[ObjectResult] = []
     # pack every object (in chunks of MAX_FACES faces), ground them all in batched calls, then read facts
     jobs = []
@@ -239,6 +240,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 if n in SIDE_NAMES:
                     cands.append((SIDE_NAMES[n], (f.id,), c["p_sides"][i], float(n)))
                 if n - 1 in SIDE_NAMES and has_plane[i]:  # one vertex may be a point on a straight side
+                    fewer.add(len(cands))
                     cands.append((SIDE_NAMES[n - 1], (f.id,), c["p_fewer"][i], float(n - 1)))
                 if n == 4:
                     cands.append(("parallelogram", (f.id,), c["p_parallelogram"][i], c["para_dev_deg"][i]))
@@ -272,22 +274,25 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         cands.append(("object", (obj.id,), max(face_conf.values(), default=0.0), None))
         results.append(ObjectResult(obj, face_results, dihedrals, status, raw))
     if calibrate:
-        # measurements only for the candidates whose map reads them (they cost more than the maps)
+        # (n - 1) side counts have maps of their own; measurements only for the candidates whose map reads them
+        # (they cost more than the maps)
+        keys = [grounding.calibration_key(c[0], k in fewer) for k, c in enumerate(cands)]
         needs = _needs(scene.modality)
-        feats = calibration_features([c for c in cands if needs[c[0]]], results)
+        feats = calibration_features([c for c, key in zip(cands, keys) if needs[key]], results)
         it = iter(feats)
         calibrate_one, modality = grounding.calibrate, scene.modality
-        cands = [(pred, args, calibrate_one(modality, pred, p, next(it) if needs[pred] else None), value)
-                 for pred, args, p, value in cands]
+        cands = [(pred, args, calibrate_one(modality, key, p, next(it) if needs[key] else None), value)
+                 for (pred, args, p, value), key in zip(cands, keys)]
     return cands, results
 
 
 @functools.cache
 def _needs(modality: str) -> dict[str, bool]:
-    """Per predicate whether its calibration map in ``modality`` reads face measurements."""
+    """Per calibration key (grounding.calibration_key) whether its map in ``modality`` reads face measurements."""
     import grounding
 
-    return {pred: bool(grounding.measures_used(modality, pred)) for pred in PREDICATES}
+    keys = {grounding.calibration_key(pred, fewer) for pred in PREDICATES for fewer in (False, True)}
+    return {key: bool(grounding.measures_used(modality, key)) for key in keys}
 
 
 def _largest_std(cov: np.ndarray) -> np.ndarray:
@@ -381,7 +386,8 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
     about two faces, the weaker of each (smaller value), the length of the side they share
     (``shared_side_px``, :func:`shared_side_px`) and, where both have planes, how far they are from one plane
     (``plane_gap_mm``, :func:`plane_gap_mm`); for ``object`` the object's best face; and, for a candidate with a
-    measured value, that value as ``value``."""
+    measured value, that value as ``value``. An (n - 1) side count reads the face's measurements without its weakest
+    corner, marked ``is_fewer`` (its calibration key is its own: grounding.calibration_key)."""
     by_face = {fr.face.id: fr.features for res in results for fr in res.faces}
     by_result = {fr.face.id: fr for res in results for fr in res.faces}
     by_obj = {res.obj.id: [fr.features for fr in res.faces] for res in results}
@@ -410,7 +416,7 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
             if pred in _SIDE_PREDS:
                 fewer = by_face.get(args[0], {}).get("fewer")
                 if fewer is not None and value == fewer["sides"]:
-                    f = fewer  # the (sides - 1) fact: the polygon without its weakest corner
+                    f = {**fewer, "is_fewer": 1.0}  # the (sides - 1) fact: the polygon without its weakest corner
             out.append(f if value is None else {**f, "value": value})
     return out
 

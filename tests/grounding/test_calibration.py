@@ -167,3 +167,20 @@ def test_pack_object_uses_the_small_shape_when_the_object_fits():
     five = [_square(100 + 50 * i, 100) for i in range(SIZES[0][0] + 1)]
     big, index = grounding.pack_object(five, intrinsics=(600.0, 600.0, 320.0, 240.0))
     assert big.face_index.shape == SIZES[-1][:2] and index.shape == (len(five), SIZES[-1][1])
+
+
+def test_one_side_fewer_has_maps_of_its_own_where_they_were_fitted():
+    assert grounding.calibration_key("pentagon") == "pentagon"
+    assert grounding.calibration_key("pentagon", fewer=True) == "pentagon_fewer"
+    own = {"features": ["logit_p"], "bias": 0.0, "coef": [1.0]}
+    fewer = {"features": ["logit_p"], "bias": -2.0, "coef": [1.0]}
+    table = {"rgbd": {"pentagon": own, "pentagon_fewer": fewer}}
+    old = {"rgbd": {"x": [0.0, 1.0], "y": [0.0, 1.0]}}              # fitted before (n - 1) keys existed
+    new = {"rgbd": {"x": [0.0, 1.0], "y": [0.0, 1.0], "fewer_maps": True}}
+    p = 0.6
+    same = calibrate_with(table, "rgbd", "pentagon", p, {}, old)
+    assert calibrate_with(table, "rgbd", "pentagon_fewer", p, {}, old) == same
+    # logit 0.6 = log 1.5, moved by the fewer map's bias -2
+    assert math.isclose(calibrate_with(table, "rgbd", "pentagon_fewer", p, {}, new),
+                        1 / (1 + math.exp(2 - math.log(1.5))))
+    assert FINAL["rgbd"].get("fewer_maps") and not FINAL["depth"].get("fewer_maps")  # depth: session 17's maps
