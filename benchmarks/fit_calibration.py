@@ -49,6 +49,7 @@ sys.path.insert(0, str(ROOT))
 
 from benchmarks.calibration_error import chance_ece, ece, log_loss  # noqa: E402
 from grounding._calibration import TOL_FRAC_PREDS, calibration_key, inputs  # noqa: E402
+from lv3d.describe import SIDE_NAMES  # noqa: E402
 from lv3d.facts import PREDICATES  # noqa: E402
 
 MODALITIES = ("rgbd", "depth")  # rgb is left raw: see docs/grounding.md (its labels need a look first)
@@ -69,7 +70,7 @@ PLANE_GAP_FEATURES = ["plane_gap_mm"]
 # facts about one face: their final maps are chosen on their rows alone (fit_final); with the (n - 1) side counts,
 # which have maps of their own (grounding.calibration_key)
 FACE_PREDS = tuple(p for p, (arity, _) in PREDICATES.items() if arity == 1 and p != "object")
-FACE_PREDS += tuple(calibration_key(p, True) for p in ("triangle", "quadrilateral", "pentagon", "hexagon"))
+FACE_PREDS += tuple(calibration_key(p, True) for p in SIDE_NAMES.values())
 
 
 def row_key(r: dict) -> str:
