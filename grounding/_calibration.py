@@ -69,6 +69,9 @@ def _tol_fraction(pred: str):
     return lambda v: min(max(frac(v), -3.0), 3.0)  # 3 tolerances out is as false as it gets
 
 
+_FEWER = "_fewer"
+
+
 def calibration_key(pred: str, fewer: bool = False) -> str:
     """The name a fact's maps are filed under: the predicate, or for a side count read as one side fewer than the
     polygon has (a face's ``p_fewer`` fact: one vertex a point on a straight side) ``pred + "_fewer"``. The two
@@ -76,8 +79,6 @@ def calibration_key(pred: str, fewer: bool = False) -> str:
     count without its weakest corner) and came out calibrated in opposite directions on one map."""
     return f"{pred}{_FEWER}" if fewer else pred
 
-
-_FEWER = "_fewer"
 
 
 def _filed_under(key: str, final: dict | None) -> str:

@@ -76,6 +76,9 @@ class Confidences(eqx.Module):
     corner_spread_deg: Float[Array, " F"]   # largest - smallest corner on the plane
     right_dev_deg: Float[Array, " F"]       # largest |corner - 90| on the plane
     para_dev_deg: Float[Array, " F"]        # largest image deviation of opposite sides from parallel
+    # per vertex slot: its turn past the corner limit in units of its spread, on the face's plane where it has one
+    # (in the image without); P(corner) = Phi(corner_z)
+    corner_z: Float[Array, "F S"]
 
 
 def interval(mu, sigma, lo, hi):
@@ -138,9 +141,10 @@ def confidences(q: Quantities, std: Quantities, jq, cov, face_vmask, face_mask, 
     # a corner: the outline turns there. On a plane the turn is free of foreshortening, so true corners (60 deg and
     # more for the data set's solids) stand far from kinks of a traced outline (docs/grounding.md); without one, the
     # image turn
-    p_image = ndtr((180.0 - q.corner_deg - CORNER_TURN_MIN_DEG) / sd.corner_deg)
-    p_plane = ndtr((180.0 - q.corner3d_deg - CORNER_TURN_MIN_PLANE_DEG) / sd.corner3d_deg)
-    p_corner = jnp.where(planar[:, None], p_plane, p_image)
+    z_image = (180.0 - q.corner_deg - CORNER_TURN_MIN_DEG) / sd.corner_deg
+    z_plane = (180.0 - q.corner3d_deg - CORNER_TURN_MIN_PLANE_DEG) / sd.corner3d_deg
+    corner_z = jnp.where(planar[:, None], z_plane, z_image)
+    p_corner = ndtr(corner_z)
     support = jnp.clip(edge_support / SUPPORT_FULL, 0.0, 1.0)
     p_real = jnp.where(face_vmask, p_corner, 1.0)
     p_sides = jnp.prod(p_real, axis=1) * support
@@ -185,4 +189,4 @@ def confidences(q: Quantities, std: Quantities, jq, cov, face_vmask, face_mask, 
     right_dev = jnp.max(jnp.where(mf, jnp.abs(c3 - 90.0), 0.0), -1)
     return Confidences(sides, p_sides * face_mask, p_fewer * face_mask, p_para * face_mask, p_rect, p_square,
                        p_regular, p_h, p_v, p_perp, p_par, p_acute, p_obtuse, edge_support, side_ratio,
-                       corner_spread, right_dev, jnp.max(q.para_dev_deg, -1))
+                       corner_spread, right_dev, jnp.max(q.para_dev_deg, -1), corner_z)

@@ -180,7 +180,6 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         field = edge_field(frame, scene.modality, scene)
     support = None if scene.support_plane is None else _plane_row(scene.support_plane)
     cands: list[tuple[str, tuple[str, ...], float, float | None]] = []
-    fewer: set[int] = set()  # indices in cands of the (n - 1) side counts
     results: list[ObjectResult] = []
     # pack every object (in chunks of MAX_FACES faces), ground them all in batched calls, then read facts
     jobs = []
@@ -240,7 +239,6 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 if n in SIDE_NAMES:
                     cands.append((SIDE_NAMES[n], (f.id,), c["p_sides"][i], float(n)))
                 if n - 1 in SIDE_NAMES and has_plane[i]:  # one vertex may be a point on a straight side
-                    fewer.add(len(cands))
                     cands.append((SIDE_NAMES[n - 1], (f.id,), c["p_fewer"][i], float(n - 1)))
                 if n == 4:
                     cands.append(("parallelogram", (f.id,), c["p_parallelogram"][i], c["para_dev_deg"][i]))
@@ -276,7 +274,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     if calibrate:
         # (n - 1) side counts have maps of their own; measurements only for the candidates whose map reads them
         # (they cost more than the maps)
-        keys = [grounding.calibration_key(c[0], k in fewer) for k, c in enumerate(cands)]
+        keys = [grounding.calibration_key(c[0], fewer) for c, fewer in zip(cands, one_side_fewer(cands, results))]
         needs = _needs(scene.modality)
         feats = calibration_features([c for c, key in zip(cands, keys) if needs[key]], results)
         it = iter(feats)
@@ -307,21 +305,15 @@ def _face_features(g: dict, index: np.ndarray, ns: list[int], has_plane: list[bo
     turn in units of its spread (how sure the side count is; on the face's plane where it has one, as the
     confidence reads it), edge support, image area and shortest side. ``index``: (faces, S) union vertex id of
     each polygon slot; ``ns``: each face's side count; ``has_plane``: which faces have a plane (default none)."""
-    import grounding
-
     nf = len(ns)
     real = np.arange(index.shape[1])[None, :] < np.asarray(ns)[:, None]
     planar = np.zeros(nf, bool) if has_plane is None else np.asarray(has_plane[:nf], bool)
-    floors = _floors()
-    # float32, as per face before; the minimum over each face's real corners (padding reads +inf)
+    # the minimum over each face's real corners (padding reads +inf)
     cols = slice(None, index.shape[1])
     turn_img = 180.0 - g["quantities"]["corner_deg"][:nf, cols]
     turn_pl = 180.0 - g["quantities"]["corner3d_deg"][:nf, cols]
-    z_img = (turn_img - grounding.CORNER_TURN_MIN_DEG) / np.hypot(g["std"]["corner_deg"][:nf, cols], floors.corner_deg)
-    z_pl = (turn_pl - grounding.CORNER_TURN_MIN_PLANE_DEG) / np.hypot(g["std"]["corner3d_deg"][:nf, cols],
-                                                                       floors.corner3d_deg)
     turn = np.where(real, np.where(planar[:, None], turn_pl, turn_img), np.inf)
-    z = np.where(real, np.where(planar[:, None], z_pl, z_img), np.inf)
+    z = np.where(real, g["conf"]["corner_z"][:nf, cols], np.inf)  # grounding's corner test, as p_sides reads it
     weakest = np.argmin(z, axis=1)
     support = g["conf"]["edge_support"][:nf].tolist()
     out = []
@@ -338,14 +330,6 @@ def _face_features(g: dict, index: np.ndarray, ns: list[int], has_plane: list[bo
                           "min_side_px": _min_side(np.delete(poly, k, 0))}
         out.append(f)
     return out
-
-
-@functools.lru_cache(maxsize=1)
-def _floors():
-    """grounding's default noise floors (built once: _face_features runs per object)."""
-    import grounding
-
-    return grounding.Floors()
 
 
 def _min_side(poly: np.ndarray) -> float:
@@ -381,6 +365,15 @@ def plane_gap_mm(a: FaceResult, b: FaceResult) -> float | None:
     return 1e3 * max(abs(float(ca @ b.plane[:3] + b.plane[3])), abs(float(cb @ a.plane[:3] + a.plane[3])))
 
 
+def one_side_fewer(cands: list, results: list[ObjectResult]) -> list[bool]:
+    """For each candidate ``(pred, args, p, value)`` of :func:`ground`, whether it is an (n - 1) side count: a side
+    count one short of its face's polygon (the polygon without its weakest corner). Its calibration key is its own
+    (grounding.calibration_key) and its measurements are the polygon's without that corner
+    (:func:`calibration_features`)."""
+    sides = {fr.face.id: fr.features["sides"] for res in results for fr in res.faces}
+    return [pred in _SIDE_PREDS and args[0] in sides and value == sides[args[0]] - 1 for pred, args, _, value in cands]
+
+
 def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]:
     """Per candidate the face measurements its calibration may read (:func:`_face_features`); for a fact
     about two faces, the weaker of each (smaller value), the length of the side they share
@@ -407,16 +400,14 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
         return weaker[key]
 
     out = []
-    for pred, args, _, value in cands:
+    for (pred, args, _, value), fewer in zip(cands, one_side_fewer(cands, results)):
         if pred == "object":
             fs = by_obj.get(args[0], [])
             out.append(max(fs, key=lambda f: f["support"]) if fs else {})
         else:
             f = combined(args)
-            if pred in _SIDE_PREDS:
-                fewer = by_face.get(args[0], {}).get("fewer")
-                if fewer is not None and value == fewer["sides"]:
-                    f = {**fewer, "is_fewer": 1.0}  # the (sides - 1) fact: the polygon without its weakest corner
+            if fewer:  # the (sides - 1) fact reads the polygon without its weakest corner
+                f = {**by_face[args[0]]["fewer"], "is_fewer": 1.0}
             out.append(f if value is None else {**f, "value": value})
     return out
 

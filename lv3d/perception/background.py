@@ -40,15 +40,14 @@ def face_chromaticity(poly: np.ndarray, chroma: np.ndarray, erode_px: int = 2, m
     return np.median(pixels, axis=0) if len(pixels) else np.full(2, np.nan)
 
 
-def background_faces(polys: list[np.ndarray], chroma: np.ndarray, radius: float = 0.01,
+def background_faces(hues: list[np.ndarray], chroma: np.ndarray, radius: float = 0.01,
                      min_share: float = 0.1) -> list[bool]:
-    """For each polygon (n, 2, pixels of the image whose ``chromaticity`` is ``chroma`` (H, W, 2)): whether it is
-    background, its median chromaticity within ``radius`` of at least ``min_share`` of the border's pixels
-    (border_chromaticity)."""
+    """For each face's median chromaticity (2,) in ``hues`` (face_chromaticity in the image whose ``chromaticity``
+    is ``chroma`` (H, W, 2)): whether the face is background, its chromaticity within ``radius`` of at least
+    ``min_share`` of the border's pixels (border_chromaticity)."""
     border = border_chromaticity(chroma)
     out = []
-    for p in polys:
-        c = face_chromaticity(np.asarray(p, np.float64), chroma)
+    for c in hues:
         near = np.hypot(border[:, 0] - c[0], border[:, 1] - c[1]) <= radius
         out.append(bool(np.isfinite(c).all() and np.mean(near) >= min_share))
     return out

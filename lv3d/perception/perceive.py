@@ -162,15 +162,18 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         swallowing = {a: o.polygons[m] for a, m in match.items() if o.polygons[m] is not None
                       and _swallows_plane(poly_px[mine[a]], m, o, plane_px)
                       and fit_face_plane(res.faces[mine[a]].polygon, dres.grid, seed=k) is None}
+        swallowing_px = {a: rasterize(poly - off, shape) for a, poly in swallowing.items()}
         colour_px = np.zeros(shape, bool)
         for a, i in enumerate(mine):
-            colour_px |= rasterize(swallowing[a] - off, shape) if a in swallowing else poly_px[i]
+            colour_px |= swallowing_px.get(a, poly_px[i])
         matched_poly = {a: swallowing[a] if a in swallowing else
                         _matched_polygon(res.faces[mine[a]].polygon, m, o, poly_px[mine[a]], off, dres, colour_px,
                                          seed=k) for a, m in match.items()}
         matched_px = np.zeros(shape, bool)  # the pixels that colour faces matched to a plane explain
         for a, poly in matched_poly.items():
-            matched_px |= poly_px[mine[a]] if poly is res.faces[mine[a]].polygon else rasterize(poly - off, shape)
+            own_outline = poly is res.faces[mine[a]].polygon
+            matched_px |= swallowing_px[a] if a in swallowing else poly_px[mine[a]] if own_outline \
+                else rasterize(poly - off, shape)
         for a, i in enumerate(mine):
             f = res.faces[i]
             if a in match:
@@ -327,12 +330,22 @@ def _matched_polygon(colour: np.ndarray, j: int, o: DepthObjectResult, colour_px
     return _pick_polygon(colour, depth, colour_px, off)
 
 
+def _held(poly_px: np.ndarray, plane_px: list[np.ndarray], fraction: float) -> list[int]:
+    """The planes (indices into ``plane_px``, their pixels) that a colour face (pixels ``poly_px``) holds at least
+    ``fraction`` of."""
+    return [j for j, q in enumerate(plane_px) if _inside(q, poly_px) >= fraction]
+
+
+def _turned_apart(o: DepthObjectResult, a: int, b: int) -> bool:
+    """Whether planes ``a`` and ``b`` of ``o`` are two faces' planes, not one face's (``_DISTINCT_PLANE_DEG``)."""
+    return angle_deg(o.planes[a].plane, o.planes[b].plane) >= _DISTINCT_PLANE_DEG
+
+
 def _swallows_plane(poly_px: np.ndarray, own: int, o: DepthObjectResult, plane_px: list[np.ndarray]) -> bool:
     """True when a colour face matched to plane ``own`` also holds a good part (``_SWALLOWED_FRACTION``) of another
     plane that is turned away from it: the colour outline took in part of the next face across a shared edge
     with too little contrast."""
-    return any(j != own and angle_deg(q.plane, o.planes[own].plane) >= _DISTINCT_PLANE_DEG
-               and _inside(plane_px[j], poly_px) >= _SWALLOWED_FRACTION for j, q in enumerate(o.planes))
+    return any(j != own and _turned_apart(o, j, own) for j in _held(poly_px, plane_px, _SWALLOWED_FRACTION))
 
 
 # a colour outline that strays over an edge takes in a few per cent of the next plane's cells (up to ~15% on dev
@@ -343,9 +356,8 @@ _SWALLOWED_FRACTION = 0.25
 def _spans_planes(poly_px: np.ndarray, o: DepthObjectResult, plane_px: list[np.ndarray]) -> bool:
     """True when a colour face holds most of two planes that are turned away from each other: its outline went
     round two faces whose shared edge had too little contrast (two faces of one shade)."""
-    held = [j for j in range(len(o.planes)) if _inside(plane_px[j], poly_px) >= 0.5]
-    return any(angle_deg(o.planes[a].plane, o.planes[b].plane) >= _DISTINCT_PLANE_DEG
-               for n, a in enumerate(held) for b in held[n + 1:])
+    held = _held(poly_px, plane_px, 0.5)
+    return any(_turned_apart(o, a, b) for n, a in enumerate(held) for b in held[n + 1:])
 
 
 _COPLANAR_DEG = 5.0

@@ -192,14 +192,18 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     n_traced = len(cands)
     cands += _thin_cands(cands, segs, dist, min_area_px, made_up)
     cands = _join_thin_to_traced(cands, n_traced, dist)
+    hues = [None] * len(cands)  # each face's chromaticity, for background_faces and _same_solid (colour alone)
     if colour_alone and cands:
-        cands = [c for c, bg in zip(cands, background_faces([c[0] for c in cands], chroma)) if not bg]
-    faces = [RGBFace(p + np.array([u0, v0], float), e, s, a) for p, e, s, a in cands]
-    faces.sort(key=lambda f: (-f.area_px, float(f.polygon[0, 0]), float(f.polygon[0, 1])))
+        hues = [face_chromaticity(np.asarray(c[0], np.float64), chroma) for c in cands]
+        bg = background_faces(hues, chroma)
+        cands, hues = [c for c, b in zip(cands, bg) if not b], [h for h, b in zip(hues, bg) if not b]
+    faces = [(RGBFace(p + np.array([u0, v0], float), e, s, a), hue) for (p, e, s, a), hue in zip(cands, hues)]
+    faces.sort(key=lambda fh: (-fh[0].area_px, float(fh[0].polygon[0, 0]), float(fh[0].polygon[0, 1])))
+    faces, hues = [f for f, _ in faces], [h for _, h in faces]
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
                  if faces[i].edges & faces[j].edges]
     if colour_alone:
-        adjacency = _same_solid(adjacency, [f.polygon - np.array([u0, v0], float) for f in faces], chroma, solids)
+        adjacency = _same_solid(adjacency, [f.polygon - np.array([u0, v0], float) for f in faces], hues, solids)
     lab = union_find_labels(len(faces), np.array(adjacency, int).reshape(-1, 2))
     groups: dict[int, list[int]] = {}
     for i, l in enumerate(lab):
@@ -210,15 +214,14 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     return RGBResult(faces, ordered, adjacency, timings, dist)
 
 
-def _same_solid(pairs: list[tuple[int, int]], polys: list[np.ndarray], chroma: np.ndarray, solids: np.ndarray,
+def _same_solid(pairs: list[tuple[int, int]], polys: list[np.ndarray], hue: list[np.ndarray], solids: np.ndarray,
                 max_chroma: float = 0.1) -> list[tuple[int, int]]:
-    """The pairs of neighbouring faces (polygons ``polys`` in the pixels of the image whose chromaticity is
-    ``chroma``, background.chromaticity) that can be faces of one solid:
+    """The pairs of neighbouring faces (polygons ``polys``, pixels; ``hue``: the median chromaticity of each,
+    background.face_chromaticity) that can be faces of one solid:
     on one region of ``solids`` (silhouette.foreground), and of median chromaticities within ``max_chroma`` (a
     solid's faces share its colour, whatever their shading). The graph joins solids that nearly touch or overlap
     in the image; without depth this is what parts them."""
     region = regions_of(polys, solids)
-    hue = [face_chromaticity(p, chroma) for p in polys]
     return [(i, j) for i, j in pairs if region[i] == region[j] and np.hypot(*(hue[i] - hue[j])) <= max_chroma]
 
 

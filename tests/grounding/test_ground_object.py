@@ -107,3 +107,27 @@ def test_side_count_confidence_falls_for_a_nearly_straight_corner(n):
     # without a plane no (n - 1)-gon: in the image a true corner seen obliquely turns little too (tests/test_describe.py
     # has the face with a plane)
     assert float(c_spur.p_fewer[0]) == 0.0 and float(c_clean.p_fewer[0]) == 0.0
+
+
+
+@pytest.mark.parametrize("with_planes", [True, False])
+def test_corner_z_is_the_turn_past_the_corner_limit_that_the_side_count_reads(with_planes):
+    """``corner_z``, which the calibration reads as the weakest corner's margin, is the corner test itself:
+    (turn - limit) / floored spread, on the plane where the face has one (limit 35 deg) and in the image without
+    (15 deg); P(sides) is the product of Phi(z) over the corners times the edge support."""
+    from jax.scipy.special import ndtr
+
+    from grounding._confidence import CORNER_TURN_MIN_DEG, CORNER_TURN_MIN_PLANE_DEG, SUPPORT_FULL, Floors
+
+    prob, _, field, polys, _ = _problem(90.0, np.random.default_rng(7))
+    if not with_planes:
+        prob, _ = grounding.pack_object(polys, intrinsics=INTR, adjacency=wedge(90.0)[1])
+    c = grounding.ground_object(prob, field, True)
+    which, limit, floor = ("corner3d_deg", CORNER_TURN_MIN_PLANE_DEG, Floors().corner3d_deg) if with_planes \
+        else ("corner_deg", CORNER_TURN_MIN_DEG, Floors().corner_deg)
+    turn = 180.0 - np.asarray(getattr(c.quantities, which))[:2, :4]
+    sd = np.hypot(np.asarray(getattr(c.std, which))[:2, :4], floor)
+    z = np.asarray(c.conf.corner_z)[:2, :4]
+    np.testing.assert_allclose(z, (turn - limit) / sd, rtol=1e-5)
+    support = np.clip(np.asarray(c.conf.edge_support)[:2] / SUPPORT_FULL, 0, 1)
+    np.testing.assert_allclose(np.asarray(c.conf.p_sides)[:2], np.prod(np.asarray(ndtr(z)), 1) * support, rtol=1e-5)

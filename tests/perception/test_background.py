@@ -1,6 +1,6 @@
 import numpy as np
 
-from lv3d.perception.background import background_faces, border_chromaticity, chromaticity
+from lv3d.perception.background import background_faces, border_chromaticity, chromaticity, face_chromaticity
 from lv3d.perception.rgb import rgb_faces
 
 FLOOR = np.array([200.0, 140.0, 90.0])    # sandy floor
@@ -31,7 +31,9 @@ def test_chromaticity_ignores_brightness():
 
 def test_a_shadow_and_a_floor_strip_are_background_the_object_is_not():
     strip = np.array([[20.0, 150.0], [120.0, 150.0], [120.0, 160.0], [20.0, 160.0]])
-    assert background_faces([SQUARE, SHADOW, strip], chromaticity(_scene())) == [False, True, True]
+    chroma = chromaticity(_scene())
+    hues = [face_chromaticity(p, chroma) for p in (SQUARE, SHADOW, strip)]
+    assert background_faces(hues, chroma) == [False, True, True]
 
 
 def test_colour_alone_drops_the_shadow_beside_a_solid():
