@@ -48,7 +48,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.calibration_error import chance_ece, ece, log_loss  # noqa: E402
-from grounding._calibration import TOL_FRAC_PREDS, calibration_key, inputs  # noqa: E402
+from grounding._calibration import SHARED_SIDE_PREDS, TOL_FRAC_PREDS, calibration_key, inputs  # noqa: E402
 from lv3d.describe import SIDE_NAMES  # noqa: E402
 from lv3d.facts import PREDICATES  # noqa: E402
 
@@ -58,10 +58,11 @@ MIN_ROWS = 12        # fewer rows (or one class of label only): keep the raw pro
 C_REG = 0.5          # inverse L2 strength of the logistic fits (standardised inputs)
 MIN_CONF = 0.05
 MIN_OWN_FINAL = 50   # fewer rows of either label: a type's own isotonic map would be steps of a few facts
+FINAL_REPEATS = 5    # fold draws the final maps are chosen over (_choose_final)
 SUPPORT_PREDS = ("face_of", "adjacent", "object")
 # facts about two faces whose map may also read the side the faces share (0: none, e.g. pyramid laterals
 # touching at the apex); not parallel: ~60 fit rows, and out of sample it made parallel's log loss worse
-PAIR_PREDS = ("adjacent", "acute", "obtuse", "perpendicular")
+PAIR_PREDS = SHARED_SIDE_PREDS
 PAIR_FEATURES = ["shared_side_px"]
 # facts about two planes whose map may also read how far the two faces are from one plane: parallel facts that
 # hold are mostly two pieces of one face, a few mm apart (docs/grounding.md, session 14)
@@ -74,8 +75,9 @@ FACE_PREDS += tuple(calibration_key(p, True) for p in SIDE_NAMES.values())
 
 
 def row_key(r: dict) -> str:
-    """The calibration key of a row (``lv3d.describe.calibration_features`` marks (n - 1) side counts)."""
-    return calibration_key(r["pred"], r.get("is_fewer", 0.0) > 0)
+    """The calibration key of a row (``lv3d.describe.calibration_features`` marks (n - 1) side counts and gives a
+    pair's ``shared_side_px``), as ``lv3d.describe.calibration_keys`` gives it at run time."""
+    return calibration_key(r["pred"], r.get("is_fewer", 0.0) > 0, r.get("shared_side_px"))
 
 
 def _fit(x: np.ndarray, y: np.ndarray):
@@ -186,28 +188,36 @@ def _knots(iso) -> dict:
 def _choose_final(oof: dict, pool: list[str], members: list[str], seed: int) -> tuple[dict, dict, dict]:
     """Fit the isotonic map of the rows of the types in ``pool`` together and choose, for each type in
     ``members``, among none, that pooled map and the type's own (with ``MIN_OWN_FINAL`` rows of each label)
-    by scene-grouped 5-fold CV log loss on its own rows. Returns (pooled knots, {member: "pooled", None or
-    own knots}, {member: {choice: CV log loss}}). Nothing outside ``pool`` enters the choice."""
+    by scene-grouped 5-fold CV log loss on its own rows, averaged over ``FINAL_REPEATS`` fold draws (one draw's
+    choice between near-equal maps was a coin toss: rgbd pentagon flipped from the pooled map to none when a
+    sixth of the rows was added, and its check-set ECE doubled). Returns (pooled knots, {member: "pooled", None or
+    own knots}, {member: {choice: mean CV log loss}}). Nothing outside ``pool`` enters the choice."""
     conf, y, seeds = (np.concatenate([oof[p][i] for p in pool]) for i in range(3))
-    fold = _scene_fold_of(seeds, seed)
-    folds = np.array([fold[s] for s in seeds.tolist()])
-    pooled = [_isotonic(conf[folds != k], y[folds != k]) for k in range(5)]
+    sums: dict = defaultdict(lambda: defaultdict(float))
+    for rep in range(FINAL_REPEATS):
+        fold = _scene_fold_of(seeds, seed + rep)
+        folds = np.array([fold[s] for s in seeds.tolist()])
+        pooled = [_isotonic(conf[folds != k], y[folds != k]) for k in range(5)]
+        for pred in members:
+            c, t = oof[pred][0], oof[pred][1]
+            f = np.array([fold[s] for s in oof[pred][2]])
+            cands = {"none": c, "pooled": np.empty(len(c))}
+            if min(t.sum(), len(t) - t.sum()) >= MIN_OWN_FINAL:
+                cands["own"] = np.empty(len(c))
+            for k in range(5):
+                te = f == k
+                if not te.any():  # a rare type (depth parallel: 8 rows in session 9) may miss a fold
+                    continue
+                cands["pooled"][te] = pooled[k].predict(c[te])
+                if "own" in cands:
+                    cands["own"][te] = _isotonic(c[~te], t[~te]).predict(c[te])
+            for name, v in cands.items():
+                sums[pred][name] += log_loss(v, t) / FINAL_REPEATS
     choice, losses = {}, {}
     for pred in members:
-        c, t = oof[pred][0], oof[pred][1]
-        f = np.array([fold[s] for s in oof[pred][2]])
-        cands = {"none": c, "pooled": np.empty(len(c))}
-        if min(t.sum(), len(t) - t.sum()) >= MIN_OWN_FINAL:
-            cands["own"] = np.empty(len(c))
-        for k in range(5):
-            te = f == k
-            if not te.any():  # a rare type (depth parallel: 8 rows in session 9) may miss a fold
-                continue
-            cands["pooled"][te] = pooled[k].predict(c[te])
-            if "own" in cands:
-                cands["own"][te] = _isotonic(c[~te], t[~te]).predict(c[te])
-        losses[pred] = {name: log_loss(v, t) for name, v in cands.items()}
+        losses[pred] = dict(sums[pred])
         best = min(losses[pred], key=losses[pred].get)
+        c, t = oof[pred][0], oof[pred][1]
         choice[pred] = best if best == "pooled" else None if best == "none" else _knots(_isotonic(c, t))
     return _knots(_isotonic(conf, y)), choice, losses
 
@@ -230,7 +240,7 @@ def fit_final(oof: dict, seed: int = 0) -> tuple[dict, dict]:
         final["faces"], choice, face_losses = _choose_final(oof, faces, faces, seed)
         by_pred.update({p: "faces" if c == "pooled" else c for p, c in choice.items()})
         losses.update(face_losses)
-    return {**final, "by_pred": by_pred, "fewer_maps": True}, losses
+    return {**final, "by_pred": by_pred, "fewer_maps": True, "touch_maps": True}, losses
 
 
 def report(rows: list[dict], table: tuple, title: str, shipped: tuple | None = None) -> None:

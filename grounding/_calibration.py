@@ -69,24 +69,41 @@ def _tol_fraction(pred: str):
     return lambda v: min(max(frac(v), -3.0), 3.0)  # 3 tolerances out is as false as it gets
 
 
-_FEWER = "_fewer"
+# facts about two faces whose maps may read the length of the side the two share (0: they touch at a point); the
+# facts about two faces that touch at a point have maps of their own (``calibration_key``)
+SHARED_SIDE_PREDS = ("adjacent", "acute", "obtuse", "perpendicular")
+
+# the kinds of candidate filed apart from their predicate: key suffix -> the flag a modality's FINAL entry carries
+# when its maps were fitted with that kind apart (a modality fitted before sees the predicate's maps)
+_FEWER, _TOUCH = "_fewer", "_touch"
+_KIND_FLAG = {_FEWER: "fewer_maps", _TOUCH: "touch_maps"}
 
 
-def calibration_key(pred: str, fewer: bool = False) -> str:
-    """The name a fact's maps are filed under: the predicate, or for a side count read as one side fewer than the
-    polygon has (a face's ``p_fewer`` fact: one vertex a point on a straight side) ``pred + "_fewer"``. The two
-    kinds of one predicate have different probabilities behind them (a pentagon face's own count and a hexagon's
-    count without its weakest corner) and came out calibrated in opposite directions on one map."""
-    return f"{pred}{_FEWER}" if fewer else pred
+def calibration_key(pred: str, fewer: bool = False, shared_side_px: float | None = None) -> str:
+    """The name a fact's maps are filed under: the predicate, or one of two kinds filed apart.
 
+    - A side count read as one side fewer than the polygon has (``fewer``: a face's ``p_fewer`` fact, one vertex a
+      point on a straight side): ``pred + "_fewer"``. The two kinds of one predicate have different probabilities
+      behind them (a pentagon face's own count and a hexagon's count without its weakest corner) and came out
+      calibrated in opposite directions on one map.
+    - A fact about two faces (``SHARED_SIDE_PREDS``) that share no side (``shared_side_px`` 0,
+      ``lv3d.describe.shared_side_px``: they touch at a point, or a gap or a spurious corner parts their outlines):
+      ``pred + "_touch"``. Their errors are of another kind (opposite laterals of a pyramid meeting at its apex are
+      no neighbours; a tetrahedron's faces traced apart are), and one map over both kinds read its measurements
+      alike for both (session 19, docs/grounding.md)."""
+    if fewer:
+        return pred + _FEWER
+    if pred in SHARED_SIDE_PREDS and shared_side_px is not None and shared_side_px <= 0.0:
+        return pred + _TOUCH
+    return pred
 
 
 def _filed_under(key: str, final: dict | None) -> str:
-    """``key`` itself, or for an (n - 1) key in a modality whose maps were fitted before such keys existed (its
-    ``FINAL`` entry lacks "fewer_maps") the predicate's own key: that modality's maps saw both kinds as one."""
-    if key.endswith(_FEWER) and not (final or {}).get("fewer_maps", False):
-        return key[: -len(_FEWER)]
-    return key
+    """``key`` itself, or for a key of a kind filed apart (``_KIND_FLAG``) in a modality whose maps were fitted
+    before that kind was (its ``FINAL`` entry lacks the kind's flag) the predicate's own key: that modality's maps
+    saw both kinds as one."""
+    pred = _predicate(key)
+    return key if pred == key or (final or {}).get(_KIND_FLAG[key[len(pred):]], False) else pred
 
 
 def inputs(pred: str, p: float, x: dict, names: list[str]) -> list[float]:
@@ -103,7 +120,7 @@ def measures_used(modality: str, pred: str) -> list[str]:
 def calibrate(modality: str, pred: str, p: float, x: dict | None = None) -> float:
     """Calibrated probability of one candidate fact with raw probability ``p`` and face measurements ``x``
     (keys as ``lv3d.describe.calibration_features`` gives them); ``pred``: its calibration key
-    (:func:`calibration_key`: the predicate, or an (n - 1) side count's own key). ``p`` itself where nothing was fitted;
+    (:func:`calibration_key`: the predicate, or the key of a kind filed apart). ``p`` itself where nothing was fitted;
     0 stays 0 (a predicate the geometry rules out is not revived). :func:`calibrate_with` on ``TABLE`` and
     ``FINAL``, with each map's inputs looked up once (a frame has ~150 candidates)."""
     return _apply(_compiled(modality, pred), p, x)
@@ -120,9 +137,18 @@ def calibrate_with(table: dict, modality: str, pred: str, p: float, x: dict | No
     return _apply(_compile(pred, table.get(modality, {}).get(pred), fin), p, x)
 
 
-def _inputs(pred: str, names: list[str]) -> list:
-    """[(key of the measurement in x, or None for logit p; its scale)] of ``pred``'s map's named inputs."""
-    return [(None, None) if n == "logit_p" else ("value", _tol_fraction(pred)) if n == "tol_frac"
+def _predicate(key: str) -> str:
+    """The predicate a calibration key is of (the key without the suffix of a kind filed apart)."""
+    for suffix in _KIND_FLAG:
+        if key.endswith(suffix):
+            return key[: -len(suffix)]
+    return key
+
+
+def _inputs(key: str, names: list[str]) -> list:
+    """[(key of the measurement in x, or None for logit p; its scale)] of the named inputs of the map filed under
+    ``key`` (a predicate, or the key of a kind filed apart: its predicate's tolerance)."""
+    return [(None, None) if n == "logit_p" else ("value", _tol_fraction(_predicate(key))) if n == "tol_frac"
             else (n, _SCALE.get(n, float)) for n in names]
 
 

@@ -272,9 +272,9 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         cands.append(("object", (obj.id,), max(face_conf.values(), default=0.0), None))
         results.append(ObjectResult(obj, face_results, dihedrals, status, raw))
     if calibrate:
-        # (n - 1) side counts have maps of their own; measurements only for the candidates whose map reads them
+        # some kinds of candidate have maps of their own; measurements only for the candidates whose map reads them
         # (they cost more than the maps)
-        keys = [grounding.calibration_key(c[0], fewer) for c, fewer in zip(cands, one_side_fewer(cands, results))]
+        keys = calibration_keys(cands, results)
         needs = _needs(scene.modality)
         feats = calibration_features([c for c, key in zip(cands, keys) if needs[key]], results)
         it = iter(feats)
@@ -289,7 +289,8 @@ def _needs(modality: str) -> dict[str, bool]:
     """Per calibration key (grounding.calibration_key) whether its map in ``modality`` reads face measurements."""
     import grounding
 
-    keys = {grounding.calibration_key(pred, fewer) for pred in PREDICATES for fewer in (False, True)}
+    keys = {grounding.calibration_key(pred, fewer, side) for pred in PREDICATES
+            for fewer, side in ((False, None), (True, None), (False, 0.0))}
     return {key: bool(grounding.measures_used(modality, key)) for key in keys}
 
 
@@ -372,6 +373,27 @@ def one_side_fewer(cands: list, results: list[ObjectResult]) -> list[bool]:
     (:func:`calibration_features`)."""
     sides = {fr.face.id: fr.features["sides"] for res in results for fr in res.faces}
     return [pred in _SIDE_PREDS and args[0] in sides and value == sides[args[0]] - 1 for pred, args, _, value in cands]
+
+
+def calibration_keys(cands: list, results: list[ObjectResult]) -> list[str]:
+    """Each candidate's calibration key (grounding.calibration_key): its predicate, or a key of its own for an
+    (n - 1) side count (:func:`one_side_fewer`) and for a fact about two faces that share no side
+    (:func:`shared_side_px` 0, the measurement their maps read)."""
+    import grounding
+
+    by_result = {fr.face.id: fr for res in results for fr in res.faces}
+    shared: dict[tuple[str, str], float] = {}  # a pair has up to four such facts, each in both orders
+
+    def side(args) -> float | None:
+        if len(args) != 2 or args[0] not in by_result or args[1] not in by_result:
+            return None
+        key = (min(args), max(args))
+        if key not in shared:
+            shared[key] = shared_side_px(by_result[key[0]].polygon, by_result[key[1]].polygon)
+        return shared[key]
+
+    return [grounding.calibration_key(pred, fewer, side(args) if pred in grounding.SHARED_SIDE_PREDS else None)
+            for (pred, args, _, _), fewer in zip(cands, one_side_fewer(cands, results))]
 
 
 def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]:

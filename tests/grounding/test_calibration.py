@@ -184,3 +184,30 @@ def test_one_side_fewer_has_maps_of_its_own_where_they_were_fitted():
     assert math.isclose(calibrate_with(table, "rgbd", "pentagon_fewer", p, {}, new),
                         1 / (1 + math.exp(2 - math.log(1.5))))
     assert FINAL["rgbd"].get("fewer_maps") and not FINAL["depth"].get("fewer_maps")  # depth: session 17's maps
+
+
+def test_facts_about_faces_that_touch_at_a_point_have_maps_of_their_own_where_they_were_fitted():
+    from lv3d.describe import FaceResult, ObjectResult, calibration_keys
+
+    assert grounding.calibration_key("acute", shared_side_px=40.0) == "acute"
+    assert grounding.calibration_key("acute", shared_side_px=0.0) == "acute_touch"
+    assert grounding.calibration_key("parallel", shared_side_px=0.0) == "parallel"  # its map reads no shared side
+    assert grounding.calibration_key("acute") == "acute"                             # nothing measured
+
+    def face(fid, poly):
+        return FaceResult(SimpleNamespace(id=fid), np.asarray(poly, float), None, np.zeros(len(poly)), dict(MEASURES))
+
+    res = ObjectResult(SimpleNamespace(id="o1"), [face("f1", [[0, 0], [30, 0], [30, 40], [0, 40]]),
+                                                  face("f2", [[30, 0], [60, 0], [60, 40], [30, 40]]),
+                                                  face("f3", [[30, 40], [60, 40], [60, 80]])], {}, 0, [])
+    cands = [("acute", ("f1", "f2"), 0.9, 60.0), ("acute", ("f3", "f1"), 0.9, 60.0),
+             ("adjacent", ("f1", "f3"), 0.9, None), ("parallel", ("f1", "f3"), 0.9, 2.0)]
+    assert calibration_keys(cands, [res]) == ["acute", "acute_touch", "adjacent_touch", "parallel"]
+    # in a modality whose maps were fitted before touch keys existed, a touch key reads its predicate's maps
+    table = {"rgbd": {"acute": {"features": ["logit_p"], "bias": 0.0, "coef": [1.0]},
+                      "acute_touch": {"features": ["logit_p"], "bias": -2.0, "coef": [1.0]}}}
+    old = {"rgbd": {"x": [0.0, 1.0], "y": [0.0, 1.0], "fewer_maps": True}}
+    new = {"rgbd": {**old["rgbd"], "touch_maps": True}}
+    assert calibrate_with(table, "rgbd", "acute_touch", 0.6, {}, old) == calibrate_with(table, "rgbd", "acute", 0.6, {}, old)
+    assert math.isclose(calibrate_with(table, "rgbd", "acute_touch", 0.6, {}, new), 1 / (1 + math.exp(2 - math.log(1.5))))
+    assert FINAL["rgbd"].get("touch_maps") and "acute_touch" in TABLE["rgbd"] and not FINAL["depth"].get("touch_maps")
