@@ -1,12 +1,22 @@
 """Fit the per-(modality, predicate) confidence calibration maps and write grounding/_calibration_table.py.
 
-The table in the tree (docs/grounding.md, "Calibration on perceived scenes"): rgbd refitted in session 18, after
-rgbd perception changed and (n - 1) side counts got maps of their own (``row_key``), on the same 3500 scene seeds
-and 420-scene check set as below with ``--modalities rgbd`` (each 1050-scene set ~3.3 min on one core; rows made
-before describe marked the (n - 1) rows were marked by inference, which matched the mark on all 1217 rows of a
-marked 35-scene set); depth is session 17's, fitted for both modalities after the dihedral tolerance became
-90 +- 7 deg (docs/facts.md) and side counts moved onto the plane: 3500 scenes, each 1050-scene set ~3.5 min on one
-core with rgbd and depth, the 420-scene check set ~1.2 min, the fit ~20 s:
+The table in the tree (docs/grounding.md, "Calibration on perceived scenes"): rgbd refitted in session 19, after
+facts about two faces that share no side got maps of their own (``row_key``), on 5600 scenes: session 18's rows of
+the 3500 scene seeds below (refitted for rgbd in session 18 after its perception changed and (n - 1) side counts got
+keys of their own; rows made before describe marked the (n - 1) rows were marked by inference, which matched the
+mark on all 1217 rows of a marked 35-scene set) and two new 1050-scene sets (each ~3.3 min on one core), checked on
+1470 scenes (seeds 100000+ and the 420 of 50000+)::
+
+    for a in "80000 e80000" "90000 f90000" "100000 chk100000"; do set -- $a
+        .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class 150 --modalities rgbd \
+            --out out/calib/$2.pkl; done
+    .venv/bin/python benchmarks/fit_calibration.py out/calib/{a150,b150,d60000,d70000,e80000,f90000}.pkl \
+        --check out/calib/chk_all.pkl --modalities rgbd
+
+(chk_all: the rows of chk100000 and of the 420-scene set together). Depth is session 17's, fitted for both
+modalities after the dihedral tolerance became 90 +- 7 deg (docs/facts.md) and side counts moved onto the plane:
+3500 scenes, each 1050-scene set ~3.5 min on one core with rgbd and depth, the 420-scene check set ~1.2 min, the fit
+~20 s:
 
     for a in "30000 150 a150" "40000 150 b150" "60000 100 d60000" "70000 100 d70000"; do set -- $a
         .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class $2 --modalities rgbd,depth \

@@ -208,6 +208,8 @@ def test_facts_about_faces_that_touch_at_a_point_have_maps_of_their_own_where_th
                       "acute_touch": {"features": ["logit_p"], "bias": -2.0, "coef": [1.0]}}}
     old = {"rgbd": {"x": [0.0, 1.0], "y": [0.0, 1.0], "fewer_maps": True}}
     new = {"rgbd": {**old["rgbd"], "touch_maps": True}}
-    assert calibrate_with(table, "rgbd", "acute_touch", 0.6, {}, old) == calibrate_with(table, "rgbd", "acute", 0.6, {}, old)
-    assert math.isclose(calibrate_with(table, "rgbd", "acute_touch", 0.6, {}, new), 1 / (1 + math.exp(2 - math.log(1.5))))
+    assert calibrate_with(table, "rgbd", "acute_touch", 0.6, {}, old) == \
+        calibrate_with(table, "rgbd", "acute", 0.6, {}, old)
+    assert math.isclose(calibrate_with(table, "rgbd", "acute_touch", 0.6, {}, new),
+                        1 / (1 + math.exp(2 - math.log(1.5))))
     assert FINAL["rgbd"].get("touch_maps") and "acute_touch" in TABLE["rgbd"] and not FINAL["depth"].get("touch_maps")
