@@ -10,9 +10,13 @@ from ._confidence import ACUTE_BELOW_DEG as ACUTE_BELOW_DEG
 from ._confidence import CORNER_TURN_MIN_DEG as CORNER_TURN_MIN_DEG
 from ._confidence import CORNER_TURN_MIN_PLANE_DEG as CORNER_TURN_MIN_PLANE_DEG
 from ._confidence import Confidences as Confidences
+from ._confidence import EQUAL_CORNERS_DEG as EQUAL_CORNERS_DEG
 from ._confidence import Floors as Floors
 from ._confidence import OBTUSE_ABOVE_DEG as OBTUSE_ABOVE_DEG
+from ._confidence import PARALLEL_SIDES_DEG as PARALLEL_SIDES_DEG
 from ._confidence import PERPENDICULAR_DEG as PERPENDICULAR_DEG
+from ._confidence import PLANE_ANGLE_DEG as PLANE_ANGLE_DEG
+from ._confidence import RIGHT_ANGLE_DEG as RIGHT_ANGLE_DEG
 from ._confidence import SUPPORT_FULL as SUPPORT_FULL
 from ._confidence import interval as interval
 from ._field import edge_distance_field as edge_distance_field

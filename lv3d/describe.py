@@ -274,13 +274,16 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     if calibrate:
         # some kinds of candidate have maps of their own; measurements only for the candidates whose map reads them
         # (they cost more than the maps)
-        keys = calibration_keys(cands, results)
+        fewer, shared = one_side_fewer(cands, results), {}  # both read by keys and features: found once
+        keys = calibration_keys(cands, results, fewer=fewer, shared=shared)
         needs = _needs(scene.modality)
-        feats = calibration_features([c for c, key in zip(cands, keys) if needs[key]], results)
+        picked = [needs[key] for key in keys]
+        feats = calibration_features([c for c, pick in zip(cands, picked) if pick], results,
+                                     fewer=[f for f, pick in zip(fewer, picked) if pick], shared=shared)
         it = iter(feats)
         calibrate_one, modality = grounding.calibrate, scene.modality
-        cands = [(pred, args, calibrate_one(modality, key, p, next(it) if needs[key] else None), value)
-                 for (pred, args, p, value), key in zip(cands, keys)]
+        cands = [(pred, args, calibrate_one(modality, key, p, next(it) if pick else None), value)
+                 for (pred, args, p, value), key, pick in zip(cands, keys, picked)]
     return cands, results
 
 
@@ -375,37 +378,47 @@ def one_side_fewer(cands: list, results: list[ObjectResult]) -> list[bool]:
     return [pred in _SIDE_PREDS and args[0] in sides and value == sides[args[0]] - 1 for pred, args, _, value in cands]
 
 
-def calibration_keys(cands: list, results: list[ObjectResult]) -> list[str]:
+def _shared_side(shared: dict, by_result: dict, args) -> float | None:
+    """:func:`shared_side_px` of the two faces ``args``, memoised in ``shared`` by unordered pair (a pair has up to
+    six facts, each in both orders); None unless ``args`` names two grounded faces."""
+    if len(args) != 2 or args[0] not in by_result or args[1] not in by_result:
+        return None
+    key = (min(args), max(args))
+    if key not in shared:
+        shared[key] = shared_side_px(by_result[key[0]].polygon, by_result[key[1]].polygon)
+    return shared[key]
+
+
+def calibration_keys(cands: list, results: list[ObjectResult], *, fewer: list[bool] | None = None,
+                     shared: dict | None = None) -> list[str]:
     """Each candidate's calibration key (grounding.calibration_key): its predicate, or a key of its own for an
-    (n - 1) side count (:func:`one_side_fewer`) and for a fact about two faces that share no side
-    (:func:`shared_side_px` 0, the measurement their maps read)."""
+    (n - 1) side count (:func:`one_side_fewer`; pass ``fewer`` where it is known) and for a fact about two faces that
+    share no side (:func:`shared_side_px` 0, the measurement their maps read; ``shared`` is a memo by pair that
+    :func:`calibration_features` may reuse)."""
     import grounding
 
     by_result = {fr.face.id: fr for res in results for fr in res.faces}
-    shared: dict[tuple[str, str], float] = {}  # a pair has up to four such facts, each in both orders
-
-    def side(args) -> float | None:
-        if len(args) != 2 or args[0] not in by_result or args[1] not in by_result:
-            return None
-        key = (min(args), max(args))
-        if key not in shared:
-            shared[key] = shared_side_px(by_result[key[0]].polygon, by_result[key[1]].polygon)
-        return shared[key]
-
-    return [grounding.calibration_key(pred, fewer, side(args) if pred in grounding.SHARED_SIDE_PREDS else None)
-            for (pred, args, _, _), fewer in zip(cands, one_side_fewer(cands, results))]
+    fewer = one_side_fewer(cands, results) if fewer is None else fewer
+    shared = {} if shared is None else shared
+    return [grounding.calibration_key(pred, few, _shared_side(shared, by_result, args)
+                                      if pred in grounding.SHARED_SIDE_PREDS else None)
+            for (pred, args, _, _), few in zip(cands, fewer)]
 
 
-def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]:
+def calibration_features(cands: list, results: list[ObjectResult], *, fewer: list[bool] | None = None,
+                         shared: dict | None = None) -> list[dict]:
     """Per candidate the face measurements its calibration may read (:func:`_face_features`); for a fact
     about two faces, the weaker of each (smaller value), the length of the side they share
     (``shared_side_px``, :func:`shared_side_px`) and, where both have planes, how far they are from one plane
     (``plane_gap_mm``, :func:`plane_gap_mm`); for ``object`` the object's best face; and, for a candidate with a
     measured value, that value as ``value``. An (n - 1) side count reads the face's measurements without its weakest
-    corner, marked ``is_fewer`` (its calibration key is its own: grounding.calibration_key)."""
+    corner, marked ``is_fewer`` (its calibration key is its own: grounding.calibration_key). ``fewer`` and ``shared``
+    as :func:`calibration_keys` takes them."""
     by_face = {fr.face.id: fr.features for res in results for fr in res.faces}
     by_result = {fr.face.id: fr for res in results for fr in res.faces}
     by_obj = {res.obj.id: [fr.features for fr in res.faces] for res in results}
+    fewer = one_side_fewer(cands, results) if fewer is None else fewer
+    shared = {} if shared is None else shared
     weaker: dict[tuple[str, ...], dict] = {}  # by faces: a pair has up to six facts, each in both orders
 
     def combined(args):
@@ -413,22 +426,22 @@ def calibration_features(cands: list, results: list[ObjectResult]) -> list[dict]
         if key not in weaker:
             fs = [by_face[a] for a in key if a in by_face]
             weaker[key] = {k: min(f[k] for f in fs) for k in fs[0] if k != "fewer"} if fs else {}
-            if len(key) == 2 and key[0] in by_result and key[1] in by_result:
-                a, b = by_result[key[0]], by_result[key[1]]
-                weaker[key]["shared_side_px"] = shared_side_px(a.polygon, b.polygon)
-                gap = plane_gap_mm(a, b)
+            side = _shared_side(shared, by_result, key)
+            if side is not None:
+                weaker[key]["shared_side_px"] = side
+                gap = plane_gap_mm(by_result[key[0]], by_result[key[1]])
                 if gap is not None:
                     weaker[key]["plane_gap_mm"] = gap
         return weaker[key]
 
     out = []
-    for (pred, args, _, value), fewer in zip(cands, one_side_fewer(cands, results)):
+    for (pred, args, _, value), few in zip(cands, fewer):
         if pred == "object":
             fs = by_obj.get(args[0], [])
             out.append(max(fs, key=lambda f: f["support"]) if fs else {})
         else:
             f = combined(args)
-            if fewer:  # the (sides - 1) fact reads the polygon without its weakest corner
+            if few:  # the (sides - 1) fact reads the polygon without its weakest corner
                 f = {**by_face[args[0]]["fewer"], "is_fewer": 1.0}
             out.append(f if value is None else {**f, "value": value})
     return out

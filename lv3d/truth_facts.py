@@ -12,14 +12,13 @@ import itertools
 
 import numpy as np
 
-from grounding import ACUTE_BELOW_DEG, OBTUSE_ABOVE_DEG, PERPENDICULAR_DEG
+from grounding import (ACUTE_BELOW_DEG, EQUAL_CORNERS_DEG, OBTUSE_ABOVE_DEG, PARALLEL_SIDES_DEG, PERPENDICULAR_DEG,
+                       PLANE_ANGLE_DEG, RIGHT_ANGLE_DEG)
 
 from .errors import InputError
 from .facts import PREDICATES, Fact, SceneFacts, face_id, object_id
 
 SIDES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
-ANGLE_TOL_DEG = 10.0       # parallel, horizontal, vertical, corners
-PARALLELOGRAM_TOL_DEG = 8.0
 EQUAL_SIDES_TOL = 0.12     # relative spread of side lengths for square and regular
 STRUCTURE = ("object", "face_of")  # never perturbed: without them there is no object to speak of
 
@@ -54,15 +53,15 @@ def _face_shape(poly_px: np.ndarray, poly_3d: np.ndarray) -> list[str]:
     if n == 4:
         e = np.roll(poly_px, -1, axis=0) - poly_px
         par = [min(_angle_deg(e[i], e[i + 2]), 180 - _angle_deg(e[i], e[i + 2])) for i in (0, 1)]
-        if max(par) <= PARALLELOGRAM_TOL_DEG:
+        if max(par) <= PARALLEL_SIDES_DEG:
             out.append("parallelogram")
     sides, corners = _sides(poly_3d), _corners_deg(poly_3d)
     equal = (sides.max() - sides.min()) / sides.max() <= EQUAL_SIDES_TOL
-    if n == 4 and np.all(np.abs(corners - 90) <= ANGLE_TOL_DEG):
+    if n == 4 and np.all(np.abs(corners - 90) <= RIGHT_ANGLE_DEG):
         out.append("rectangle")
         if equal:
             out.append("square")
-    if equal and corners.max() - corners.min() <= ANGLE_TOL_DEG:
+    if equal and corners.max() - corners.min() <= EQUAL_CORNERS_DEG:
         out.append("regular")
     return out
 
@@ -87,9 +86,9 @@ def _exact_facts(truth: dict, k: dict, scene_id: str) -> list[Fact]:
         poly3 = _on_plane(poly, n, float(f["plane"]["offset"]), k)
         facts += [Fact(p, (fid,), 1.0) for p in _face_shape(poly, poly3)]
         tilt = _angle_deg(n, up)
-        if tilt <= ANGLE_TOL_DEG:
+        if tilt <= PLANE_ANGLE_DEG:
             facts.append(Fact("horizontal", (fid,), 1.0, tilt))
-        if abs(tilt - 90) <= ANGLE_TOL_DEG:
+        if abs(tilt - 90) <= PLANE_ANGLE_DEG:
             facts.append(Fact("vertical", (fid,), 1.0, tilt))
     for a in truth.get("adjacency", []):
         i, j = (int(x) for x in a["faces"])
@@ -108,7 +107,7 @@ def _exact_facts(truth: dict, k: dict, scene_id: str) -> list[Fact]:
         for x, y in ((names[i], names[j]), (names[j], names[i])):
             if abs(d - 90) <= PERPENDICULAR_DEG:
                 facts.append(Fact("perpendicular", (x, y), 1.0, d))
-            if d <= ANGLE_TOL_DEG or d >= 180 - ANGLE_TOL_DEG:
+            if d <= PLANE_ANGLE_DEG or d >= 180 - PLANE_ANGLE_DEG:
                 facts.append(Fact("parallel", (x, y), 1.0, d))
     return facts
 
