@@ -115,17 +115,49 @@ def normal_edge_field(depth: np.ndarray, intrinsics: tuple[float, float, float, 
 
     ``depth``: (H, W) metres, 0 = no reading. ``intrinsics``: fx, fy, cx, cy in pixels. Points are
     smoothed over ``smooth_px`` (normalised convolution, so holes do not drag them to zero) before the
-    normals are taken from central differences.
+    normals are taken from central differences. ``roi`` as :func:`edge_distance_field` takes it: each box's
+    normals are computed on a window around it just wide enough that the field inside the box is the one the
+    whole frame would give.
     """
     z = np.asarray(depth, np.float32)
     valid = (z > 0) & np.isfinite(z)
-    z = np.where(valid, z, 0.0).astype(np.float32)
+    z = np.where(valid, z, np.float32(0.0))
     h, w = z.shape
-    fx, fy, cx, cy = intrinsics
-    u, v = np.meshgrid(np.arange(w, dtype=np.float32), np.arange(h, dtype=np.float32))
-    pts = np.stack([(u - cx) / fx * z, (v - cy) / fy * z, z], -1)
     wsum = cv2.GaussianBlur(valid.astype(np.float32), (0, 0), smooth_px)
-    pts = cv2.GaussianBlur(pts, (0, 0), smooth_px) / np.maximum(wsum, 1e-6)[..., None]
+    # depth steps are read as log depth above the frame's nearest (smoothed) reading
+    near = None
+    if valid.any():
+        zs = cv2.GaussianBlur(z, (0, 0), smooth_px) / np.maximum(wsum, 1e-6)
+        near = float(np.log(np.maximum(zs[valid].min(), 1e-3)))
+    args = (z, valid, wsum, near, intrinsics, smooth_px)
+    if roi is None:
+        return edge_distance_field(_normal_image((0, 0, w, h), *args), low=low, high=high, cap_px=cap_px)
+    out = np.full((h, w), cap_px, np.float32)
+    # the smoothing kernel's reach and the central differences, with room to spare
+    margin = int(np.ceil(4 * smooth_px)) + 4
+    for box in (roi if isinstance(roi, list) else [roi]):
+        u0, v0 = max(0, int(box[0])), max(0, int(box[1]))  # as edge_distance_field reads a box
+        u1, v1 = min(w, int(np.ceil(box[2]))), min(h, int(np.ceil(box[3])))
+        if u1 - u0 < 8 or v1 - v0 < 8:
+            continue
+        win = (max(0, u0 - margin), max(0, v0 - margin), min(w, u1 + margin), min(h, v1 + margin))
+        img = _normal_image(win, *args)
+        du, dv = u0 - win[0], v0 - win[1]
+        out[v0:v1, u0:u1] = edge_distance_field(img[dv:dv + v1 - v0, du:du + u1 - u0], low=low, high=high,
+                                                cap_px=cap_px)
+    return out
+
+
+def _normal_image(win: tuple[int, int, int, int], z: np.ndarray, valid: np.ndarray, wsum: np.ndarray,
+                  near: float | None, intrinsics: tuple[float, float, float, float], smooth_px: float) -> np.ndarray:
+    """The uint8 image :func:`normal_edge_field` finds edges in, over the window (u0, v0, u1, v1): the smoothed
+    surface normal's three components and, where the frame has readings, log depth above ``near``."""
+    u0, v0, u1, v1 = win
+    fx, fy, cx, cy = intrinsics
+    zc, valid_c = z[v0:v1, u0:u1], valid[v0:v1, u0:u1]
+    u, v = np.meshgrid(np.arange(u0, u1, dtype=np.float32), np.arange(v0, v1, dtype=np.float32))
+    pts = np.stack([(u - cx) / fx * zc, (v - cy) / fy * zc, zc], -1)
+    pts = cv2.GaussianBlur(pts, (0, 0), smooth_px) / np.maximum(wsum[v0:v1, u0:u1], 1e-6)[..., None]
     du = np.zeros_like(pts)
     dv = np.zeros_like(pts)
     du[:, 1:-1] = pts[:, 2:] - pts[:, :-2]
@@ -133,9 +165,8 @@ def normal_edge_field(depth: np.ndarray, intrinsics: tuple[float, float, float, 
     n = np.cross(du, dv)
     n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-12)
     img = np.clip((n + 1.0) * 127.5, 0, 255)
-    # depth steps: log depth, so a jump of a given ratio looks the same near and far
-    logz = np.log(np.maximum(pts[..., 2], 1e-3))
-    if valid.any():
-        img = np.concatenate([img, np.clip((logz - logz[valid].min()) * 400.0, 0, 255)[..., None]], -1)
-    img[~valid] = 0
-    return edge_distance_field(img.astype(np.uint8), low=low, high=high, cap_px=cap_px, roi=roi)
+    if near is not None:
+        logz = np.log(np.maximum(pts[..., 2], 1e-3))
+        img = np.concatenate([img, np.clip((logz - near) * 400.0, 0, 255)[..., None]], -1)
+    img[~valid_c] = 0
+    return img.astype(np.uint8)

@@ -22,6 +22,7 @@ from .scene import Face, Scene, SceneObject
 
 MIN_CONF = 0.05
 CAP_PX = 30.0  # edge fields are clipped to +-this many pixels
+COLOUR_FIRST_PX = 6.0  # rgbd fields near a depth-found face: colour's edge stands where it is within this (px)
 SIDE_NAMES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
 _SIDE_PREDS = frozenset(SIDE_NAMES.values())
 
@@ -101,13 +102,14 @@ def dense_face_points(face: Face, frame: RGBD, margin_px: int = 2, gate_m: float
     return np.compress(near, pts, axis=0) if np.count_nonzero(near) >= len(face.points) else None
 
 
-def _boxes(scene: Scene, margin_px: float) -> list[tuple[float, float, float, float]]:
-    """Boxes (u0, v0, u1, v1) around each object's polygons plus ``margin_px``, overlapping
-    ones merged: the field is needed only near the sides that are sampled, and one box around objects
-    spread over the frame would cover most of it."""
+def _boxes(scene: Scene, margin_px: float, provenance: str | None = None) -> list[tuple[float, float, float, float]]:
+    """Boxes (u0, v0, u1, v1) around each object's polygons (only its faces of ``provenance``, if given) plus
+    ``margin_px``, overlapping ones merged: the field is needed only near the sides that are sampled, and one box
+    around objects spread over the frame would cover most of it."""
     boxes = []
     for o in scene.objects:
-        polys = [np.asarray(f.polygon, float).reshape(-1, 2) for f in o.faces if len(f.polygon)]
+        polys = [np.asarray(f.polygon, float).reshape(-1, 2) for f in o.faces
+                 if len(f.polygon) and provenance in (None, f.provenance)]
         if polys:
             p = np.concatenate(polys)
             boxes.append([*(p.min(0) - margin_px), *(p.max(0) + margin_px)])
@@ -134,12 +136,24 @@ def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px
     import grounding
 
     boxes = _boxes(scene, margin_px) if scene is not None else []
+    k = frame.intrinsics
+    intr = (k.fx, k.fy, k.cx, k.cy)
     if modality == "depth":
-        k = frame.intrinsics
         # the depth field smooths the whole image anyway: one box around all objects
         roi = (*np.min([b[:2] for b in boxes], 0), *np.max([b[2:] for b in boxes], 0)) if boxes else None
-        return grounding.normal_edge_field(frame.depth, (k.fx, k.fy, k.cx, k.cy), roi=roi, cap_px=CAP_PX)
-    return grounding.edge_distance_field(frame.color, roi=boxes or None, cap_px=CAP_PX)
+        return grounding.normal_edge_field(frame.depth, intr, roi=roi, cap_px=CAP_PX)
+    colour = grounding.edge_distance_field(frame.color, roi=boxes or None, cap_px=CAP_PX)
+    if modality == "rgb" or scene is None:
+        return colour
+    # rgbd: a face that depth found and colour did not is judged against depth's edges too, as it is in the depth
+    # system: around such faces colour's edges stand where there is one nearby (they are sharper), and
+    # elsewhere depth's, where nearer
+    fill = _boxes(scene, margin_px, provenance="depth")
+    if not fill:
+        return colour
+    depth = grounding.normal_edge_field(frame.depth, intr, roi=fill, cap_px=CAP_PX)
+    near = np.abs(colour)
+    return np.where((near <= COLOUR_FIRST_PX) | (near <= np.abs(depth)), colour, depth)
 
 
 def _chunks(faces: list[Face], max_faces: int, max_vertices: int, max_sides: int) -> list[list[Face]]:
