@@ -174,3 +174,24 @@ def test_dense_face_points_take_every_reading_inside_the_shrunk_outline():
     # a face without a plane, or whose outline holds fewer readings than perception found, keeps its points
     assert dense_face_points(Face("f", poly, "rgb"), frame) is None
     assert dense_face_points(Face("f", poly, "rgbd", plane=plane, points=np.zeros((10 ** 6, 3))), frame) is None
+
+
+def test_rgbd_judges_a_face_depth_found_against_depth_edges_where_colour_has_none():
+    from lv3d.describe import edge_field
+
+    scene, frame = _scene("rgbd", np.random.default_rng(6))
+    f1, f2 = scene.objects[0].faces
+    top = np.all(frame.color == (210, 160, 90), axis=-1)
+    frame.color[~top] = 40  # the front face in the floor's colour: colour sees none of its sides
+    outer = (f2.polygon[2] + f2.polygon[3]) / 2  # its lower side, against the floor
+    u, v = np.round(outer).astype(int)
+    colour_only = edge_field(frame, "rgbd", scene)
+    assert np.abs(colour_only[v - 1:v + 2, u - 1:u + 2]).min() > 3.0  # every face colour found: colour's edges only
+    f2.provenance = "depth"
+    filled = edge_field(frame, "rgbd", scene)
+    assert np.abs(filled[v - 1:v + 2, u - 1:u + 2]).min() < 1.5  # depth's edge where colour has none
+    # colour's edges stand where colour has one: along the side the two faces share, and away from the face
+    shared = np.round((f1.polygon[0] + f1.polygon[1]) / 2).astype(int)
+    near = (slice(shared[1] - 2, shared[1] + 3), slice(shared[0] - 2, shared[0] + 3))
+    np.testing.assert_array_equal(filled[near], colour_only[near])
+    assert np.array_equal(filled[:20], colour_only[:20])

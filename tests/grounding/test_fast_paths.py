@@ -111,3 +111,36 @@ def test_face_features_equal_the_per_face_computation():
                              "min_turn_z": float(np.delete(z, k).min()),
                              "min_side_px": float(np.linalg.norm(np.diff(rest, axis=0, append=rest[:1]), axis=1).min())}
         assert got[i] == want
+
+
+def test_normal_edge_field_in_boxes_is_the_whole_frame_field_there():
+    rng = np.random.default_rng(4)
+    v, u = np.mgrid[0:240, 0:320].astype(np.float32)
+    depth = 0.8 + 0.0005 * u + 0.0003 * v  # a tilted floor
+    roof = (np.abs(u - 120) + np.abs(v - 110) < 50)  # a pyramid-like bump: normals turn along its ridges
+    depth = np.where(roof, depth - 0.002 * (50 - np.abs(u - 120) - np.abs(v - 110)), depth)
+    depth = (depth * (1 + rng.normal(0, 0.001, depth.shape))).astype(np.float32)
+    depth[200:215, 250:280] = 0  # a hole without readings
+    intr = (300.0, 300.0, 160.0, 120.0)
+    whole = grounding.normal_edge_field(depth, intr)
+    boxes = [(60.2, 50.7, 181.3, 170.1), (230.0, 180.5, 300.9, 236.2)]
+    part = grounding.normal_edge_field(depth, intr, roi=boxes)
+    for u0, v0, u1, v1 in boxes:
+        inside = (slice(int(v0), int(np.ceil(v1))), slice(int(u0), int(np.ceil(u1))))
+        # each box's own field, as edge_distance_field computes a box on its own, at normal_edge_field's thresholds
+        want = grounding.edge_distance_field(_normal_image_of(depth, intr)[inside], low=40.0, high=100.0)
+        np.testing.assert_array_equal(part[inside], want)
+    assert np.any(np.abs(whole[50:170, 60:181]) < 1) and np.all(part[:40] == 30.0)
+
+
+def _normal_image_of(depth, intr):
+    """The whole frame's normal image (grounding._field's own), to cut boxes from."""
+    from grounding._field import _normal_image
+    import cv2
+
+    valid = depth > 0
+    z = np.where(valid, depth, np.float32(0.0))
+    wsum = cv2.GaussianBlur(valid.astype(np.float32), (0, 0), 2.0)
+    zs = cv2.GaussianBlur(z, (0, 0), 2.0) / np.maximum(wsum, 1e-6)
+    near = float(np.log(np.maximum(zs[valid].min(), 1e-3)))
+    return _normal_image((0, 0, depth.shape[1], depth.shape[0]), z, valid, wsum, near, intr, 2.0)
