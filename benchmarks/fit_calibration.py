@@ -1,19 +1,18 @@
 """Fit the per-(modality, predicate) confidence calibration maps and write grounding/_calibration_table.py.
 
-The table in the tree (docs/grounding.md, "Calibration on perceived scenes"): rgbd refitted in session 19, after
-facts about two faces that share no side got maps of their own (``row_key``), on 5600 scenes: session 18's rows of
-the 3500 scene seeds below (refitted for rgbd in session 18 after its perception changed and (n - 1) side counts got
-keys of their own; rows made before describe marked the (n - 1) rows were marked by inference, which matched the
-mark on all 1217 rows of a marked 35-scene set) and two new 1050-scene sets (each ~3.3 min on one core), checked on
-1470 scenes (seeds 100000+ and the 420 of 50000+)::
+The table in the tree (docs/grounding.md, "Calibration on perceived scenes"): rgbd refitted in session 20, after
+its edge field took depth's edges around faces depth alone found (``lv3d.describe.edge_field``), on 5600 fresh
+scenes of the same dev seeds as session 19's fit (each 1050-scene set ~3.7 min on one core, two at a time), checked
+on 1470 scenes (seeds 100000+ and 50000+)::
 
-    for a in "80000 e80000" "90000 f90000" "100000 chk100000"; do set -- $a
-        .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class 150 --modalities rgbd \
-            --out out/calib/$2.pkl; done
+    for a in "30000 150 a150" "40000 150 b150" "60000 100 d60000" "70000 100 d70000" "80000 150 e80000" \
+             "90000 150 f90000" "100000 150 chk100000" "50000 60 c60"; do set -- $a
+        .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class $2 --modalities rgbd \
+            --out out/calib/$3.pkl; done
     .venv/bin/python benchmarks/fit_calibration.py out/calib/{a150,b150,d60000,d70000,e80000,f90000}.pkl \
         --check out/calib/chk_all.pkl --modalities rgbd
 
-(chk_all: the rows of chk100000 and of the 420-scene set together). Depth is session 17's, fitted for both
+(chk_all: the rows and scenes of chk100000 and c60 concatenated into one pickle; the fit takes ~20 s). Depth is session 17's, fitted for both
 modalities after the dihedral tolerance became 90 +- 7 deg (docs/facts.md) and side counts moved onto the plane:
 3500 scenes, each 1050-scene set ~3.5 min on one core with rgbd and depth, the 420-scene check set ~1.2 min, the fit
 ~20 s:
@@ -281,6 +280,8 @@ def report(rows: list[dict], table: tuple, title: str, shipped: tuple | None = N
               f"true {cal[:, 1].mean() if len(cal) else float('nan'):.2f}")
     for mod in MODALITIES:  # every emitted fact, and the log loss of every candidate (p > 0): a proper score
         rs = [r for r in rows if r["modality"] == mod and r["p"] > 0]
+        if not rs:  # a set made for the other modality only
+            continue
         y = np.array([r["y"] for r in rs], float)
         line = f"  {mod:5s} all facts     "
         for name, tab in (("shipped", shipped), ("calibrated", table)):

@@ -131,8 +131,10 @@ def _boxes(scene: Scene, margin_px: float, provenance: str | None = None) -> lis
 
 def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px: float = 24.0) -> np.ndarray:
     """The edge-distance field (H, W) float32 pixels a system that sees ``modality`` may use: colour edges
-    for rgb and rgbd, edges of the depth image's surface normals and depth steps for depth. With ``scene``,
-    only the boxes around its objects' polygons (plus ``margin_px``) are computed; the rest is the cap."""
+    for rgb, edges of the depth image's surface normals and depth steps for depth, and for rgbd colour edges with,
+    around each face depth found and colour did not (provenance "depth"), depth's edges where colour has none
+    within ``COLOUR_FIRST_PX``. With ``scene``, only the boxes around its objects' polygons (plus ``margin_px``)
+    are computed; the rest is the cap."""
     import grounding
 
     boxes = _boxes(scene, margin_px) if scene is not None else []
