@@ -243,7 +243,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
             support_l = np.clip(g["conf"]["edge_support"] / grounding.SUPPORT_FULL, 0.0, 1.0).tolist()
             vstd_all = _largest_std(g["vertex_cov"])
             ns = [len(p) for p in polys]
-            feats = _face_features(g, index, ns, has_plane)
+            feats = _face_features(g, index, ns)
             for i, f in enumerate(chunk):
                 n = ns[i]
                 ids_i = index[i, :n]
@@ -320,33 +320,27 @@ def _largest_std(cov: np.ndarray) -> np.ndarray:
     return np.sqrt(np.clip(0.5 * (a + c) + np.hypot(0.5 * (a - c), b), 0.0, None))
 
 
-def _face_features(g: dict, index: np.ndarray, ns: list[int], has_plane: list[bool] | None = None) -> list[dict]:
+def _face_features(g: dict, index: np.ndarray, ns: list[int]) -> list[dict]:
     """Measurements of each face of a grounding result that the calibration may read: the weakest corner's
-    turn in units of its spread (how sure the side count is; on the face's plane where it has one, as the
-    confidence reads it), edge support, image area and shortest side. ``index``: (faces, S) union vertex id of
-    each polygon slot; ``ns``: each face's side count; ``has_plane``: which faces have a plane (default none)."""
+    turn in units of its spread (grounding's ``corner_z``, on the face's plane where it has one: how sure the side
+    count is), edge support, image area and shortest side. ``index``: (faces, S) union vertex id of each polygon
+    slot; ``ns``: each face's side count."""
     nf = len(ns)
     real = np.arange(index.shape[1])[None, :] < np.asarray(ns)[:, None]
-    planar = np.zeros(nf, bool) if has_plane is None else np.asarray(has_plane[:nf], bool)
-    # the minimum over each face's real corners (padding reads +inf)
-    cols = slice(None, index.shape[1])
-    turn_img = 180.0 - g["quantities"]["corner_deg"][:nf, cols]
-    turn_pl = 180.0 - g["quantities"]["corner3d_deg"][:nf, cols]
-    turn = np.where(real, np.where(planar[:, None], turn_pl, turn_img), np.inf)
-    z = np.where(real, g["conf"]["corner_z"][:nf, cols], np.inf)  # grounding's corner test, as p_sides reads it
+    # the minimum over each face's real corners (padding reads +inf); grounding's corner test, as p_sides reads it
+    z = np.where(real, g["conf"]["corner_z"][:nf, :index.shape[1]], np.inf)
     weakest = np.argmin(z, axis=1)
     support = g["conf"]["edge_support"][:nf].tolist()
     out = []
     for i, n in enumerate(ns):
         poly = g["vertices"][index[i, :n]]
-        f = {"sides": n, "min_turn_deg": float(turn[i].min()), "min_turn_z": float(z[i].min()),
+        f = {"sides": n, "min_turn_z": float(z[i].min()),
              "support": support[i], "log_area_px": float(np.log(max(area(poly), 1.0))),
              "min_side_px": _min_side(poly), "faces": nf}
         if n > 3:
             # the same measurements of the polygon without its weakest corner: what a (sides - 1) fact reads
             k = weakest[i]
-            f["fewer"] = {**f, "sides": n - 1, "min_turn_deg": float(np.delete(turn[i], k).min()),
-                          "min_turn_z": float(np.delete(z[i], k).min()),
+            f["fewer"] = {**f, "sides": n - 1, "min_turn_z": float(np.delete(z[i], k).min()),
                           "min_side_px": _min_side(np.delete(poly, k, 0))}
         out.append(f)
     return out

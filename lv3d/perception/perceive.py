@@ -341,16 +341,16 @@ def _turned_apart(o: DepthObjectResult, a: int, b: int) -> bool:
     return angle_deg(o.planes[a].plane, o.planes[b].plane) >= _DISTINCT_PLANE_DEG
 
 
+# a colour outline that strays over an edge takes in a few per cent of the next plane's cells (up to ~15% on dev
+# seed 4343); one that went on across a faint edge, a third of it (a pentagonal prism's top taking in its end)
+_SWALLOWED_FRACTION = 0.25
+
+
 def _swallows_plane(poly_px: np.ndarray, own: int, o: DepthObjectResult, plane_px: list[np.ndarray]) -> bool:
     """True when a colour face matched to plane ``own`` also holds a good part (``_SWALLOWED_FRACTION``) of another
     plane that is turned away from it: the colour outline took in part of the next face across a shared edge
     with too little contrast."""
     return any(j != own and _turned_apart(o, j, own) for j in _held(poly_px, plane_px, _SWALLOWED_FRACTION))
-
-
-# a colour outline that strays over an edge takes in a few per cent of the next plane's cells (up to ~15% on dev
-# seed 4343); one that went on across a faint edge, a third of it (a pentagonal prism's top taking in its end)
-_SWALLOWED_FRACTION = 0.25
 
 
 def _spans_planes(poly_px: np.ndarray, o: DepthObjectResult, plane_px: list[np.ndarray]) -> bool:

@@ -86,29 +86,23 @@ def test_face_features_equal_the_per_face_computation():
 
     rng = np.random.default_rng(5)
     f, s, u = 4, 6, 16
-    g = {"quantities": {"corner_deg": rng.uniform(60, 179, (f, s)).astype(np.float32),
-                        "corner3d_deg": rng.uniform(60, 179, (f, s)).astype(np.float32)},
-         "conf": {"edge_support": rng.uniform(0, 1, f).astype(np.float32),
+    g = {"conf": {"edge_support": rng.uniform(0, 1, f).astype(np.float32),
                   "corner_z": rng.uniform(-3, 30, (f, s)).astype(np.float32)},
          "vertices": rng.uniform(0, 400, (u, 2)).astype(np.float32)}
     ns = [3, 6, 4]
-    has_plane = [False, True, False]
     index = rng.integers(0, u, (len(ns), s))
-    got = _face_features(g, index, ns, has_plane)
+    got = _face_features(g, index, ns)
     for i, n in enumerate(ns):
-        # the turn on the plane where the face has one, else in the image; its z as grounding's corner test gives it
-        turn = 180.0 - g["quantities"]["corner3d_deg" if has_plane[i] else "corner_deg"][i, :n]
-        z = g["conf"]["corner_z"][i, :n]
+        z = g["conf"]["corner_z"][i, :n]  # each corner's turn in spreads, as grounding's corner test gives it
         poly = g["vertices"][index[i, :n]]
-        want = {"sides": n, "min_turn_deg": float(turn.min()), "min_turn_z": float(z.min()),
+        want = {"sides": n, "min_turn_z": float(z.min()),
                 "support": float(g["conf"]["edge_support"][i]), "log_area_px": float(np.log(max(area(poly), 1.0))),
                 "min_side_px": float(np.linalg.norm(np.diff(poly, axis=0, append=poly[:1]), axis=1).min()),
                 "faces": len(ns)}
         if n > 3:  # the polygon without its weakest corner (smallest turn in spreads)
             k = int(np.argmin(z))
             rest = np.delete(poly, k, 0)
-            want["fewer"] = {**want, "sides": n - 1, "min_turn_deg": float(np.delete(turn, k).min()),
-                             "min_turn_z": float(np.delete(z, k).min()),
+            want["fewer"] = {**want, "sides": n - 1, "min_turn_z": float(np.delete(z, k).min()),
                              "min_side_px": float(np.linalg.norm(np.diff(rest, axis=0, append=rest[:1]), axis=1).min())}
         assert got[i] == want
 
