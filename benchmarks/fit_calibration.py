@@ -1,18 +1,20 @@
 """Fit the per-(modality, predicate) confidence calibration maps and write grounding/_calibration_table.py.
 
-The table in the tree (docs/grounding.md, "Calibration on perceived scenes"): rgbd refitted in session 20, after
-its edge field took depth's edges around faces depth alone found (``lv3d.describe.edge_field``), on 5600 fresh
-scenes of the same dev seeds as session 19's fit (each 1050-scene set ~3.7 min on one core, two at a time), checked
-on 1470 scenes (seeds 100000+ and 50000+)::
+The table in the tree (docs/grounding.md, "Calibration on perceived scenes"): rgbd refitted in session 21, when
+parallel's maps were offered the side the two faces share, on 9800 fresh scenes of dev seeds (session 20's 5600
+and 4200 more; each 1050-scene set ~2-4 min on one core, two at a time), checked on 3570 scenes (seeds 100000+,
+50000+, 150000+ and 160000+)::
 
     for a in "30000 150 a150" "40000 150 b150" "60000 100 d60000" "70000 100 d70000" "80000 150 e80000" \
-             "90000 150 f90000" "100000 150 chk100000" "50000 60 c60"; do set -- $a
+             "90000 150 f90000" "110000 150 g110000" "120000 150 g120000" "130000 150 g130000" \
+             "140000 150 g140000" "100000 150 chk100000" "50000 60 c60" "150000 150 k150000" \
+             "160000 150 k160000"; do set -- $a
         .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class $2 --modalities rgbd \
             --out out/calib/$3.pkl; done
     .venv/bin/python benchmarks/fit_calibration.py out/calib/{a150,b150,d60000,d70000,e80000,f90000}.pkl \
-        --check out/calib/chk_all.pkl --modalities rgbd
+        out/calib/{g110000,g120000,g130000,g140000}.pkl --check out/calib/chk_all.pkl --modalities rgbd
 
-(chk_all: the rows and scenes of chk100000 and c60 concatenated into one pickle; the fit takes ~20 s). Depth is session 17's, fitted for both
+(chk_all: the rows and scenes of chk100000, c60, k150000 and k160000 concatenated into one pickle; the fit takes ~30 s). Depth is session 17's, fitted for both
 modalities after the dihedral tolerance became 90 +- 7 deg (docs/facts.md) and side counts moved onto the plane:
 3500 scenes, each 1050-scene set ~3.5 min on one core with rgbd and depth, the 420-scene check set ~1.2 min, the fit
 ~20 s:
@@ -28,7 +30,7 @@ the raw probability unchanged, a shift in logit space, Platt scaling (bias + slo
 plus a few face measurements (``FEATURES``) and, for predicates with a tolerance, the measured value in
 tolerances (``tol_frac``); for facts about two faces (``PAIR_PREDS``) also that map plus the length of the side
 the two faces share (``PAIR_FEATURES``), and for parallel (``PLANE_GAP_PREDS``) that map plus how far the two faces
-are from one plane (``PLANE_GAP_FEATURES``). The winner is refitted on all rows (L2-regularised logistic regression,
+are from one plane (``PLANE_GAP_FEATURES``), and that map plus the shared side. The winner is refitted on all rows (L2-regularised logistic regression,
 measurements standardised, the standardisation folded into the coefficients). A map whose slope on
 logit p comes out negative is not used (confidence must grow with the measured probability). Then the
 final map (``FINAL``) of out-of-fold confidences: per modality one isotonic map of every type pooled, one of
@@ -70,7 +72,8 @@ MIN_OWN_FINAL = 50   # fewer rows of either label: a type's own isotonic map wou
 FINAL_REPEATS = 5    # fold draws the final maps are chosen over (_choose_final)
 SUPPORT_PREDS = ("face_of", "adjacent", "object")
 # facts about two faces whose map may also read the side the faces share (0: none, e.g. pyramid laterals
-# touching at the apex); not parallel: ~60 fit rows, and out of sample it made parallel's log loss worse
+# touching at the apex); parallel is offered it beside the plane gap (PLANE_GAP_PREDS): with ~60 fit rows (session
+# 14) it made parallel's log loss worse out of sample, with ~900 (session 21) better
 PAIR_PREDS = SHARED_SIDE_PREDS
 PAIR_FEATURES = ["shared_side_px"]
 # facts about two planes whose map may also read how far the two faces are from one plane: parallel facts that
@@ -160,6 +163,7 @@ def fit_one(rows: list[dict], seed: int = 0):
         cands["platt+measures+shared"] = ["logit_p"] + FEATURES + PAIR_FEATURES + tol
     if rows[0]["pred"] in PLANE_GAP_PREDS:
         cands["platt+measures+gap"] = ["logit_p"] + FEATURES + PLANE_GAP_FEATURES + tol
+        cands["platt+measures+gap+shared"] = ["logit_p"] + FEATURES + PLANE_GAP_FEATURES + PAIR_FEATURES + tol
     if rows[0]["pred"] in SUPPORT_PREDS:  # p is edge support, not a geometric probability: may be ignored
         cands["const"] = []
     losses, oof = {}, {}
