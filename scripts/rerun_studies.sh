@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Rerun every study in experiments/ after a change to lv3d's code, retraining only the lv3d systems:
+# Rerun every study in experiments/ after a change to lv3d's code, retraining only the lv3d systems, and the seed
+# protocol's two replicates (its lv3d systems on data seeds 1 and 2; scripts/pooled_replicates.py pools them):
 # each study's baseline fold files are restored from its committed results.csv first
 # (scripts/restore_baselines.py), then `lv3d experiment run` computes the lv3d folds and rewrites the report.
 # Two studies run at a time (one per core). The seed protocol, learning curve, ablations and few-shot study
@@ -32,7 +33,14 @@ study few_shot "${CACHE[@]}" & study noise_depth; wait
 study noise_color & study noise_occlusion; wait
 study noise_clutter & study noise_lighting; wait
 
+replicate() {  # replicate SEED: the seed protocol's lv3d systems on images of another data seed (no baselines)
+    OMP_NUM_THREADS=1 $LV3D experiment run experiments/seed_protocol.yaml --out "$RUNS/seed_protocol_seed$1" \
+        --set seed="$1" --set "systems=[lv3d-rgb,lv3d-depth,lv3d-rgbd]" > "$RUNS/seed_protocol_seed$1.log" 2>&1
+    echo "$(date +%T) seed_protocol_seed$1: $(grep -a 'fold results computed' "$RUNS/seed_protocol_seed$1.log" | tail -1)"
+}
+replicate 1 & replicate 2; wait
+
 for d in "$RUNS"/*/results.csv; do
     name=$(basename "$(dirname "$d")")
-    echo "cp $RUNS/$name/results.{csv,md} $RUNS/$name/*.png experiments/results/$name/"
+    echo "mkdir -p experiments/results/$name; cp $RUNS/$name/results.{csv,md} $RUNS/$name/*.png experiments/results/$name/"
 done

@@ -23,11 +23,17 @@ def mean_std(values: list[float]) -> tuple[float, float]:
     return float(v.mean()), float(v.std(ddof=1)) if len(v) > 1 else 0.0
 
 
+def _differences(a: list[float], b: list[float]) -> np.ndarray:
+    """a - b, rounded to 12 decimals: accuracies are fractions of a test set, and float subtraction leaves noise
+    (0.975 - 0.95 and 1.0 - 0.975 differ in the 17th digit) that would turn ties into wins and split tied ranks."""
+    return np.round(np.asarray(a, float) - np.asarray(b, float), 12)
+
+
 def sign_test(a: list[float], b: list[float]) -> dict:
     """Exact two-sided sign test of paired values: wins of a, wins of b, ties, p."""
     from scipy.stats import binomtest
 
-    d = np.asarray(a, float) - np.asarray(b, float)
+    d = _differences(a, b)
     wins, losses = int((d > 0).sum()), int((d < 0).sum())
     n = wins + losses
     p = 1.0 if n == 0 else float(binomtest(wins, n, 0.5, alternative="two-sided").pvalue)
@@ -38,7 +44,7 @@ def wilcoxon_test(a: list[float], b: list[float]) -> dict:
     """Wilcoxon signed-rank test of paired values (zero differences dropped): statistic, n, p."""
     from scipy.stats import wilcoxon
 
-    d = np.asarray(a, float) - np.asarray(b, float)
+    d = _differences(a, b)
     nz = d[d != 0]
     if len(nz) == 0:
         return {"n": 0, "statistic": float("nan"), "p": 1.0}

@@ -23,6 +23,9 @@ from .rgb import RGBFace, rgb_faces
 from .support import noise_threshold
 
 _CROP_MARGIN_PX = 14
+# a colour face with as many corners as its plane's depth outline, which leaves out this much of that outline
+# where no other colour face lies, traced only part of the face: the depth outline is kept (session 21)
+_PART_LEFT_OUT = 0.25
 
 
 def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 0) -> Scene:
@@ -163,11 +166,9 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
                       and _swallows_plane(poly_px[mine[a]], m, o, plane_px)
                       and fit_face_plane(res.faces[mine[a]].polygon, dres.grid, seed=k) is None}
         swallowing_px = {a: rasterize(poly - off, shape) for a, poly in swallowing.items()}
-        colour_px = np.zeros(shape, bool)
-        for a, i in enumerate(mine):
-            colour_px |= swallowing_px.get(a, poly_px[i])
         matched_poly = {a: swallowing[a] if a in swallowing else
-                        _matched_polygon(res.faces[mine[a]].polygon, m, o, poly_px[mine[a]], off, dres, colour_px,
+                        _matched_polygon(res.faces[mine[a]].polygon, m, o, poly_px[mine[a]], off, dres,
+                                         _off_plane_px(mine, poly_px, swallowing_px, plane_px[m], shape),
                                          seed=k) for a, m in match.items()}
         matched_px = np.zeros(shape, bool)  # the pixels that colour faces matched to a plane explain
         for a, poly in matched_poly.items():
@@ -308,17 +309,19 @@ def _matched_polygon(colour: np.ndarray, j: int, o: DepthObjectResult, colour_px
                      dres: DepthResult, all_colour_px: np.ndarray, seed: int) -> np.ndarray:
     """The polygon of a colour face matched to plane ``j`` (one that swallowed another plane takes the depth one
     before this is asked): see :func:`_pick_polygon`; the colour one when the depth outline reaches over the
-    other colour faces (``all_colour_px``: their pixels, with this face's own ``colour_px``, over the crop;
-    the depth outline in place of a swallowing face's)."""
+    other colour faces (``all_colour_px``: the pixels over the crop of the colour faces not on plane ``j``,
+    :func:`_off_plane_px`)."""
     depth = o.polygons[j]
     if depth is None:
-        return colour
-    if len(depth) == len(colour):
         return colour
     dm = rasterize(depth - off, colour_px.shape)
     beyond = dm & ~colour_px
     if np.count_nonzero(beyond) >= 0.1 * max(1, np.count_nonzero(dm)) and _inside(beyond, all_colour_px) >= 0.5:
         return colour
+    if len(depth) == len(colour):
+        # as many corners, but the colour outline leaves out part of the plane's outline that no other colour face
+        # holds: colour lost an edge inside the face (a shadow or shading line) and traced part of it
+        return depth if np.count_nonzero(beyond) >= _PART_LEFT_OUT * max(1, np.count_nonzero(dm)) else colour
     if len(colour) > len(depth):
         # more colour corners: the depth outline may have lost a corner region of a face seen obliquely (its
         # mask thins out there); the colour one is right when it holds the depth one and is all on its plane
@@ -328,6 +331,20 @@ def _matched_polygon(colour: np.ndarray, j: int, o: DepthObjectResult, colour_px
                 angle_deg(fit[0], o.planes[j].plane) < _SAME_PLANE_DEG:
             return colour
     return _pick_polygon(colour, depth, colour_px, off)
+
+
+def _off_plane_px(mine: list[int], poly_px: list[np.ndarray], swallowing_px: dict[int, np.ndarray],
+                  plane: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """The pixels of the colour faces ``mine`` (a swallowing face's depth outline in place of its own) that do not
+    lie mostly on the plane of pixels ``plane``: the faces that may explain where that plane's depth outline
+    reaches beyond the colour face matched to it. A colour face mostly on the same plane is a piece of that face
+    (cut off by a shadow or a shading line), not a neighbour."""
+    out = np.zeros(shape, bool)
+    for a, i in enumerate(mine):
+        px = swallowing_px.get(a, poly_px[i])
+        if _inside(px, plane) < 0.5:
+            out |= px
+    return out
 
 
 def _held(poly_px: np.ndarray, plane_px: list[np.ndarray], fraction: float) -> list[int]:

@@ -102,3 +102,28 @@ def test_a_diagonal_within_a_blurred_edge_of_the_outline_has_no_strength_measure
     shallow, across = _mean_clear_of_outline(2, *samples, clear_px=2.5)
     assert shallow == 0.0 and across < 5.0
     assert _mean_clear_of_outline(2, *samples, clear_px=1.0)[0] > 50.0
+
+
+def test_a_colour_face_that_traced_part_of_its_plane_takes_the_depth_outline():
+    # dev scene (seed 4242, realsense): a pentagonal prism's end face cut in two by a shading line; the colour face
+    # matched to the plane holds half of it, the other half is a colour face on the same plane
+    from types import SimpleNamespace
+
+    from lv3d.perception.perceive import _matched_polygon, _off_plane_px
+    from lv3d.perception.polygons import rasterize
+
+    off, shape = np.zeros(2), (100, 100)
+    square = np.array([[10.0, 10.0], [90.0, 10.0], [90.0, 90.0], [10.0, 90.0]])  # the plane's depth outline
+    upper = np.array([[10.0, 10.0], [90.0, 10.0], [90.0, 50.0], [10.0, 50.0]])
+    lower = np.array([[10.0, 50.0], [90.0, 50.0], [90.0, 90.0], [10.0, 90.0]])
+    o = SimpleNamespace(polygons=[square])
+    px = [rasterize(upper, shape), rasterize(lower, shape)]
+    plane = rasterize(square, shape)
+    others = _off_plane_px([0, 1], px, {}, plane, shape)
+    assert not others.any()  # both halves lie on the plane: pieces of one face, not neighbours
+    assert _matched_polygon(upper, 0, o, px[0], off, None, others, seed=0) is square
+    # the other half on another plane (a neighbour face the depth outline reached over): colour's outline stays
+    assert _matched_polygon(upper, 0, o, px[0], off, None, px[1], seed=0) is upper
+    # the colour face holds nearly all of the outline: colour's sharper corners stay
+    most = np.array([[10.0, 10.0], [90.0, 10.0], [90.0, 85.0], [10.0, 85.0]])
+    assert _matched_polygon(most, 0, o, rasterize(most, shape), off, None, others, seed=0) is most
