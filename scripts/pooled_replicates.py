@@ -47,8 +47,8 @@ def main(argv=None) -> int:
         if not a or not b:
             raise SystemExit(f"{run}: no class-task rows of {args.a if not a else args.b}")
         for key in sorted(a.keys() & b.keys()):
-            pairs[key[0]][0].append(round(100 * a[key], 6))
-            pairs[key[0]][1].append(round(100 * b[key], 6))
+            pairs[key[0]][0].append(100 * a[key])  # stats rounds the differences
+            pairs[key[0]][1].append(100 * b[key])
     for cond, (a, b) in sorted(pairs.items()):
         t = paired(a, b)
         print(f"{cond}: {args.a} - {args.b} over {len(a)} cells of {len(args.runs)} runs: {t['mean_diff']:+.2f} points "
