@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .background import background_faces, chromaticity, face_chromaticity
+from .background import background_faces, chromaticity, face_chromaticity, log_gradient, smooth_faces
 from .edges import channel_edges, channels, edge_distance, edge_support
 from .faces import bounded_faces, build_graph
 from .gaps import close_gaps
@@ -108,7 +108,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     traced whole is cut along a faint straight edge from one of its corners (step_edge.step_cut): most colour-only
     misses on noisy renders are corners the segments stop short of and two faces of one colour traced as one. Faces
     of the colour of the image's border (floor texture, shadows, painted lines) are then dropped
-    (background.background_faces): most false colour-only faces on noisy renders are such. With depth (rgbd), the
+    (background.background_faces): most false colour-only faces on noisy renders are such; those much smoother than
+    the floor of their hue are kept (background.smooth_faces: an object of the table's hue). With depth (rgbd), the
     planes find and part such faces; cut there too, the colour part that keeps a thin neighbour's strip outvotes
     that neighbour's plane (realsense rgbd recall fell by one face on dev seeds 1000 and 2000)."""
     import time
@@ -196,6 +197,9 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     if colour_alone and cands:
         hues = [face_chromaticity(np.asarray(c[0], np.float64), chroma) for c in cands]
         bg = background_faces(hues, chroma)
+        if any(bg):  # unless a face is much smoother than the floor of its hue: an object of the floor's hue
+            smooth = smooth_faces([c[0] for c in cands], hues, bg, chroma, log_gradient(crop))
+            bg = [b and not s for b, s in zip(bg, smooth)]
         cands, hues = [c for c, b in zip(cands, bg) if not b], [h for h, b in zip(hues, bg) if not b]
     faces = [(RGBFace(p + np.array([u0, v0], float), e, s, a), hue) for (p, e, s, a), hue in zip(cands, hues)]
     faces.sort(key=lambda fh: (-fh[0].area_px, float(fh[0].polygon[0, 0]), float(fh[0].polygon[0, 1])))

@@ -1,6 +1,8 @@
 import numpy as np
 
-from lv3d.perception.background import background_faces, border_chromaticity, chromaticity, face_chromaticity
+from lv3d.perception.background import (background_faces, border_chromaticity, chromaticity, face_chromaticity,
+                                        log_gradient, smooth_faces)
+from lv3d.perception.polygons import rasterize
 from lv3d.perception.rgb import rgb_faces
 
 FLOOR = np.array([200.0, 140.0, 90.0])    # sandy floor
@@ -46,3 +48,35 @@ def test_colour_alone_drops_the_shadow_beside_a_solid():
     faces = rgb_faces(img, colour_alone=True).faces
     assert not shadow_found(faces)
     assert any(abs(f.area_px - 80 * 80) < 300 for f in faces)
+
+
+def _grained(seed: int = 0) -> np.ndarray:
+    """200 x 200: a plain square of the floor's own hue (a little brighter) on a floor with wood grain, and a
+    shadow on that floor (its grain goes on under it)."""
+    u, v = np.meshgrid(np.arange(200), np.arange(200))
+    grain = 1.0 - 0.2 * (0.5 + 0.5 * np.sin(2 * np.pi * (v + 4 * np.sin(u / 9.0)) / 11.0))
+    img = FLOOR[None, None, :] * grain[..., None]
+    img[50:130, 50:130] = 1.1 * FLOOR
+    in_shadow = (u >= 130) & (u < 175) & (v >= 70) & (v < 130)
+    img[in_shadow] *= 0.45
+    return np.clip(img, 0, 255).astype(np.uint8)
+
+
+def test_a_plain_face_of_the_floors_hue_is_told_from_the_floor_by_its_texture():
+    img = _grained()
+    chroma = chromaticity(img)
+    shadow = np.array([[130.0, 70.0], [175.0, 70.0], [175.0, 130.0], [130.0, 130.0]])
+    polys = [SQUARE, shadow]
+    hues = [face_chromaticity(p, chroma) for p in polys]
+    assert background_faces(hues, chroma) == [True, True]  # both of the floor's hue
+    smooth = smooth_faces(polys, hues, [True, True], chroma, log_gradient(img))
+    assert smooth == [True, False]
+    # a face not asked about is not judged
+    assert smooth_faces(polys, hues, [False, False], chroma, log_gradient(img)) == [False, False]
+
+
+def test_colour_alone_keeps_a_solid_of_the_floors_hue():
+    square = rasterize(SQUARE, (200, 200))
+    ious = [np.count_nonzero(square & m) / np.count_nonzero(square | m)
+            for m in (rasterize(f.polygon, (200, 200)) for f in rgb_faces(_grained(), colour_alone=True).faces)]
+    assert max(ious, default=0.0) >= 0.8
