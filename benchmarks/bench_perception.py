@@ -63,8 +63,8 @@ def evaluate(scene, frame, faces_mask, min_face_px: int) -> dict:
     reads = np.isfinite(frame.depth) & (frame.depth > 0)
     read = {g["id"]: np.count_nonzero(gt_masks[g["id"]] & reads) >= _READ_SHARE * np.count_nonzero(gt_masks[g["id"]])
             for g in gt}
-    out = {"gt_faces": len(gt), "gt_read": sum(read.values()), "found_read": 0, "found": 0, "det_faces": 0, "det_ok": 0, "sides_ok": 0, "vertex_err": [],
-           "normal_err": [], "dihedral_err": [], "target_hit": 0}
+    out = {"gt_faces": len(gt), "gt_read": sum(read.values()), "found_read": 0, "found": 0, "det_faces": 0,
+           "det_ok": 0, "sides_ok": 0, "vertex_err": [], "normal_err": [], "dihedral_err": [], "target_hit": 0}
     if best_obj is None:
         return out
     t = scene.target()

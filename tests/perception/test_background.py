@@ -50,7 +50,7 @@ def test_colour_alone_drops_the_shadow_beside_a_solid():
     assert any(abs(f.area_px - 80 * 80) < 300 for f in faces)
 
 
-def _grained(seed: int = 0) -> np.ndarray:
+def _grained() -> np.ndarray:
     """200 x 200: a plain square of the floor's own hue (a little brighter) on a floor with wood grain, and a
     shadow on that floor (its grain goes on under it)."""
     u, v = np.meshgrid(np.arange(200), np.arange(200))
