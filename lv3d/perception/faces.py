@@ -111,7 +111,54 @@ def build_graph(segs: np.ndarray, reach_px: float = 10.0, rel_reach: float = 0.3
         if va != vb:
             edges.add((min(va, vb), max(va, vb)))
     e = np.array(sorted(edges), dtype=int).reshape(-1, 2)
-    return prune(PlanarGraph(vertices, e))
+    return prune(planarize(PlanarGraph(vertices, e)))
+
+
+def planarize(g: PlanarGraph, snap_px: float = 0.5) -> PlanarGraph:
+    """``g`` with every pair of edges that cross (each through the other's interior, no shared vertex) split at
+    their crossing, a new vertex there (or the existing end within ``snap_px`` of it). The junction rules join
+    each segment's junctions in order along it, so two segments whose junctions interleave (overlapping pieces of
+    an edge around an obtuse corner, realsense blur) give edges that cross; the face walk (:func:`bounded_faces`)
+    holds only for a planar embedding, and on a crossing it traces no face or a wrong one."""
+    v, e = g.vertices, g.edges
+    if len(e) < 2:
+        return g
+    p, q = v[e[:, 0]], v[e[:, 1]]
+    d = q - p
+    # edge a from p_a along d_a, edge b from p_b along d_b: p_a + s d_a = p_b + t d_b
+    den = d[:, None, 0] * d[None, :, 1] - d[:, None, 1] * d[None, :, 0]
+    rx = p[None, :, 0] - p[:, None, 0]
+    ry = p[None, :, 1] - p[:, None, 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = (rx * d[None, :, 1] - ry * d[None, :, 0]) / den
+        t = (rx * d[:, None, 1] - ry * d[:, None, 0]) / den
+    shared = (e[:, None, 0] == e[None, :, 0]) | (e[:, None, 0] == e[None, :, 1]) | \
+             (e[:, None, 1] == e[None, :, 0]) | (e[:, None, 1] == e[None, :, 1])
+    eps = 1e-9
+    cross = (np.abs(den) > eps) & ~shared & (s > eps) & (s < 1 - eps) & (t > eps) & (t < 1 - eps)
+    ii, jj = np.nonzero(np.triu(cross, 1))
+    if len(ii) == 0:
+        return g
+    verts = [tuple(x) for x in v]
+    cuts: dict[int, list[tuple[float, int]]] = {}
+    for a, b in zip(ii.tolist(), jj.tolist()):
+        x = p[a] + s[a, b] * d[a]
+        near = np.hypot(*(v[[e[a, 0], e[a, 1], e[b, 0], e[b, 1]]] - x).T)
+        k = int(np.argmin(near))
+        if near[k] <= snap_px:
+            vid = int([e[a, 0], e[a, 1], e[b, 0], e[b, 1]][k])
+        else:
+            vid = len(verts)
+            verts.append((float(x[0]), float(x[1])))
+        cuts.setdefault(a, []).append((float(s[a, b]), vid))
+        cuts.setdefault(b, []).append((float(t[a, b]), vid))
+    out = set()
+    for k, (a, b) in enumerate(e.tolist()):
+        chain = [a] + [vid for _, vid in sorted(cuts.get(k, []))] + [b]
+        for x, y in zip(chain, chain[1:]):
+            if x != y:
+                out.add((min(x, y), max(x, y)))
+    return PlanarGraph(np.array(verts, float), np.array(sorted(out), dtype=int).reshape(-1, 2))
 
 
 def _far_meetings(p0: np.ndarray, u: np.ndarray, length: np.ndarray, s: np.ndarray, t: np.ndarray,

@@ -1,6 +1,7 @@
 import numpy as np
 
-from lv3d.perception.faces import bounded_faces, build_graph
+from lv3d.perception.faces import PlanarGraph, bounded_faces, build_graph, planarize, prune
+from lv3d.perception.polygons import signed_area
 from lv3d.perception.segments import merge_collinear, union_find_labels
 
 
@@ -99,3 +100,31 @@ def test_parallel_pieces_further_apart_than_the_overlap_tolerance_stay_apart():
     segs = np.array([[13, 10, 97, 10], [100, 13, 100, 97], [97, 100, 13, 100],
                      [10, 13, 10, 70], [13, 50, 13, 97]], float)
     assert bounded_faces(build_graph(segs)) == []
+
+
+def test_crossing_edges_are_split_where_they_cross():
+    # a square with both diagonals: four triangles, whose common corner is the crossing
+    v = np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)
+    e = np.array([[0, 1], [1, 2], [2, 3], [0, 3], [0, 2], [1, 3]])
+    g = planarize(PlanarGraph(v, e))
+    assert len(g.vertices) == 5
+    np.testing.assert_allclose(g.vertices[4], [5.0, 5.0])
+    faces = bounded_faces(g)
+    assert len(faces) == 4
+    assert all(len(f.cycle) == 3 for f in faces)
+    np.testing.assert_allclose(sorted(abs(signed_area(f.polygon)) for f in faces), [25.0] * 4)
+    # edges that only share a corner, or touch end to end, are left as they are
+    tri = PlanarGraph(v[:3], np.array([[0, 1], [1, 2], [0, 2]]))
+    assert planarize(tri) is tri
+
+
+def test_a_hexagon_whose_graph_edges_cross_at_an_obtuse_corner_is_still_a_face():
+    # the junction graph of a cuboid's silhouette on a clean render (dev seed 3003): at the right, the edges of two
+    # overlapping pieces around an obtuse corner cross; unsplit, the face walk found no bounded face
+    v = np.array([[268, 242], [266, 178], [272, 276], [358, 172], [362, 200], [367, 247], [364, 270], [367, 233]],
+                 float)
+    e = np.array([[0, 1], [0, 2], [1, 3], [2, 6], [3, 4], [4, 5], [4, 7], [5, 7], [6, 7]])
+    assert bounded_faces(prune(PlanarGraph(v, e))) == []
+    faces = bounded_faces(prune(planarize(PlanarGraph(v, e))))
+    big = max(faces, key=lambda f: signed_area(f.polygon))
+    assert signed_area(big.polygon) > 0.95 * 92 * 98
