@@ -16,6 +16,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from .polygons import rasterize
+
 
 def chromaticity(color: np.ndarray) -> np.ndarray:
     """(H, W, 2) float32: the red and green share of each pixel of ``color`` (H, W, 3) uint8 RGB in its sum."""
@@ -66,14 +68,13 @@ def smooth_faces(polys: list[np.ndarray], hues: list[np.ndarray], which: list[bo
     ``realsense``, where image noise makes both alike and nothing is rescued."""
     h, w = chroma.shape[:2]
     k = np.ones((2 * erode_px + 1, 2 * erode_px + 1), np.uint8)
-    on_faces = np.zeros((h, w), np.uint8)
+    on_faces = np.zeros((h, w), bool)
     masks = []
     for p, want in zip(polys, which):
-        m = np.zeros((h, w), np.uint8)
-        cv2.fillPoly(m, [np.round(p).astype(np.int32)], 1)
+        m = rasterize(p, (h, w))
         on_faces |= m
-        masks.append(cv2.erode(m, k).astype(bool) if want else None)
-    free = ~cv2.dilate(on_faces, k).astype(bool)
+        masks.append(cv2.erode(m.view(np.uint8), k).view(bool) if want else None)
+    free = ~cv2.dilate(on_faces.view(np.uint8), k).view(bool)
     out = []
     for m, c in zip(masks, hues):
         if m is None or np.count_nonzero(m) < min_px or not np.isfinite(c).all():

@@ -57,13 +57,7 @@ def build_graph(segs: np.ndarray, reach_px: float = 10.0, rel_reach: float = 0.3
     length = np.hypot(d[:, 0], d[:, 1])
     u = d / length[:, None]
     reach = np.minimum(reach_px, rel_reach * length)
-    # line crossing of i and j: p0_i + s u_i = p0_j + t u_j
-    cross = u[:, None, 0] * u[None, :, 1] - u[:, None, 1] * u[None, :, 0]
-    dx = p0[None, :, 0] - p0[:, None, 0]
-    dy = p0[None, :, 1] - p0[:, None, 1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = (dx * u[None, :, 1] - dy * u[None, :, 0]) / cross
-        t = (dx * u[:, None, 1] - dy * u[:, None, 0]) / cross
+    cross, s, t = _line_crossings(p0, u)  # s, t in pixels along the unit directions
     apart = np.abs(cross) >= np.sin(np.radians(min_angle_deg))
     ok_i = (s >= -reach[:, None]) & (s <= length[:, None] + reach[:, None])
     ok_j = (t >= -reach[None, :]) & (t <= length[None, :] + reach[None, :])
@@ -114,6 +108,19 @@ def build_graph(segs: np.ndarray, reach_px: float = 10.0, rel_reach: float = 0.3
     return prune(planarize(PlanarGraph(vertices, e)))
 
 
+def _line_crossings(p0: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where lines ``p0[i] + s d[i]`` (p0, d: (n, 2)) cross: (cross, s, t), each (n, n), with
+    ``p0[i] + s[i, j] d[i] = p0[j] + t[i, j] d[j]`` and ``cross[i, j]`` = d[i] x d[j] (0 for parallel lines, whose
+    s and t are then inf or nan)."""
+    cross = d[:, None, 0] * d[None, :, 1] - d[:, None, 1] * d[None, :, 0]
+    dx = p0[None, :, 0] - p0[:, None, 0]
+    dy = p0[None, :, 1] - p0[:, None, 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = (dx * d[None, :, 1] - dy * d[None, :, 0]) / cross
+        t = (dx * d[:, None, 1] - dy * d[:, None, 0]) / cross
+    return cross, s, t
+
+
 def planarize(g: PlanarGraph, snap_px: float = 0.5) -> PlanarGraph:
     """``g`` with every pair of edges that cross (each through the other's interior, no shared vertex) split at
     their crossing, a new vertex there (or the existing end within ``snap_px`` of it). The junction rules join
@@ -125,13 +132,7 @@ def planarize(g: PlanarGraph, snap_px: float = 0.5) -> PlanarGraph:
         return g
     p, q = v[e[:, 0]], v[e[:, 1]]
     d = q - p
-    # edge a from p_a along d_a, edge b from p_b along d_b: p_a + s d_a = p_b + t d_b
-    den = d[:, None, 0] * d[None, :, 1] - d[:, None, 1] * d[None, :, 0]
-    rx = p[None, :, 0] - p[:, None, 0]
-    ry = p[None, :, 1] - p[:, None, 1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = (rx * d[None, :, 1] - ry * d[None, :, 0]) / den
-        t = (rx * d[:, None, 1] - ry * d[:, None, 0]) / den
+    den, s, t = _line_crossings(p, d)  # s, t as fractions of each edge
     shared = (e[:, None, 0] == e[None, :, 0]) | (e[:, None, 0] == e[None, :, 1]) | \
              (e[:, None, 1] == e[None, :, 0]) | (e[:, None, 1] == e[None, :, 1])
     eps = 1e-9
