@@ -66,3 +66,32 @@ def test_traced_part_keeps_the_traced_bends_between_outline_corners():
             assert len(part) == 4 and any(np.allclose(v, bend) for v in part)
         else:
             np.testing.assert_allclose(part, q)
+
+
+def test_a_faint_edge_inside_a_concave_outline_is_cut_before_the_outline_is_split():
+    # a box's top and front faces of one colour, 4 grey levels apart, and its dark left face: the graph traces top and
+    # front as one concave outline, and their faint edge runs from its reflex corner (80, 80) to a point of its right
+    # side, not to a corner, where no corner-to-corner cut can follow it (split_concave cut the diagonal (80, 80) to
+    # (160, 30) before)
+    img = np.full((240, 320, 3), (120, 80, 50), np.uint8)
+    top = np.array([(40, 30), (160, 30), (160, 80), (80, 80), (40, 80)])
+    front = np.array([(80, 80), (160, 80), (160, 170), (80, 170)])
+    left = np.array([(40, 80), (80, 80), (80, 170), (40, 170)])
+    for poly, colour in ((top, (192, 202, 142)), (front, (188, 198, 138)), (left, (93, 99, 69))):
+        cv2.fillPoly(img, [poly.astype(np.int32)], colour)
+
+    def best_iou(res, poly):
+        want = np.zeros(img.shape[:2], np.uint8)
+        cv2.fillPoly(want, [poly.astype(np.int32)], 1)
+        ious = []
+        for f in res.faces:
+            got = np.zeros_like(want)
+            cv2.fillPoly(got, [np.round(f.polygon).astype(np.int32)], 1)
+            ious.append(np.count_nonzero(got & want) / np.count_nonzero(got | want))
+        return max(ious, default=0.0)
+
+    res = rgb_faces(img, colour_alone=True)
+    assert min(best_iou(res, p) for p in (top, front, left)) > 0.9
+    # with no step between top and front no cut is made along their line
+    cv2.fillPoly(img, [front.astype(np.int32)], (192, 202, 142))
+    assert best_iou(rgb_faces(img, colour_alone=True), top) < 0.8
