@@ -34,7 +34,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.calibration_error import chance_ece, ece, log_loss, reliability_bins, scene_interval  # noqa: E402
+from benchmarks.calibration_error import ECE_TARGET, chance_ece, ece, log_loss, reliability_bins, scene_interval  # noqa: E402
 from benchmarks.grounding_truth import match_faces, truth_labels, truth_quantities, truth_scene  # noqa: E402
 from lv3d.describe import MIN_CONF, ground  # noqa: E402
 from lv3d.perception import perceive  # noqa: E402
@@ -43,7 +43,6 @@ from lv3d.render import render_scene  # noqa: E402
 CLASSES = ["cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
            "tetrahedron"]
 CUT_TARGET = 0.30      # refinement cuts vertex and dihedral error by at least this at realsense
-ECE_TARGET = 0.05
 FRAME_MS_TARGET = 20.0
 FIRST_CALL_S_TARGET = 2.0
 DEBUG = bool(os.environ.get("BENCH_DEBUG"))

@@ -1,6 +1,7 @@
 import cv2
 import numpy as np
 
+from lv3d.perception.polygons import rasterize
 from lv3d.perception.rgb import rgb_faces
 
 
@@ -81,13 +82,9 @@ def test_a_faint_edge_inside_a_concave_outline_is_cut_before_the_outline_is_spli
         cv2.fillPoly(img, [poly.astype(np.int32)], colour)
 
     def best_iou(res, poly):
-        want = np.zeros(img.shape[:2], np.uint8)
-        cv2.fillPoly(want, [poly.astype(np.int32)], 1)
-        ious = []
-        for f in res.faces:
-            got = np.zeros_like(want)
-            cv2.fillPoly(got, [np.round(f.polygon).astype(np.int32)], 1)
-            ious.append(np.count_nonzero(got & want) / np.count_nonzero(got | want))
+        want = rasterize(poly, img.shape[:2])
+        ious = [np.count_nonzero(got & want) / np.count_nonzero(got | want)
+                for got in (rasterize(f.polygon, img.shape[:2]) for f in res.faces)]
         return max(ious, default=0.0)
 
     res = rgb_faces(img, colour_alone=True)
