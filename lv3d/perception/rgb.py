@@ -18,7 +18,7 @@ from .polygons import (area, clockwise, drop_short_sides, is_simple, mean_width,
 from .segments import detect_color_segments, union_find_labels
 from .silhouette import foreground, regions_of, silhouette_segments
 from .split import reflex_corners, split_by_diagonal, split_concave
-from .step_edge import smoothed_gradients, step_cut
+from .step_edge import fork_cut, smoothed_gradients, step_cut, step_lines
 from .thin import thin_faces
 
 
@@ -106,7 +106,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     never neighbours (the graph joins solids that nearly touch or overlap; a solid is taken to be of one colour, so
     a printed carton comes out as one object per colour: _same_solid), and a kept face whose outline the graph
     traced whole, or a concave traced outline before it is split, is cut along a faint straight edge from one of its
-    corners (step_edge.step_cut): most colour-only
+    corners (step_edge.step_cut), and a convex one that no such line cuts is cut at a fork of three faint edges from
+    three of its corners (step_edge.fork_cut: a solid showing three faces of one colour): most colour-only
     misses on noisy renders are corners the segments stop short of and two faces of one colour traced as one. Faces
     of the colour of the image's border (floor texture, shadows, painted lines) are then dropped
     (background.background_faces): most false colour-only faces on noisy renders are such; those much smoother than
@@ -141,6 +142,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     # count as neighbours), or a thin face's contact with the faces beside it (_thin_cands)
     made_up = ((k, k) for k in itertools.count(-1, -1))
     image_cuts = set()  # made-up keys of cuts along an image edge (split_by_diagonal, step_cut): never joined back
+    measured = {}  # index in cands -> step_edge.StepLines of a whole traced face, when measured already
     for f in bounded_faces(g):
         traced_area = area(f.polygon)
         if traced_area < min_area_px or traced_area > max_area_frac * w * h:
@@ -159,19 +161,21 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         # Canny's gradient, which the faint edge is under. Stricter than step_cut on whole faces (a step 10 times its
         # control, 12 clear samples: a short edge ending on a side keeps few); the parts, their corners found again,
         # are then split as before (docs/perception.md, session 23)
-        stepped = step_cut(poly, sgrads, min_area_px, rel_step=10.0, min_samples=12) \
-            if colour_alone and reflex_corners(poly) else None
+        lines = step_lines(poly, sgrads) if colour_alone and reflex_corners(poly) else None
+        stepped = step_cut(poly, sgrads, min_area_px, rel_step=10.0, min_samples=12, lines=lines) \
+            if lines is not None else None
         pieces = [q for part in (map(_outline, stepped) if stepped else [poly])
                   for q in split_concave(part, grad, min_area_px)]
-        by_gradient = stepped is not None or len(pieces) == 1
+        image_cut = stepped is not None or len(pieces) == 1
         if len(pieces) == 1:
             pieces = split_by_diagonal(poly, grad, min_area_px)
         if len(pieces) == 1:
+            measured[len(cands)] = lines  # step_cut tests these lines again below, as a whole face
             cands.append((poly, f.edges, sup, a, True))
             continue
         # the cut is an edge the graph lacks: a shared made-up edge key makes the parts neighbours
         cut = next(made_up)
-        if by_gradient:
+        if image_cut:
             image_cuts.add(cut)
         # split_by_diagonal may cut a non-convex outline across a notch: the part cut off lies outside the traced
         # face, its traced vertices are the notch's, and the parts do not tile the outline
@@ -186,12 +190,14 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     region = [any(j != i and cands[j][3] < cands[i][3] and _contains(cands[i][0], cands[j][0])
                   for j in range(len(cands))) for i in range(len(cands))]
     kept = []
-    for (poly, es, sup, a, whole), around in zip(cands, region):
+    for i, ((poly, es, sup, a, whole), around) in enumerate(zip(cands, region)):
         if around:
             continue
         parts = None
         if colour_alone and whole:
-            parts = step_cut(poly, sgrads, min_area_px)
+            parts = step_cut(poly, sgrads, min_area_px, lines=measured.get(i))
+            if parts is None:
+                parts = fork_cut(poly, sgrads, min_area_px)
         if parts is None:
             kept.append((poly, es, sup, a))
             continue

@@ -1,14 +1,19 @@
-"""A faint straight edge inside a traced colour face: the line from one of its corners to a point of its outline
-across which the smoothed colour steps, found by the mean signed step along the line (sensor noise averages out
-over its length, while a mean gradient magnitude keeps it) against the same step on the lines shifted off it to
-either side (texture and shading vary smoothly, so they step there as much)."""
+"""Faint straight edges inside a traced colour face: the line from one of its corners to a point of its outline (or
+three lines from three corners to one point inside: a fork) across which the smoothed colour steps, found by the
+mean signed step along the line (sensor noise averages out over its length, while a mean gradient magnitude keeps
+it) against the same step on the lines shifted off it to either side (texture and shading vary smoothly, so they
+step there as much)."""
 
 from __future__ import annotations
+
+import itertools
+from typing import NamedTuple
 
 import cv2
 import numpy as np
 
 from .polygons import area
+from .split import reflex_corners
 
 
 def smoothed_gradients(chans: list[np.ndarray], sigma_px: float = 1.0) -> np.ndarray:
@@ -79,22 +84,25 @@ def _depth_inside(p: np.ndarray, pts: np.ndarray) -> np.ndarray:
     return depth[np.clip(q[:, 1], 0, h - 1), np.clip(q[:, 0], 0, w - 1)]
 
 
-def step_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: float = 6.0,
-             min_step: float = 1.0, rel_step: float = 3.0, min_samples: int = 15, step_px: float = 2.0,
-             sample_px: float = 2.0, trim_px: float = 3.0, sigma_px: float = 1.0) -> list[np.ndarray] | None:
-    """The two parts of ``poly`` (n, 2, pixels) cut along the line from a corner to a point of a side not at that
-    corner, where the colour steps across it, or None. ``grads``: :func:`smoothed_gradients` (blurred by
-    ``sigma_px``) in the polygon's pixel frame. A line's step is, per channel, the mean derivative across it over
-    its samples (every ``sample_px``, ``trim_px`` left out at each end) lying ``shift_px`` + 2 ``sigma_px`` + 1 px
-    or more inside the outline, so that the outline's own edge and the shifted lines stay out; its control is the
-    largest such step on the line shifted ``shift_px`` to either side. A cut needs at least ``min_samples`` clear
-    samples, a step (largest over the channels) of at least ``min_step`` grey levels per pixel and ``rel_step``
-    times its control, and parts of at least ``min_area_px``. Of the lines that pass, the one whose step exceeds
-    ``rel_step`` times its control by most is taken. On realsense renders (dev seeds 1000-1004, true outlines), the
-    colour difference 2 px to either side of the faint edge between two faces of one colour was about 4 times that 6
-    px off where the edge could be seen at all (cube 1004's top and front, 8.6 grey levels; a pentagonal prism's top
-    and side, 10); of nine such edges, five stood out 2.2 times or less. Clean renders gain too (a thin top face
-    whose edge is faint)."""
+class StepLines(NamedTuple):
+    """The lines :func:`step_cut` tries on one outline, measured once for any of its tests: each line runs from
+    corner ``corner`` (k,) to outline point ``point`` (k,) (of ``points`` (m, 2), lying on side ``side`` (m,)),
+    ``length`` (k,) px long, with its clear ``samples`` (k,), ``peak`` step (k,) and ``control`` (k,)."""
+
+    points: np.ndarray
+    side: np.ndarray
+    corner: np.ndarray
+    point: np.ndarray
+    length: np.ndarray
+    samples: np.ndarray
+    peak: np.ndarray
+    control: np.ndarray
+
+
+def step_lines(poly: np.ndarray, grads: np.ndarray, shift_px: float = 6.0, step_px: float = 2.0,
+               sample_px: float = 2.0, trim_px: float = 3.0, sigma_px: float = 1.0) -> StepLines | None:
+    """The lines from each corner of ``poly`` (n, 2, pixels) to points every ``step_px`` along the sides not at
+    that corner, measured as :func:`step_cut` describes, or None when there are none."""
     p = np.asarray(poly, np.float64)
     n = len(p)
     q, side = _outline_points(p, step_px)
@@ -106,7 +114,7 @@ def step_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: 
     corner, point = corner[ok], point[ok]
     a, b = p[corner], q[point]
     length = np.hypot(*(b - a).T)
-    long = length > 2 * trim_px + sample_px * min_samples
+    long = length > 2 * trim_px + sample_px
     corner, point, a, b, length = corner[long], point[long], a[long], b[long], length[long]
     if not len(a):
         return None
@@ -117,11 +125,40 @@ def step_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: 
     if not len(pts):
         return None
     step, control = line_steps(pts, owner, nrm, samples, grads, shift_px)
-    peak = np.abs(step).max(axis=1)
-    passes = (samples >= min_samples) & (peak >= min_step) & (peak >= rel_step * control)
-    score = peak - rel_step * control
+    return StepLines(q, side, corner, point, length, samples, np.abs(step).max(axis=1), control)
+
+
+def step_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: float = 6.0,
+             min_step: float = 1.0, rel_step: float = 3.0, min_samples: int = 15, step_px: float = 2.0,
+             sample_px: float = 2.0, trim_px: float = 3.0, sigma_px: float = 1.0,
+             lines: StepLines | None = None) -> list[np.ndarray] | None:
+    """The two parts of ``poly`` (n, 2, pixels) cut along the line from a corner to a point of a side not at that
+    corner, where the colour steps across it, or None. ``grads``: :func:`smoothed_gradients` (blurred by
+    ``sigma_px``) in the polygon's pixel frame. A line's step is, per channel, the mean derivative across it over
+    its samples (every ``sample_px``, ``trim_px`` left out at each end) lying ``shift_px`` + 2 ``sigma_px`` + 1 px
+    or more inside the outline, so that the outline's own edge and the shifted lines stay out; its control is the
+    largest such step on the line shifted ``shift_px`` to either side. A cut needs at least ``min_samples`` clear
+    samples, a step (largest over the channels) of at least ``min_step`` grey levels per pixel and ``rel_step``
+    times its control, and parts of at least ``min_area_px``. Of the lines that pass, the one whose step exceeds
+    ``rel_step`` times its control by most is taken. ``lines``: the outline's :func:`step_lines`, when measured
+    already (with the same ``shift_px``, ``step_px``, ``sample_px``, ``trim_px`` and ``sigma_px``). On realsense
+    renders (dev seeds 1000-1004, true outlines), the colour difference 2 px to either side of the faint edge
+    between two faces of one colour was about 4 times that 6 px off where the edge could be seen at all (cube
+    1004's top and front, 8.6 grey levels; a pentagonal prism's top and side, 10); of nine such edges, five stood
+    out 2.2 times or less. Clean renders gain too (a thin top face whose edge is faint)."""
+    p = np.asarray(poly, np.float64)
+    n = len(p)
+    if lines is None:
+        lines = step_lines(p, grads, shift_px, step_px, sample_px, trim_px, sigma_px)
+    if lines is None:
+        return None
+    q, side = lines.points, lines.side
+    long = lines.length > 2 * trim_px + sample_px * min_samples
+    passes = long & (lines.samples >= min_samples) & (lines.peak >= min_step) & \
+        (lines.peak >= rel_step * lines.control)
+    score = lines.peak - rel_step * lines.control
     for k in sorted(np.nonzero(passes)[0], key=lambda k: (-score[k], k)):
-        i, j = int(corner[k]), int(point[k])
+        i, j = int(lines.corner[k]), int(lines.point[k])
         s = int(side[j])
         ring = np.roll(p, -i, axis=0)  # corner i first; side s now runs from ring[s - i] to the next corner
         s = (s - i) % n
@@ -130,3 +167,82 @@ def step_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: 
         if min(area(first), area(second)) >= min_area_px:
             return [first, second]
     return None
+
+
+def fork_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: float = 6.0,
+             min_step: float = 0.5, rel_step: float = 3.0, min_samples: int = 10, grid_px: float = 4.0,
+             sample_px: float = 2.0, trim_px: float = 3.0, sigma_px: float = 1.0) -> list[np.ndarray] | None:
+    """The three parts of a convex ``poly`` (n, 2, pixels) cut along three lines from three of its corners to one
+    point inside, where the colour steps across each line, or None: a solid showing three faces of one colour,
+    traced as its silhouette alone, whose three inner edges meet at a fork (a trihedral corner seen from outside).
+    Each line is tested as in :func:`step_cut` (``min_samples`` clear samples, a step of ``min_step`` and
+    ``rel_step`` times its control), leaving out its last ``2 * shift_px`` before the fork, where the shifted
+    control lines cross the other two edges. The fork is searched on a grid every ``grid_px``, then about the best
+    point every pixel; of the triples of corners whose three lines pass, the one whose weakest line exceeds its
+    test by most is taken; each part must be at least ``min_area_px``. ``min_step`` is half step_cut's: three lines
+    must pass together, and the faint edge between two sides of a pentagonal prism of one colour (clean dev seed
+    4004, 2 grey levels apart) steps by 0.58 grey levels per pixel."""
+    p = np.asarray(poly, np.float64)
+    if len(p) < 5 or len(reflex_corners(p)):
+        return None
+    clear_px = shift_px + 2 * sigma_px + 1.0
+    args = (grads, shift_px, min_step, rel_step, min_samples, sample_px, trim_px)
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    gx, gy = np.meshgrid(np.arange(lo[0], hi[0], grid_px), np.arange(lo[1], hi[1], grid_px))
+    coarse = np.stack([gx.ravel(), gy.ravel()], axis=1)
+    best = _best_fork(p, coarse[_depth_inside(p, coarse) >= clear_px], *args, clear_px)
+    if best is None:
+        return None
+    off = np.arange(-grid_px, grid_px + 1)
+    fine = best[1] + np.stack(np.meshgrid(off, off), axis=-1).reshape(-1, 2)
+    finer = _best_fork(p, fine[_depth_inside(p, fine) >= clear_px], *args, clear_px)
+    if finer is not None and finer[0] > best[0]:
+        best = finer
+    return _fork_parts(p, best, min_area_px)
+
+
+def _best_fork(p, cand, grads, shift_px, min_step, rel_step, min_samples, sample_px, trim_px, clear_px):
+    """(score, fork point, corners) of the best fork among the points ``cand`` (m, 2), or None."""
+    n, m = len(p), len(cand)
+    if not m:
+        return None
+    a = np.repeat(p, m, axis=0)          # corner k's lines to every candidate: rows k * m .. k * m + m - 1
+    b = np.tile(cand, (n, 1))
+    length = np.hypot(*(b - a).T)
+    # the fork's end is trimmed by 2 * shift_px: lines from the corner stop short of it
+    u = (b - a) / np.maximum(length, 1e-9)[:, None]
+    b_trim = b - u * max(2 * shift_px - trim_px, 0.0)
+    pts, owner, _, nrm = line_samples(a, b_trim, sample_px, trim_px)
+    clear = _depth_inside(p, pts) >= clear_px
+    owner, pts = owner[clear], pts[clear]
+    samples = np.bincount(owner, minlength=len(a))
+    if not len(pts):
+        return None
+    step, control = line_steps(pts, owner, nrm, samples, grads, shift_px)
+    peak = np.abs(step).max(axis=1)
+    passes = (samples >= min_samples) & (peak >= min_step) & (peak >= rel_step * control)
+    score = np.where(passes, peak - rel_step * control, -np.inf).reshape(n, m)  # (corner, candidate)
+    ok = np.isfinite(score)
+    if (ok.sum(axis=0) < 3).all():
+        return None
+    best = None
+    for c in np.nonzero(ok.sum(axis=0) >= 3)[0]:
+        corners = np.nonzero(ok[:, c])[0]
+        for tri in itertools.combinations(corners, 3):
+            s = float(score[list(tri), c].min())
+            if best is None or s > best[0]:
+                best = (s, cand[c], tri)
+    return best
+
+
+def _fork_parts(p: np.ndarray, fork: tuple, min_area_px: float) -> list[np.ndarray] | None:
+    """The three parts of ``p`` cut from its corners ``fork[2]`` (increasing) to the point ``fork[1]``."""
+    _, j, (i, k, l) = fork
+    n = len(p)
+    parts = []
+    for s, e in ((i, k), (k, l), (l, i + n)):
+        ring = [p[t % n] for t in range(s, e + 1)]
+        parts.append(np.concatenate([np.asarray(ring), j[None]]))
+    if min(area(q) for q in parts) < min_area_px:
+        return None
+    return parts

@@ -2,7 +2,7 @@ import cv2
 import numpy as np
 
 from lv3d.perception.polygons import area
-from lv3d.perception.step_edge import smoothed_gradients, step_cut
+from lv3d.perception.step_edge import fork_cut, smoothed_gradients, step_cut, step_lines
 
 # a cube's top and front faces traced as one outline: their shared edge runs from the outline's corner (40, 80)
 # to a point in the middle of its right side, (160, 80), not to a corner
@@ -35,3 +35,48 @@ def test_noise_alone_or_a_smooth_shading_ramp_is_not_cut():
     ramp = _grads(20.0, 20.0, ramp=1.2)
     assert step_cut(OUTLINE, ramp, min_area_px=150.0, rel_step=0.0) is not None
     assert step_cut(OUTLINE, ramp, min_area_px=150.0) is None
+
+
+def test_lines_measured_once_give_the_same_cut_under_either_test():
+    grads = _grads(125.0, 120.0)
+    lines = step_lines(OUTLINE, grads)
+    for kw in ({}, {"rel_step": 10.0, "min_samples": 12}):
+        a = step_cut(OUTLINE, grads, min_area_px=150.0, **kw)
+        b = step_cut(OUTLINE, grads, min_area_px=150.0, lines=lines, **kw)
+        assert (a is None) == (b is None)
+        if a is not None:
+            assert all(np.array_equal(x, y) for x, y in zip(a, b))
+
+
+# a prism seen from above its side: the silhouette is a hexagon, its top and two sides meet at a fork (100, 80)
+# whose three inner edges run to the hexagon's corners 0, 2 and 4
+HEXAGON = np.array([[30.0, 60.0], [100.0, 20.0], [170.0, 60.0], [170.0, 160.0], [100.0, 190.0], [30.0, 160.0]])
+FORK = np.array([100.0, 80.0])
+
+
+def _fork_grads(levels: tuple[float, float, float], noise: float = 3.0, seed: int = 4):
+    rng = np.random.default_rng(seed)
+    img = np.zeros((220, 200), np.float64)
+    h = HEXAGON
+    for level, part in zip(levels, ([h[0], h[1], h[2], FORK], [h[2], h[3], h[4], FORK], [h[4], h[5], h[0], FORK])):
+        mask = np.zeros(img.shape, np.uint8)
+        cv2.fillPoly(mask, [np.round(np.asarray(part)).astype(np.int32)], 1)
+        img[mask.astype(bool)] = level
+    img += rng.normal(0.0, noise, img.shape)
+    chan = cv2.GaussianBlur(np.clip(img, 0, 255).astype(np.uint8), (3, 3), 0)
+    return smoothed_gradients([chan, chan, chan])
+
+
+def test_three_faces_of_one_colour_traced_as_their_silhouette_are_cut_at_their_fork():
+    # 4 and 6 grey levels apart under noise of 3: too faint for the edge map, clear along each whole line
+    parts = fork_cut(HEXAGON, _fork_grads((110.0, 104.0, 100.0)), min_area_px=150.0)
+    assert parts is not None and len(parts) == 3
+    assert all(np.hypot(*(p[-1] - FORK)) <= 3.0 for p in parts)
+    assert sorted(len(p) for p in parts) == [4, 4, 4]
+    assert abs(sum(area(p) for p in parts) - area(HEXAGON)) < 1.0
+
+
+def test_a_silhouette_of_one_shade_or_a_concave_outline_has_no_fork():
+    assert fork_cut(HEXAGON, _fork_grads((104.0, 104.0, 104.0)), min_area_px=150.0) is None
+    notched = np.concatenate([HEXAGON[:3], [[120.0, 110.0]], HEXAGON[3:]])  # a reflex corner: not one solid's
+    assert fork_cut(notched, _fork_grads((110.0, 104.0, 100.0)), min_area_px=150.0) is None
