@@ -34,7 +34,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.calibration_error import ECE_TARGET, chance_ece, ece, log_loss, reliability_bins, scene_interval  # noqa: E402
+from benchmarks.calibration_error import chance_ece, ece, ece_verdict, log_loss, reliability_bins, scene_interval  # noqa: E402
 from benchmarks.grounding_truth import match_faces, truth_labels, truth_quantities, truth_scene  # noqa: E402
 from lv3d.describe import MIN_CONF, ground  # noqa: E402
 from lv3d.perception import perceive  # noqa: E402
@@ -231,7 +231,7 @@ def main(argv=None) -> int:
             p, y, scenes = np.array(rows).T
             e = ece(p, y)
             lo, hi = scene_interval(p, y, scenes)
-            tgt = f"  (target <= {ECE_TARGET}: {'met' if e <= ECE_TARGET else 'NOT met'})" if preset == "realsense" else ""
+            tgt = f"  {ece_verdict(e)}" if preset == "realsense" else ""
             print(f"  ECE {pred:14s} {e:.3f}  n={len(p):4d}  chance {chance_ece(p):.3f}  scenes 95% {lo:.3f}-{hi:.3f}  "
                   f"mean conf {p.mean():.2f}  true {y.mean():.2f}  log loss {candidates_log_loss(st['candidates'][pred]):.4f}{tgt}")
             if pred in a.bins.split(","):

@@ -24,7 +24,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.calibration_error import ECE_TARGET, chance_ece, ece, log_loss, scene_interval  # noqa: E402
+from benchmarks.calibration_error import ECE_TARGET, chance_ece, ece, ece_verdict, log_loss, scene_interval  # noqa: E402
 from benchmarks.fit_calibration import MIN_CONF, row_key  # noqa: E402
 
 
@@ -60,7 +60,7 @@ def report(name: str, rows: list[dict], modality: str, draws: int) -> None:
         met += e <= ECE_TARGET
         lo, hi = scene_interval(f[:, 0], f[:, 1], f[:, 2], draws=draws)
         print(f"  ECE {pred:14s} {e:.3f}  n={len(f):6d}  chance {chance_ece(f[:, 0]):.3f}  scenes 95% {lo:.3f}-{hi:.3f}"
-              f"  (target <= {ECE_TARGET}: {'met' if e <= ECE_TARGET else 'NOT met'})")
+              f"  {ece_verdict(e)}")
     print(f"  {met} of {len(facts)} types within {ECE_TARGET}")
 
 

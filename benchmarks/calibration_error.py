@@ -1,11 +1,16 @@
 """Expected calibration error of fact confidences, and the level sampling alone produces (used by
-bench_grounding.py and fit_calibration.py)."""
+bench_grounding.py, calibration_check.py and fit_calibration.py)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 ECE_TARGET = 0.05  # issue 4: per fact type, at the realsense preset
+
+
+def ece_verdict(e: float) -> str:
+    """The target beside a fact type's ECE ``e``: "(target <= 0.05: met)" or "... NOT met"."""
+    return f"(target <= {ECE_TARGET}: {'met' if e <= ECE_TARGET else 'NOT met'})"
 
 
 def log_loss(p: np.ndarray, y: np.ndarray) -> float:

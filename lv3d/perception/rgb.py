@@ -141,7 +141,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     # made-up edge keys (k, k), k < 0: a cut the graph lacks, shared by the parts either side of it (so that they
     # count as neighbours), or a thin face's contact with the faces beside it (_thin_cands)
     made_up = ((k, k) for k in itertools.count(-1, -1))
-    image_cuts = set()  # made-up keys of cuts along an image edge (split_by_diagonal, step_cut): never joined back
+    # made-up keys of cuts along an image edge (split_by_diagonal, step_cut, fork_cut): never joined back
+    image_cuts = set()
     measured = {}  # index in cands -> step_edge.StepLines of a whole traced face, when measured already
     for f in bounded_faces(g):
         traced_area = area(f.polygon)

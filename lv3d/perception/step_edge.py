@@ -118,14 +118,31 @@ def step_lines(poly: np.ndarray, grads: np.ndarray, shift_px: float = 6.0, step_
     corner, point, a, b, length = corner[long], point[long], a[long], b[long], length[long]
     if not len(a):
         return None
+    measured = _measure(p, a, b, grads, shift_px, sample_px, trim_px, shift_px + 2 * sigma_px + 1.0)
+    return None if measured is None else StepLines(q, side, corner, point, length, *measured)
+
+
+def _measure(p: np.ndarray, a: np.ndarray, b: np.ndarray, grads: np.ndarray, shift_px: float, sample_px: float,
+             trim_px: float, clear_px: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Each line's (``a`` (k, 2) to ``b`` (k, 2)) count of samples at least ``clear_px`` inside polygon ``p``, its
+    step over them (largest over the channels) and its control, each (k,) (:func:`line_steps`), or None when no
+    sample is clear."""
     pts, owner, _, nrm = line_samples(a, b, sample_px, trim_px)
-    clear = _depth_inside(p, pts) >= shift_px + 2 * sigma_px + 1.0
+    clear = _depth_inside(p, pts) >= clear_px
     owner, pts = owner[clear], pts[clear]
     samples = np.bincount(owner, minlength=len(a))
     if not len(pts):
         return None
     step, control = line_steps(pts, owner, nrm, samples, grads, shift_px)
-    return StepLines(q, side, corner, point, length, samples, np.abs(step).max(axis=1), control)
+    return samples, np.abs(step).max(axis=1), control
+
+
+def _margin(samples: np.ndarray, peak: np.ndarray, control: np.ndarray, min_samples: int, min_step: float,
+            rel_step: float) -> np.ndarray:
+    """How far each line's step exceeds ``rel_step`` times its control where the line passes (at least
+    ``min_samples`` clear samples, a step of at least ``min_step`` and ``rel_step`` times its control), else -inf."""
+    passes = (samples >= min_samples) & (peak >= min_step) & (peak >= rel_step * control)
+    return np.where(passes, peak - rel_step * control, -np.inf)
 
 
 def step_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: float = 6.0,
@@ -154,10 +171,9 @@ def step_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: 
         return None
     q, side = lines.points, lines.side
     long = lines.length > 2 * trim_px + sample_px * min_samples
-    passes = long & (lines.samples >= min_samples) & (lines.peak >= min_step) & \
-        (lines.peak >= rel_step * lines.control)
-    score = lines.peak - rel_step * lines.control
-    for k in sorted(np.nonzero(passes)[0], key=lambda k: (-score[k], k)):
+    score = np.where(long, _margin(lines.samples, lines.peak, lines.control, min_samples, min_step, rel_step),
+                     -np.inf)
+    for k in sorted(np.flatnonzero(np.isfinite(score)), key=lambda k: (-score[k], k)):
         i, j = int(lines.corner[k]), int(lines.point[k])
         s = int(side[j])
         ring = np.roll(p, -i, axis=0)  # corner i first; side s now runs from ring[s - i] to the next corner
@@ -212,19 +228,11 @@ def _best_fork(p, cand, grads, shift_px, min_step, rel_step, min_samples, sample
     # the fork's end is trimmed by 2 * shift_px: lines from the corner stop short of it
     u = (b - a) / np.maximum(length, 1e-9)[:, None]
     b_trim = b - u * max(2 * shift_px - trim_px, 0.0)
-    pts, owner, _, nrm = line_samples(a, b_trim, sample_px, trim_px)
-    clear = _depth_inside(p, pts) >= clear_px
-    owner, pts = owner[clear], pts[clear]
-    samples = np.bincount(owner, minlength=len(a))
-    if not len(pts):
+    measured = _measure(p, a, b_trim, grads, shift_px, sample_px, trim_px, clear_px)
+    if measured is None:
         return None
-    step, control = line_steps(pts, owner, nrm, samples, grads, shift_px)
-    peak = np.abs(step).max(axis=1)
-    passes = (samples >= min_samples) & (peak >= min_step) & (peak >= rel_step * control)
-    score = np.where(passes, peak - rel_step * control, -np.inf).reshape(n, m)  # (corner, candidate)
+    score = _margin(*measured, min_samples, min_step, rel_step).reshape(n, m)  # (corner, candidate)
     ok = np.isfinite(score)
-    if (ok.sum(axis=0) < 3).all():
-        return None
     best = None
     for c in np.nonzero(ok.sum(axis=0) >= 3)[0]:
         corners = np.nonzero(ok[:, c])[0]
