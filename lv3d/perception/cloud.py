@@ -1,8 +1,9 @@
 """The depth image as an organised point grid: back-projection on a strided pixel grid, per-point normals from
 neighbouring points, and removal of isolated (flying) points.
 
-A grid is (h, w, 3) camera-frame metres for pixels (u, v) = (stride * j + off, stride * i + off); invalid
-points are zero with ``valid`` False. Working on a strided grid keeps every depth stage within its time budget.
+A grid is (h, w, 3) camera-frame metres for pixels (u, v) = (stride * j, stride * i); invalid points are zero
+with ``valid`` False. Perception works on the full-resolution grid (stride 1, docs/perception.md, session 25);
+a strided grid is cheaper.
 """
 
 from __future__ import annotations
@@ -52,14 +53,20 @@ def remove_flying(xyz: np.ndarray, valid: np.ndarray, rel_jump: float = 0.03, mi
     ``rel_jump`` * depth of it (flying pixels between a foreground edge and the background have none)."""
     z = np.where(valid, xyz[..., 2], 0).astype(np.float32)
     zp = np.pad(z, 1)
-    count = np.zeros(z.shape, np.int32)
     h, w = z.shape
+    tol = rel_jump * z
+    count = np.zeros(z.shape, np.uint8)
+    # buffers reused for the 8 neighbours: at full resolution the temporaries cost more than the arithmetic
+    diff, near, read = np.empty_like(z), np.empty(z.shape, bool), np.empty(z.shape, bool)
     for di in (-1, 0, 1):
         for dj in (-1, 0, 1):
             if di == 0 and dj == 0:
                 continue
             nb = zp[1 + di:1 + di + h, 1 + dj:1 + dj + w]
-            count += ((nb > 0) & (np.abs(nb - z) <= rel_jump * z)).astype(np.int32)
+            np.abs(np.subtract(nb, z, out=diff), out=diff)
+            np.less_equal(diff, tol, out=near)
+            near &= np.greater(nb, 0, out=read)
+            count += near.view(np.uint8)
     return valid & (count >= min_neighbours)
 
 

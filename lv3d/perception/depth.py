@@ -41,7 +41,7 @@ class DepthResult:
     timings_ms: dict[str, float] = field(default_factory=dict)
 
 
-def depth_scene(frame: RGBD, stride: int = 2, seed: int = 0, max_objects: int = 8) -> DepthResult:
+def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int = 8) -> DepthResult:
     """Run the depth stages on one frame; at most ``max_objects`` objects (largest first) get planes."""
     t0 = time.perf_counter()
     grid = point_grid(frame.depth, frame.intrinsics, stride, normals=False)
