@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Rerun every study in experiments/ after a change to lv3d's code, retraining only the lv3d systems, and the seed
-# protocol's two replicates (its lv3d systems on data seeds 1 and 2; scripts/pooled_replicates.py pools them):
+# protocol's four replicates (its lv3d systems on data seeds 1-4; scripts/pooled_replicates.py pools them):
 # each study's baseline fold files are restored from its committed results.csv first
 # (scripts/restore_baselines.py), then `lv3d experiment run` computes the lv3d folds and rewrites the report.
 # Two studies run at a time (one per core). The seed protocol, learning curve, ablations and few-shot study
@@ -39,6 +39,7 @@ replicate() {  # replicate SEED: the seed protocol's lv3d systems on images of a
     echo "$(date +%T) seed_protocol_seed$1: $(grep -a 'fold results computed' "$RUNS/seed_protocol_seed$1.log" | tail -1)"
 }
 replicate 1 & replicate 2; wait
+replicate 3 & replicate 4; wait
 
 for d in "$RUNS"/*/results.csv; do
     name=$(basename "$(dirname "$d")")

@@ -34,6 +34,25 @@ def test_flying_points_are_removed():
     assert remove_flying(xyz, valid)[5, 5]
 
 
+def test_a_point_needs_four_near_valid_neighbours():
+    ring = [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)]
+
+    def kept(near: int, invalid_near: int = 0) -> bool:
+        xyz = np.zeros((9, 9, 3), np.float32)
+        xyz[..., 2] = 2.0  # every neighbour far (a 100% jump) unless set near below
+        xyz[4, 4, 2] = 1.0
+        valid = np.ones((9, 9), bool)
+        for k, (di, dj) in enumerate(ring[:near + invalid_near]):
+            xyz[4 + di, 4 + dj, 2] = 1.02  # within 3% of the centre's depth
+            if k >= near:
+                valid[4 + di, 4 + dj] = False  # near, but without a reading: does not count
+        return bool(remove_flying(xyz, valid)[4, 4])
+
+    assert kept(4) and kept(8)
+    assert not kept(3)
+    assert not kept(3, invalid_near=2)
+
+
 def test_support_plane_is_the_table(box_frame):
     frame, _ = box_frame
     grid = point_grid(frame.depth, frame.intrinsics)
