@@ -25,10 +25,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from lv3d.errors import InputError  # noqa: E402
 from lv3d.perception import perceive  # noqa: E402
 from lv3d.perception.polygons import rasterize  # noqa: E402
 from lv3d.plane import dihedral_deg  # noqa: E402
-from lv3d.errors import InputError  # noqa: E402
 from lv3d.render import render_scene  # noqa: E402
 from lv3d.render.noise import NoiseConfig, noise_config  # noqa: E402
 
