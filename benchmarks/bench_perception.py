@@ -169,15 +169,14 @@ def main(argv=None) -> int:
                     help="override one noise knob of every preset (lv3d.render.noise.NoiseConfig), e.g. "
                          "--set depth_sigma_k=0.008; repeatable. The issue's targets then no longer apply")
     args = ap.parse_args(argv)
-    try:
-        overrides = _overrides(args.set)
-        for preset in args.presets.split(","):
-            noise_config(preset, **overrides)  # unknown presets and knobs stop here, before any work
-    except (InputError, ValueError) as e:
-        ap.error(str(e))
     per_class, presets = args.per_class, args.presets.split(",")
     if args.quick:
         per_class, presets = 2, ["clean", "realsense"]
+    try:  # each preset's knobs, once: unknown presets and knobs stop here, before any work
+        overrides = _overrides(args.set)
+        configs = {preset: noise_config(preset, **overrides) for preset in presets}
+    except (InputError, ValueError) as e:
+        ap.error(str(e))
     modalities = args.modalities.split(",")
     timings: dict[str, list[float]] = {}
     for preset in presets:
@@ -185,7 +184,7 @@ def main(argv=None) -> int:
         t0 = time.perf_counter()
         for cls in CLASSES:
             for i in range(per_class):
-                frame, faces_mask = render_scene(cls, args.seed + i, noise=noise_config(preset, **overrides))
+                frame, faces_mask = render_scene(cls, args.seed + i, noise=configs[preset])
                 for m in modalities:
                     scene = perceive(frame, m, scene_id=f"s{i:06d}")
                     rows[m].append(evaluate(scene, frame, faces_mask, args.min_face_px))
