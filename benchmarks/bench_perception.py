@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from dataclasses import fields
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +29,8 @@ from lv3d.perception import perceive  # noqa: E402
 from lv3d.perception.polygons import rasterize  # noqa: E402
 from lv3d.plane import dihedral_deg  # noqa: E402
 from lv3d.render import render_scene  # noqa: E402
-from lv3d.render.noise import NoiseConfig, noise_config  # noqa: E402
+from lv3d.experiment.config import parse_override  # noqa: E402
+from lv3d.render.noise import noise_config  # noqa: E402
 
 CLASSES = ["cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
            "tetrahedron"]
@@ -137,26 +137,6 @@ def _fmt_target(preset: str, key: str, value: float) -> str:
     return f" (target {op} {t}: {'met' if ok else 'NOT met'})"
 
 
-def _overrides(pairs: list[str]) -> dict:
-    """``["depth_sigma_k=0.008", "shadows=true"]`` -> noise knob values, typed as NoiseConfig's fields are."""
-    types = {f.name: f.type for f in fields(NoiseConfig) if f.name != "preset"}
-    out = {}
-    for pair in pairs:
-        key, sep, value = pair.partition("=")
-        if not sep:
-            raise ValueError(f"--set {pair!r}: expected KNOB=VALUE")
-        kind = types.get(key)
-        if kind is None:
-            raise ValueError(f"--set {pair!r}: unknown noise knob {key!r}; known: {', '.join(sorted(types))}")
-        if kind in ("bool", bool):
-            if value.lower() not in ("true", "false", "1", "0"):
-                raise ValueError(f"--set {pair!r}: {key} takes true or false")
-            out[key] = value.lower() in ("true", "1")
-        else:
-            out[key] = (int if kind in ("int", int) else float)(value)
-    return out
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="2 scenes per class, clean and realsense only")
@@ -173,9 +153,9 @@ def main(argv=None) -> int:
     if args.quick:
         per_class, presets = 2, ["clean", "realsense"]
     try:  # each preset's knobs, once: unknown presets and knobs stop here, before any work
-        overrides = _overrides(args.set)
+        overrides = dict(parse_override(pair) for pair in args.set)
         configs = {preset: noise_config(preset, **overrides) for preset in presets}
-    except (InputError, ValueError) as e:
+    except InputError as e:
         ap.error(str(e))
     modalities = args.modalities.split(",")
     timings: dict[str, list[float]] = {}

@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import hashlib
 import json
+import re
 from pathlib import Path
 
 import yaml
@@ -103,11 +104,16 @@ def set_dotted(cfg: dict, key: str, value, where: str | Path) -> None:
     node[parts[-1]] = value
 
 
+_EXPONENT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
+
+
 def parse_override(text: str) -> tuple[str, object]:
     """``key=value`` with the value parsed as YAML (``8``, ``false``, ``[1, 2]``)."""
     if "=" not in text:
         raise InputError("--set", f"expected key=value, got {text!r}")
     key, raw = text.split("=", 1)
+    if _EXPONENT.fullmatch(raw.strip()):  # YAML 1.1 reads 1e-3 (no dot) as a string
+        return key.strip(), float(raw)
     try:
         return key.strip(), yaml.safe_load(raw)
     except yaml.YAMLError as e:
@@ -136,7 +142,7 @@ def validate(cfg: dict, where: Path) -> None:
     try:
         noise_config(d["noise"], **(d["noise_overrides"] or {}))
     except InputError as e:
-        key = "data.noise" if "preset" in e.problem else "data.noise_overrides"
+        key = "data.noise" if e.problem.startswith("unknown noise preset") else "data.noise_overrides"
         raise InputError(where, f"{key}: {e.problem}") from None
     except TypeError as e:
         raise InputError(where, f"data.noise_overrides: {e}") from None

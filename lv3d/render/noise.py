@@ -57,7 +57,7 @@ _PRESET_KNOBS = {
 }
 
 
-def noise_config(preset: str = "clean", **overrides) -> NoiseConfig:
+def noise_config(preset: str = "clean", /, **overrides) -> NoiseConfig:
     """The knobs of ``preset`` with any of them overridden, e.g. ``noise_config("clean", clutter=2)``."""
     if preset not in PRESETS:
         raise InputError("noise", f"unknown noise preset {preset!r}; known: {', '.join(PRESETS)}")
@@ -65,8 +65,24 @@ def noise_config(preset: str = "clean", **overrides) -> NoiseConfig:
     bad = sorted(set(overrides) - names)
     if bad:
         raise InputError("noise", f"unknown noise knob {bad[0]!r}; known: {', '.join(sorted(names))}")
+    for name, value in overrides.items():
+        _check_type(name, value)
     cfg = replace(NoiseConfig(preset=preset), **_PRESET_KNOBS[preset])
     return replace(cfg, **overrides)
+
+
+_KINDS = {f.name: f.type for f in fields(NoiseConfig)}  # "float", "int" or "bool" (annotations are strings here)
+
+
+def _check_type(name: str, value) -> None:
+    """An InputError unless ``value`` fits knob ``name``: a bool is no number, a float no count."""
+    kind = _KINDS[name]
+    is_bool = isinstance(value, bool)
+    ok = {"bool": is_bool, "int": isinstance(value, int) and not is_bool,
+          "float": isinstance(value, (int, float)) and not is_bool}[kind]
+    if not ok:
+        says = {"bool": "true or false", "int": "a whole number", "float": "a number"}[kind]
+        raise InputError("noise", f"knob {name!r} takes {says}, got {value!r}")
 
 
 def as_config(noise: str | NoiseConfig) -> NoiseConfig:

@@ -4,7 +4,7 @@ import pytest
 import yaml
 
 from lv3d.errors import InputError
-from lv3d.experiment.config import conditions, load_config
+from lv3d.experiment.config import conditions, load_config, parse_override
 
 
 def _write(tmp_path, text):
@@ -24,6 +24,8 @@ def test_defaults_fill_a_minimal_config(tmp_path):
     ("data: {classes: [cube, dodecahedron]}\n", "data.classes"),
     ("data: {noise: foggy}\n", "data.noise"),
     ("data: {noise_overrides: {fog: 1}}\n", "data.noise_overrides"),
+    ("data: {noise_overrides: {shadows: maybe}}\n", "data.noise_overrides"),
+    ("data: {noise_overrides: {preset: hard}}\n", "data.noise_overrides"),
     ("systems: [lv3d-rgb, svm]\n", "systems"),
     ("folds: 1\n", "folds"),
     ("data: {per_class: 3}\n", "data.per_class"),
@@ -68,3 +70,10 @@ def test_shipped_study_configs_are_valid():
         assert conditions(cfg, p)
         assert p.read_text().startswith("#"), f"{p.name} lacks its header comment"
         assert yaml.safe_load(p.read_text())["name"]
+
+
+@pytest.mark.parametrize("text, value", [("k=1e-3", 0.001), ("k=-2.5E+2", -250.0), ("k=0.008", 0.008), ("k=2", 2),
+                                         ("k=true", True), ("k=e5", "e5")])
+def test_override_values_read_as_yaml_and_exponents_as_numbers(text, value):
+    key, got = parse_override(text)
+    assert key == "k" and got == value and type(got) is type(value)

@@ -1,18 +1,15 @@
-"""The perception benchmark's --set KNOB=VALUE overrides: typed as the noise knobs are, bad ones named."""
+"""The perception benchmark's --set KNOB=VALUE: parsed as the study's --set is, bad knobs and values named."""
 
 import pytest
 
-from benchmarks.bench_perception import _overrides
+from benchmarks.bench_perception import main
 
 
-def test_overrides_take_each_knob_s_type():
-    got = _overrides(["depth_sigma_k=0.008", "clutter=2", "shadows=false"])
-    assert got == {"depth_sigma_k": 0.008, "clutter": 2, "shadows": False}
-    assert isinstance(got["clutter"], int)
-
-
-@pytest.mark.parametrize("bad, says", [("foo=1", "unknown noise knob 'foo'"), ("clutter", "expected KNOB=VALUE"),
-                                        ("shadows=maybe", "true or false"), ("preset=hard", "unknown noise knob")])
-def test_bad_overrides_are_named(bad, says):
-    with pytest.raises(ValueError, match=says):
-        _overrides([bad])
+@pytest.mark.parametrize("bad, says", [("foo=1", "unknown noise knob 'foo'"), ("clutter", "expected key=value"),
+                                        ("shadows=maybe", "knob 'shadows' takes true or false"),
+                                        ("clutter=2.5", "knob 'clutter' takes a whole number"),
+                                        ("preset=hard", "unknown noise knob 'preset'")])
+def test_bad_overrides_stop_before_any_work(bad, says, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["--per-class", "1", "--presets", "clean", "--set", bad])
+    assert e.value.code == 2 and says in capsys.readouterr().err

@@ -21,6 +21,15 @@ def test_presets_and_overrides():
     assert [noise_config(p).preset for p in PRESETS] == list(PRESETS)
 
 
+@pytest.mark.parametrize("knob, value, says", [("shadows", "maybe", "true or false"), ("shadows", 1, "true or false"),
+                                               ("clutter", 2.5, "a whole number"), ("clutter", True, "a whole number"),
+                                               ("depth_sigma_k", "0.008", "a number"), ("blur_px", None, "a number")])
+def test_a_knob_takes_only_its_own_type(knob, value, says):
+    with pytest.raises(InputError, match=f"knob '{knob}' takes {says}"):
+        noise_config("clean", **{knob: value})
+    assert noise_config("clean", blur_px=1, clutter=2, shadows=True).blur_px == 1  # a whole number is a number
+
+
 def test_realsense_depth_noise_is_about_a_d435():
     cfg = noise_config("clean", depth_sigma_base_m=0.001, depth_sigma_k=0.0018)
     ratios = []
