@@ -1,5 +1,5 @@
 """The depth image as an organised point grid: back-projection on a strided pixel grid, per-point normals from
-neighbouring points, and removal of isolated (flying) points.
+neighbouring points, removal of isolated (flying) points, and a measure of how noisy the depth is.
 
 A grid is (h, w, 3) camera-frame metres for pixels (u, v) = (stride * j, stride * i); invalid points are zero
 with ``valid`` False. Perception works on the full-resolution grid (stride 1, docs/perception.md, session 25);
@@ -46,6 +46,23 @@ def back_project(depth: np.ndarray, k: Intrinsics, stride: int = 2) -> tuple[np.
     xyz[..., 1] = v[:, None] * z
     xyz[..., 2] = z
     return xyz, np.isfinite(z) & (z > 0)
+
+
+def slope_noise(depth: np.ndarray, k: Intrinsics, row_step: int = 4) -> float:
+    """How noisy the depth image (H, W) metres is, in units of the pixel footprint: the robust standard deviation
+    of depth noise divided by the width z / f that one pixel spans at that depth (so also the noise of depth
+    differences between neighbouring pixels, as a slope). It is read off second differences along every
+    ``row_step``-th row, z[u-1] - 2 z[u] + z[u+1], which vanish on a plane seen at a small angle and are
+    sqrt(6) sigma wide from noise: their median absolute value, scaled by f / z pixel by pixel and by
+    1 / (0.6745 sqrt 6), is sigma's. Jumps over a tenth of the depth (edges, flying pixels) are left out.
+    0 when no three neighbouring pixels are read."""
+    z = np.ascontiguousarray(depth[::row_step]).astype(np.float32)
+    a, b, c = z[:, :-2], z[:, 1:-1], z[:, 2:]
+    d2 = np.abs(a - 2 * b + c)
+    ok = (a > 0) & (b > 0) & (c > 0) & (d2 < 0.1 * b)
+    if not ok.any():
+        return 0.0
+    return float(np.median(d2[ok] / b[ok])) * k.fx / (0.6745 * np.sqrt(6.0))
 
 
 def remove_flying(xyz: np.ndarray, valid: np.ndarray, rel_jump: float = 0.03, min_neighbours: int = 4) -> np.ndarray:

@@ -11,7 +11,7 @@ import numpy as np
 from ..plane import Plane
 from ..rgbd import RGBD
 from .boundary import mask_polygon
-from .cloud import PointGrid, point_grid
+from .cloud import PointGrid, point_grid, slope_noise
 from .objects import DepthObject, segment_objects, support_band
 from .planes import DepthPlane, object_planes, plane_adjacency
 from .plane_outline import simplify_on_plane
@@ -49,7 +49,9 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int = 
     support = _support(grid, seed)
     t2 = time.perf_counter()
     band = support_band(grid, support) if support is not None else None
-    objs = segment_objects(grid, support, band_m=band)[:max_objects]
+    # depth noise as a fraction of depth (sigma / z), measured on the frame: object cuts must stand out of it
+    noise_rel = slope_noise(frame.depth, frame.intrinsics) / frame.intrinsics.fx
+    objs = segment_objects(grid, support, band_m=band, noise_rel=noise_rel)[:max_objects]
     t3 = time.perf_counter()
     h, w = frame.shape
     results = []

@@ -36,7 +36,8 @@ def border_contact(mask: np.ndarray) -> float:
 
 def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60, min_height_m: float = 0.015,
                     rel_jump: float = 0.02, max_border: float = 0.12,
-                    band_m: float | None = None, regrow: int = 5) -> list[DepthObject]:
+                    band_m: float | None = None, regrow: int = 5, noise_rel: float = 0.0,
+                    jump_sigmas: float = 3.0) -> list[DepthObject]:
     """Objects above ``support`` on the grid, largest first. Points within the noise band of the support plane
     or below it are removed; the rest splits at depth jumps larger than ``rel_jump`` * depth; pieces with fewer
     than ``min_points`` grid points, lower than ``min_height_m``, or cut by the image border along more than
@@ -44,7 +45,14 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     dropped. ``band_m``: the noise band (metres) above the support that counts as support; by default the
     noise expected of a consumer sensor at the scene's depth (see :func:`support_band`). Each piece then takes
     back the foreground cells left out of every piece (depth jumps, the opening) within ``regrow`` cells of it.
-    Without a support plane every valid point counts as foreground."""
+    Without a support plane every valid point counts as foreground.
+
+    ``noise_rel``: the frame's depth noise sigma as a fraction of depth (:func:`~lv3d.perception.cloud.slope_noise`
+    over the focal length). Where noise alone would pass the jump test (``jump_sigmas`` standard deviations of a
+    difference of two readings over ``rel_jump``), jumps are measured on a 3x3 median of the depth, which keeps
+    steps and has about 0.45 of the noise, against the larger of ``rel_jump`` and ``jump_sigmas`` of that. Why:
+    under heavy noise (sigma = 0.008 z^2) the full grid was cut into pieces by noise and objects fell apart
+    (docs/perception.md, sessions 25 and 26); at the noise of the presets up to ``realsense`` nothing changes."""
     valid = grid.valid
     if support is not None:
         h_above = np.where(valid, grid.xyz @ support.n.astype(np.float32) + np.float32(support.offset), 0)
@@ -55,6 +63,9 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
         h_above = np.where(valid, 1.0, 0)
         fg = valid.copy()
     z = grid.xyz[..., 2]
+    if jump_sigmas * np.sqrt(2.0) * noise_rel > rel_jump:
+        z = cv2.medianBlur(np.ascontiguousarray(z), 3)
+        rel_jump = max(rel_jump, jump_sigmas * np.sqrt(2.0) * 0.45 * noise_rel)
     # cut the grid where depth jumps between neighbours: touching-in-the-image objects at different depths
     jump = np.zeros_like(fg)
     dz_u = np.abs(np.diff(z, axis=1)) > rel_jump * z[:, 1:]

@@ -1,8 +1,8 @@
 import numpy as np
 
-from lv3d.perception.cloud import point_grid, remove_flying
+from lv3d.perception.cloud import point_grid, remove_flying, slope_noise
 from lv3d.perception.depth import depth_scene
-from lv3d.perception.objects import segment_objects
+from lv3d.perception.objects import segment_objects, support_band
 from lv3d.perception.planes import outward_normal
 from lv3d.perception.support import support_plane
 from lv3d.plane import dihedral_deg
@@ -23,6 +23,34 @@ def test_back_projection_and_normals_of_a_flat_wall():
     assert np.allclose(grid.xyz[..., 2][grid.valid], 1.5)
     n = grid.normals[grid.normals[..., 2] != 0]
     assert np.allclose(n, [0, 0, -1], atol=1e-4)
+
+
+def test_slope_noise_reads_sigma_in_pixel_footprints():
+    from lv3d.camera import Intrinsics
+
+    k = Intrinsics(500, 500, 159.5, 119.5, 320, 240)
+    rng = np.random.default_rng(0)
+    wall = np.broadcast_to(1.0 + 0.0005 * np.arange(320, dtype=np.float32), (240, 320))  # turned by a few degrees
+    for sigma in (0.001, 0.004, 0.008):  # metres at about 1.1 m: 0.45, 1.8 and 3.6 pixel footprints
+        noisy = (wall + rng.normal(0, sigma, wall.shape)).astype(np.float32)
+        expect = sigma * 500 / float(np.median(wall))
+        assert abs(slope_noise(noisy, k) - expect) < 0.1 * expect
+    edge = np.array(wall, np.float32)
+    edge[:, 160:] += 0.3  # a step between two surfaces is no noise
+    assert slope_noise(edge, k) < 0.05
+    assert slope_noise(np.zeros((240, 320), np.float32), k) == 0.0  # nothing read
+
+
+def test_heavy_noise_does_not_cut_an_object_apart():
+    frame, _ = box_on_table(noise_m=0.005, seed=0)  # sigma 5 mm at 0.6 m: 2.2 pixel footprints
+    grid = point_grid(frame.depth, frame.intrinsics, stride=1, normals=False)
+    sp = support_plane(grid.xyz[::2, ::2][grid.valid[::2, ::2]].astype(float), seed=0)
+    band = support_band(grid, sp)
+    assert len(segment_objects(grid, sp, band_m=band)) > 3  # noise read as depth jumps
+    noise_rel = slope_noise(frame.depth, frame.intrinsics) / frame.intrinsics.fx
+    objs = segment_objects(grid, sp, band_m=band, noise_rel=noise_rel)
+    assert len(objs) == 1 and objs[0].size > 4000
+    assert len(depth_scene(frame, seed=0).objects) == 1
 
 
 def test_flying_points_are_removed():
