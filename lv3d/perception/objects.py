@@ -48,11 +48,12 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     Without a support plane every valid point counts as foreground.
 
     ``noise_rel``: the frame's depth noise sigma as a fraction of depth (:func:`~lv3d.perception.cloud.slope_noise`
-    over the focal length). Where noise alone would pass the jump test (``jump_sigmas`` standard deviations of a
-    difference of two readings over ``rel_jump``), jumps are measured on a 3x3 median of the depth, which keeps
-    steps and has about 0.45 of the noise, against the larger of ``rel_jump`` and ``jump_sigmas`` of that. Why:
-    under heavy noise (sigma = 0.008 z^2) the full grid was cut into pieces by noise and objects fell apart
-    (docs/perception.md, sessions 25 and 26); at the noise of the presets up to ``realsense`` nothing changes."""
+    over the focal length). Where noise alone makes jumps over ``rel_jump`` (``jump_sigmas`` standard deviations
+    of the difference of two readings), jumps are measured on a 3x3 median of the depth instead, which keeps
+    steps and has 0.41 of the noise, against the larger of ``rel_jump`` and ``jump_sigmas`` of that (0.45 taken,
+    on the safe side). Why: under heavy noise (sigma = 0.008 z^2) noise cut the full grid into pieces and objects
+    fell apart (docs/perception.md, sessions 25 and 26); at the noise of the presets up to ``realsense`` nothing
+    changes."""
     valid = grid.valid
     if support is not None:
         h_above = np.where(valid, grid.xyz @ support.n.astype(np.float32) + np.float32(support.offset), 0)
