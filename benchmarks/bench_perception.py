@@ -26,6 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from lv3d.errors import InputError  # noqa: E402
 from lv3d.perception import perceive  # noqa: E402
+from lv3d.perception.cloud import slope_noise  # noqa: E402
 from lv3d.perception.polygons import rasterize  # noqa: E402
 from lv3d.plane import dihedral_deg  # noqa: E402
 from lv3d.render import render_scene  # noqa: E402
@@ -161,10 +162,12 @@ def main(argv=None) -> int:
     timings: dict[str, list[float]] = {}
     for preset in presets:
         rows: dict[str, list[dict]] = {m: [] for m in modalities}
+        noise = []  # each frame's depth noise in pixel footprints, as depth perception measures it
         t0 = time.perf_counter()
         for cls in CLASSES:
             for i in range(per_class):
                 frame, faces_mask = render_scene(cls, args.seed + i, noise=configs[preset])
+                noise.append(slope_noise(frame.depth, frame.intrinsics))
                 for m in modalities:
                     scene = perceive(frame, m, scene_id=f"s{i:06d}")
                     rows[m].append(evaluate(scene, frame, faces_mask, args.min_face_px))
@@ -174,6 +177,8 @@ def main(argv=None) -> int:
                         timings.setdefault("total", []).append(sum(scene.timings_ms.values()))
         knobs = "".join(f", {k}={v}" for k, v in overrides.items())
         print(f"\n== preset {preset}{knobs}: {per_class} scenes x {len(CLASSES)} classes ({time.perf_counter() - t0:.0f} s)")
+        print(f"depth noise sigma, in pixel footprints (lv3d.perception.cloud.slope_noise): {min(noise):.2f} to "
+              f"{max(noise):.2f}, median {np.median(noise):.2f}")
         print(f"{'modality':8} {'recall':>7} {'prec':>6} {'sides':>6} {'vert_px':>8} {'normal':>7} {'dihedral':>8}"
               f" {'n_dih':>5} {'target':>6}")
         for m in modalities:
