@@ -196,7 +196,13 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
             continue
         parts = None
         if colour_alone and whole:
-            parts = step_cut(poly, sgrads, min_area_px, lines=measured.get(i))
+            lines = measured.get(i) or step_lines(poly, sgrads)
+            parts = step_cut(poly, sgrads, min_area_px, lines=lines)
+            if parts is None:
+                # a short faint edge keeps few clear samples; it is taken with 10 when it steps 10 times its control
+                # (a small face of one colour with its neighbour: triangular prism 1002's 509 px face, 10 samples,
+                # a step 89 times its control; docs/perception.md, session 26)
+                parts = step_cut(poly, sgrads, min_area_px, rel_step=10.0, min_samples=10, lines=lines)
             if parts is None:
                 parts = fork_cut(poly, sgrads, min_area_px)
         if parts is None:

@@ -92,3 +92,25 @@ def test_a_faint_edge_inside_a_concave_outline_is_cut_before_the_outline_is_spli
     # with no step between top and front no cut is made along their line
     cv2.fillPoly(img, [front.astype(np.int32)], (192, 202, 142))
     assert best_iou(rgb_faces(img, colour_alone=True), top) < 0.8
+
+
+def test_a_short_faint_edge_that_steps_clearly_cuts_a_small_face_off():
+    # triangular prism 1002 of the clean dev renders: its 509 px side and 1316 px end, 5-6 grey levels apart, traced
+    # as one outline; their edge keeps 10 clear samples, under step_cut's 15, but steps 89 times its control
+    off = np.array([40.0, 20.0])
+    small = np.array([(12.8, 56.4), (30.1, 37.0), (51.7, 74.0)]) + off
+    large = np.array([(30.1, 37.0), (54.1, 10.2), (72.1, 44.7), (51.7, 74.0)]) + off
+    img = np.full((140, 180, 3), (120, 80, 50), np.uint8)
+    for poly, colour in ((large, (116, 125, 97)), (small, (111, 119, 93))):
+        cv2.fillPoly(img, [np.round(poly).astype(np.int32)], colour)
+
+    def best_iou(res, poly):
+        want = rasterize(poly, img.shape[:2])
+        ious = [np.count_nonzero(got & want) / np.count_nonzero(got | want)
+                for got in (rasterize(f.polygon, img.shape[:2]) for f in res.faces)]
+        return max(ious, default=0.0)
+
+    res = rgb_faces(img, colour_alone=True)
+    assert len(res.faces) == 2 and min(best_iou(res, p) for p in (small, large)) > 0.8
+    cv2.fillPoly(img, [np.round(small).astype(np.int32)], (116, 125, 97))  # one colour: no edge, no cut
+    assert len(rgb_faces(img, colour_alone=True).faces) == 1
