@@ -5,6 +5,14 @@ from lv3d.perception.polygons import rasterize
 from lv3d.perception.rgb import rgb_faces
 
 
+def _best_iou(res, poly, shape):
+    """The best IoU of any face found in ``res`` with polygon ``poly``, both rasterised on an image of ``shape``."""
+    want = rasterize(poly, shape)
+    ious = [np.count_nonzero(got & want) / np.count_nonzero(got | want)
+            for got in (rasterize(f.polygon, shape) for f in res.faces)]
+    return max(ious, default=0.0)
+
+
 def _canvas():
     return np.full((240, 320, 3), (200, 200, 190), np.uint8)
 
@@ -81,17 +89,11 @@ def test_a_faint_edge_inside_a_concave_outline_is_cut_before_the_outline_is_spli
     for poly, colour in ((top, (192, 202, 142)), (front, (188, 198, 138)), (left, (93, 99, 69))):
         cv2.fillPoly(img, [poly.astype(np.int32)], colour)
 
-    def best_iou(res, poly):
-        want = rasterize(poly, img.shape[:2])
-        ious = [np.count_nonzero(got & want) / np.count_nonzero(got | want)
-                for got in (rasterize(f.polygon, img.shape[:2]) for f in res.faces)]
-        return max(ious, default=0.0)
-
     res = rgb_faces(img, colour_alone=True)
-    assert min(best_iou(res, p) for p in (top, front, left)) > 0.9
+    assert min(_best_iou(res, p, img.shape[:2]) for p in (top, front, left)) > 0.9
     # with no step between top and front no cut is made along their line
     cv2.fillPoly(img, [front.astype(np.int32)], (192, 202, 142))
-    assert best_iou(rgb_faces(img, colour_alone=True), top) < 0.8
+    assert _best_iou(rgb_faces(img, colour_alone=True), top, img.shape[:2]) < 0.8
 
 
 def test_a_short_faint_edge_that_steps_clearly_cuts_a_small_face_off():
@@ -104,13 +106,7 @@ def test_a_short_faint_edge_that_steps_clearly_cuts_a_small_face_off():
     for poly, colour in ((large, (116, 125, 97)), (small, (111, 119, 93))):
         cv2.fillPoly(img, [np.round(poly).astype(np.int32)], colour)
 
-    def best_iou(res, poly):
-        want = rasterize(poly, img.shape[:2])
-        ious = [np.count_nonzero(got & want) / np.count_nonzero(got | want)
-                for got in (rasterize(f.polygon, img.shape[:2]) for f in res.faces)]
-        return max(ious, default=0.0)
-
     res = rgb_faces(img, colour_alone=True)
-    assert len(res.faces) == 2 and min(best_iou(res, p) for p in (small, large)) > 0.8
+    assert len(res.faces) == 2 and min(_best_iou(res, p, img.shape[:2]) for p in (small, large)) > 0.8
     cv2.fillPoly(img, [np.round(small).astype(np.int32)], (116, 125, 97))  # one colour: no edge, no cut
     assert len(rgb_faces(img, colour_alone=True).faces) == 1
