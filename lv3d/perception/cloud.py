@@ -123,10 +123,17 @@ def point_grid(depth: np.ndarray, k: Intrinsics, stride: int = 2, normals: bool 
     return PointGrid(xyz, nrm, valid, stride)
 
 
-def crop_normals(grid: PointGrid, i0: int, j0: int, i1: int, j1: int, margin: int = 3) -> np.ndarray:
+def crop_normals(grid: PointGrid, i0: int, j0: int, i1: int, j1: int, margin: int = 3,
+                 within: np.ndarray | None = None) -> np.ndarray:
     """Normals (i1 - i0, j1 - j0, 3) of grid rows i0:i1 and columns j0:j1, computed on the crop plus a margin
-    (objects are small: normals of the whole grid would cost more than everything else)."""
+    (objects are small: normals of the whole grid would cost more than everything else). With ``within`` (h, w)
+    bool (an object's cells), from those cells' points alone wherever enough of them surround a cell, and from
+    all points elsewhere (a corner or sliver of the object with too few cells of its own)."""
     h, w = grid.shape
     a0, b0, a1, b1 = max(0, i0 - margin), max(0, j0 - margin), min(h, i1 + margin), min(w, j1 + margin)
-    n = grid_normals(np.ascontiguousarray(grid.xyz[a0:a1, b0:b1]), grid.valid[a0:a1, b0:b1])
+    xyz, valid = np.ascontiguousarray(grid.xyz[a0:a1, b0:b1]), grid.valid[a0:a1, b0:b1]
+    n = grid_normals(xyz, valid)
+    if within is not None:
+        own = grid_normals(xyz, valid & within[a0:a1, b0:b1])
+        n = np.where(own.any(axis=2, keepdims=True), own, n)
     return n[i0 - a0:i1 - a0, j0 - b0:j1 - b0]

@@ -1,6 +1,7 @@
 import numpy as np
 
-from lv3d.perception.planes import DepthPlane, merge_strips
+from lv3d.perception.cloud import PointGrid
+from lv3d.perception.planes import DepthPlane, merge_strips, object_planes
 from lv3d.perception.support import refine
 from lv3d.plane import Plane
 
@@ -80,3 +81,21 @@ def test_a_thin_face_seen_edge_on_with_its_neighbours_strip_stays_apart():
     # the same piece with its off-plane points scattered like flying pixels joins the face
     fly = lambda i, j: np.where(j < 2, 1.0 + rng.uniform(0.01, 0.05, len(i)), 1.0)
     assert len(merge_strips([big, _piece(piece, fly, rng, sigma_m=0.0)], dist_m=0.008)) == 1
+
+
+def test_points_along_the_silhouette_go_to_the_face_they_lie_on():
+    # a roof seen from the front on 2 mm cells: face A square to the camera at 1 m (columns 0-19), face B turned 45
+    # degrees away behind it (columns 20-39); above it (rows 0-9) a wall 0.3 m further back, read but not the object's
+    n, top, ridge = 40, 10, 20
+    i, j = np.mgrid[0:top + n, 0:n]
+    z = np.where(i < top, 1.3, np.where(j < ridge, 1.0, 1.0 + (j - ridge) * 0.002))
+    xyz = np.stack([j * 0.002 * z, i * 0.002 * z, z], -1).astype(np.float32)
+    grid = PointGrid(xyz, np.zeros_like(xyz), np.ones(z.shape, bool), 1)  # normals measured where needed
+    planes = object_planes(grid, i >= top, seed=0)
+    assert len(planes) == 2
+    face_a, face_b = sorted(planes, key=lambda p: -abs(p.plane.n[2]))
+    # B's top rows near the ridge lie within A's reach: normals mixed with the wall's points, which faces the camera
+    # as A does, gave them to A
+    assert np.all(face_b.mask[top:top + 3, ridge + 1:ridge + 12])
+    assert not np.any(face_a.mask[:, ridge + 1:])  # the ridge's own column lies on both
+    assert np.all(face_a.mask[top:, :ridge])
