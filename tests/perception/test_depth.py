@@ -1,6 +1,6 @@
 import numpy as np
 
-from lv3d.perception.cloud import point_grid, remove_flying, slope_noise
+from lv3d.perception.cloud import PointGrid, crop_normals, point_grid, remove_flying, slope_noise
 from lv3d.perception.depth import depth_scene
 from lv3d.perception.objects import segment_objects, support_band
 from lv3d.perception.planes import outward_normal
@@ -23,6 +23,23 @@ def test_back_projection_and_normals_of_a_flat_wall():
     assert np.allclose(grid.xyz[..., 2][grid.valid], 1.5)
     n = grid.normals[grid.normals[..., 2] != 0]
     assert np.allclose(n, [0, 0, -1], atol=1e-4)
+
+
+def test_normals_within_an_object_leave_the_wall_behind_it_out():
+    # 2 mm cells: a flat object at 1 m (columns 0-19) before a wall 0.3 m behind (20-39); one lone object cell on
+    # the wall's side, with too few of its own around it
+    i, j = np.mgrid[0:30, 0:40]
+    z = np.where(j < 20, 1.0, 1.3)
+    grid = PointGrid(np.stack([j * 0.002 * z, i * 0.002 * z, z], -1).astype(np.float32),
+                     np.zeros((30, 40, 3), np.float32), np.ones((30, 40), bool), 1)
+    obj = j < 20
+    obj[15, 30] = True
+    mixed = crop_normals(grid, 0, 0, 30, 40)
+    own = crop_normals(grid, 0, 0, 30, 40, within=obj)
+    edge = (slice(5, 25), slice(17, 20))            # the object's cells beside the wall
+    assert np.max(np.abs(mixed[edge][..., 2])) < 0.9  # their window reaches the wall: tilted
+    assert np.allclose(own[edge], [0, 0, -1], atol=1e-4)
+    assert np.linalg.norm(own[15, 30]) > 0.99 and np.allclose(own[15, 30], mixed[15, 30])  # lone: all points
 
 
 def test_slope_noise_reads_sigma_in_pixel_footprints():
