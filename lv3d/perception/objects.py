@@ -34,6 +34,12 @@ def border_contact(mask: np.ndarray) -> float:
     return edge / max(1, np.count_nonzero(inner))
 
 
+def heavy_noise(noise_rel: float, rel_jump: float = 0.02, jump_sigmas: float = 3.0) -> bool:
+    """True when depth noise alone (``noise_rel``: sigma as a fraction of depth) makes neighbouring readings differ by
+    over ``rel_jump`` of the depth at ``jump_sigmas`` standard deviations (of a difference of two readings)."""
+    return jump_sigmas * np.sqrt(2.0) * noise_rel > rel_jump
+
+
 def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60, min_height_m: float = 0.015,
                     rel_jump: float = 0.02, max_border: float = 0.12,
                     band_m: float | None = None, regrow: int = 5, noise_rel: float = 0.0,
@@ -64,7 +70,7 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
         h_above = np.where(valid, 1.0, 0)
         fg = valid.copy()
     z = grid.xyz[..., 2]
-    if jump_sigmas * np.sqrt(2.0) * noise_rel > rel_jump:
+    if heavy_noise(noise_rel, rel_jump, jump_sigmas):
         z = cv2.medianBlur(np.ascontiguousarray(z), 3)
         rel_jump = max(rel_jump, jump_sigmas * np.sqrt(2.0) * 0.45 * noise_rel)
     # cut the grid where depth jumps between neighbours: touching-in-the-image objects at different depths

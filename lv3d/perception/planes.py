@@ -34,12 +34,12 @@ def _largest_piece(mask: np.ndarray) -> np.ndarray:
 
 
 def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_planes: int = 6,
-                  min_frac: float = 0.06, max_need: int = 1500, min_points: int = 25,
+                  min_frac: float = 0.035, max_need: int = 1500, min_points: int = 25,
                   max_angle_deg: float = 20.0) -> list[DepthPlane]:
     """Planes of the object whose grid cells are ``obj_mask`` (h, w) bool, largest first. A plane needs at least
     ``max(min_points, min(min_frac * object size, max_need))`` points in one connected piece: a share of the object
-    keeps strips and noise out, and ``max_need`` lets a large object's small face in (hexagonal prism 2003's 2179 px
-    side, 4.4% of the object; docs/perception.md, session 27)."""
+    keeps strips and noise out (depth.py asks more under heavy depth noise), and ``max_need`` lets a large object's
+    small face in (hexagonal prism 2003's 2179 px side is 4.4% of its 47690 cells; docs/perception.md, session 27)."""
     rng = np.random.default_rng(seed)
     full_shape, full_mask = obj_mask.shape, obj_mask
     rows, cols = np.flatnonzero(obj_mask.any(axis=1)), np.flatnonzero(obj_mask.any(axis=0))

@@ -102,16 +102,17 @@ def test_points_along_the_silhouette_go_to_the_face_they_lie_on():
 
 
 def test_a_large_objects_small_face_gets_its_plane():
-    # 2 mm cells: a face square to the camera at 1 m (286 columns) and a 14-column side turned away, 4.7% of
-    # the object's 60000 cells: under the 6% share, above the 1500 points asked at most
+    # 2 mm cells: a face square to the camera at 1 m (286 columns) and a 14-column side turned away, 4.7% of the
+    # object's 60000 cells: under the 6% share asked under heavy noise, above the 1500 points asked at most
     i, j = np.mgrid[0:200, 0:300]
     z = np.where(j < 286, 1.0, 1.0 + (j - 286) * 0.002)
     xyz = np.stack([j * 0.002 * z, i * 0.002 * z, z], -1).astype(np.float32)
     grid = PointGrid(xyz, np.zeros_like(xyz), np.ones(z.shape, bool), 1)
     obj = np.ones(z.shape, bool)
-    planes = object_planes(grid, obj, seed=0)
+    planes = object_planes(grid, obj, seed=0, min_frac=0.06)
     assert len(planes) == 2
     side = min(planes, key=lambda p: np.count_nonzero(p.mask))
     assert np.all(side.mask[:, 290:]) and not np.any(side.mask[:, :284])
     assert _angle(side.plane, refine(xyz[:, 287:].reshape(-1, 3).astype(np.float64))) < 1
-    assert len(object_planes(grid, obj, seed=0, max_need=10 ** 9)) == 1  # a share alone: no plane for it
+    assert len(object_planes(grid, obj, seed=0, min_frac=0.06, max_need=10 ** 9)) == 1  # the share alone: none
+    assert len(object_planes(grid, obj, seed=0, max_need=10 ** 9)) == 2  # 3.5% asked where noise is not heavy
