@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from lv3d.camera import Intrinsics
+from lv3d.perception.cloud import PointGrid
 from lv3d.render.sampler import look_at
 from lv3d.rgbd import RGBD
 
@@ -65,3 +66,11 @@ def box_on_table(width=320, height=240, half=(0.05, 0.05), top=0.1, yaw_deg=30.0
 @pytest.fixture(scope="session")
 def box_frame():
     return box_on_table()
+
+
+def cell_grid(z: np.ndarray) -> PointGrid:
+    """A point grid of 2 mm cells seen straight on, at depths ``z`` (rows, cols) metres; every cell read, normals
+    left to be measured where needed (all zero)."""
+    i, j = np.mgrid[0:z.shape[0], 0:z.shape[1]]
+    xyz = np.stack([j * 0.002 * z, i * 0.002 * z, z], -1).astype(np.float32)
+    return PointGrid(xyz, np.zeros_like(xyz), np.ones(z.shape, bool), 1)

@@ -1,13 +1,13 @@
 import numpy as np
 
-from lv3d.perception.cloud import PointGrid, crop_normals, point_grid, remove_flying, slope_noise
+from lv3d.perception.cloud import crop_normals, point_grid, remove_flying, slope_noise
 from lv3d.perception.depth import depth_scene
 from lv3d.perception.objects import heavy_noise, segment_objects, support_band
 from lv3d.perception.planes import outward_normal
 from lv3d.perception.support import support_plane
 from lv3d.plane import dihedral_deg
 
-from .conftest import box_on_table
+from .conftest import box_on_table, cell_grid
 
 
 def _angle(a, b):
@@ -28,10 +28,9 @@ def test_back_projection_and_normals_of_a_flat_wall():
 def test_normals_within_an_object_leave_the_wall_behind_it_out():
     # 2 mm cells: a flat object at 1 m (columns 0-19) before a wall 0.3 m behind (20-39); one lone object cell on
     # the wall's side, with too few of its own around it
-    i, j = np.mgrid[0:30, 0:40]
+    j = np.mgrid[0:30, 0:40][1]
     z = np.where(j < 20, 1.0, 1.3)
-    grid = PointGrid(np.stack([j * 0.002 * z, i * 0.002 * z, z], -1).astype(np.float32),
-                     np.zeros((30, 40, 3), np.float32), np.ones((30, 40), bool), 1)
+    grid = cell_grid(z)
     obj = j < 20
     obj[15, 30] = True
     mixed = crop_normals(grid, 0, 0, 30, 40)

@@ -1,9 +1,10 @@
 import numpy as np
 
-from lv3d.perception.cloud import PointGrid
 from lv3d.perception.planes import DepthPlane, merge_strips, object_planes
 from lv3d.perception.support import refine
 from lv3d.plane import Plane
+
+from .conftest import cell_grid
 
 
 def _piece(mask: np.ndarray, depth_of_cell, rng: np.random.Generator, sigma_m: float = 0.002,
@@ -89,8 +90,7 @@ def test_points_along_the_silhouette_go_to_the_face_they_lie_on():
     n, top, ridge = 40, 10, 20
     i, j = np.mgrid[0:top + n, 0:n]
     z = np.where(i < top, 1.3, np.where(j < ridge, 1.0, 1.0 + (j - ridge) * 0.002))
-    xyz = np.stack([j * 0.002 * z, i * 0.002 * z, z], -1).astype(np.float32)
-    grid = PointGrid(xyz, np.zeros_like(xyz), np.ones(z.shape, bool), 1)  # normals measured where needed
+    grid = cell_grid(z)  # normals measured where needed
     planes = object_planes(grid, i >= top, seed=0)
     assert len(planes) == 2
     face_a, face_b = sorted(planes, key=lambda p: -abs(p.plane.n[2]))
@@ -104,15 +104,14 @@ def test_points_along_the_silhouette_go_to_the_face_they_lie_on():
 def test_a_large_objects_small_face_gets_its_plane():
     # 2 mm cells: a face square to the camera at 1 m (286 columns) and a 14-column side turned away, 4.7% of the
     # object's 60000 cells: under the 6% share asked under heavy noise, above the 1500 points asked at most
-    i, j = np.mgrid[0:200, 0:300]
+    j = np.mgrid[0:200, 0:300][1]
     z = np.where(j < 286, 1.0, 1.0 + (j - 286) * 0.002)
-    xyz = np.stack([j * 0.002 * z, i * 0.002 * z, z], -1).astype(np.float32)
-    grid = PointGrid(xyz, np.zeros_like(xyz), np.ones(z.shape, bool), 1)
+    grid = cell_grid(z)
     obj = np.ones(z.shape, bool)
     planes = object_planes(grid, obj, seed=0, min_frac=0.06)
     assert len(planes) == 2
     side = min(planes, key=lambda p: np.count_nonzero(p.mask))
     assert np.all(side.mask[:, 290:]) and not np.any(side.mask[:, :284])
-    assert _angle(side.plane, refine(xyz[:, 287:].reshape(-1, 3).astype(np.float64))) < 1
+    assert _angle(side.plane, refine(grid.xyz[:, 287:].reshape(-1, 3).astype(np.float64))) < 1
     assert len(object_planes(grid, obj, seed=0, min_frac=0.06, max_need=10 ** 9)) == 1  # the share alone: none
     assert len(object_planes(grid, obj, seed=0, max_need=10 ** 9)) == 2  # 3.5% asked where noise is not heavy
