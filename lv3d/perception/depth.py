@@ -20,8 +20,8 @@ from .snap import add_triple_corners, snap_polygons
 from .support import noise_threshold
 
 
-# the share of an object's points a plane needs (planes.object_planes), and under heavy depth noise
-_PLANE_SHARE = 0.035
+# the share of an object's points a plane needs under heavy depth noise (planes.object_planes' min_frac; its
+# default holds otherwise)
 _NOISY_PLANE_SHARE = 0.06
 
 
@@ -60,14 +60,14 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int = 
     # under heavy noise a small piece of an object is more often noise than a face: a plane needs a larger share
     # (3.5% lifts clean depth recall by 0.016-0.031 on dev seeds, but cost the hard preset up to 0.05 of precision;
     # docs/perception.md, session 27)
-    min_frac = _NOISY_PLANE_SHARE if heavy_noise(noise_rel) else _PLANE_SHARE
+    share = {"min_frac": _NOISY_PLANE_SHARE} if heavy_noise(noise_rel) else {}
     t3 = time.perf_counter()
     h, w = frame.shape
     results = []
     t_planes = t_boundary = 0.0
     for k, o in enumerate(objs):
         ta = time.perf_counter()
-        planes = object_planes(grid, o.mask, seed=seed + k, min_frac=min_frac)
+        planes = object_planes(grid, o.mask, seed=seed + k, **share)
         adj = plane_adjacency(planes)
         tb = time.perf_counter()
         polys = [mask_polygon(p.mask, stride, (h, w)) for p in planes]

@@ -34,16 +34,21 @@ def border_contact(mask: np.ndarray) -> float:
     return edge / max(1, np.count_nonzero(inner))
 
 
-def heavy_noise(noise_rel: float, rel_jump: float = 0.02, jump_sigmas: float = 3.0) -> bool:
+# a cut between objects: a depth jump over this share of the depth, at this many sigmas of the depth noise
+_REL_JUMP = 0.02
+_JUMP_SIGMAS = 3.0
+
+
+def heavy_noise(noise_rel: float, rel_jump: float = _REL_JUMP, jump_sigmas: float = _JUMP_SIGMAS) -> bool:
     """True when depth noise alone (``noise_rel``: sigma as a fraction of depth) makes neighbouring readings differ by
     over ``rel_jump`` of the depth at ``jump_sigmas`` standard deviations (of a difference of two readings)."""
     return jump_sigmas * np.sqrt(2.0) * noise_rel > rel_jump
 
 
 def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60, min_height_m: float = 0.015,
-                    rel_jump: float = 0.02, max_border: float = 0.12,
+                    rel_jump: float = _REL_JUMP, max_border: float = 0.12,
                     band_m: float | None = None, regrow: int = 5, noise_rel: float = 0.0,
-                    jump_sigmas: float = 3.0) -> list[DepthObject]:
+                    jump_sigmas: float = _JUMP_SIGMAS) -> list[DepthObject]:
     """Objects above ``support`` on the grid, largest first. Points within the noise band of the support plane
     or below it are removed; the rest splits at depth jumps larger than ``rel_jump`` * depth; pieces with fewer
     than ``min_points`` grid points, lower than ``min_height_m``, or cut by the image border along more than

@@ -41,30 +41,29 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     keeps strips and noise out (depth.py asks more under heavy depth noise), and ``max_need`` lets a large object's
     small face in (hexagonal prism 2003's 2179 px side is 4.4% of its 47690 cells; docs/perception.md, session 27)."""
     rng = np.random.default_rng(seed)
-    full_shape, full_mask = obj_mask.shape, obj_mask
     rows, cols = np.flatnonzero(obj_mask.any(axis=1)), np.flatnonzero(obj_mask.any(axis=0))
     if len(rows) == 0:
         return []
     # work on the object's bounding box of the grid: connected components there are cheap
     i0, j0, i1, j1 = rows[0], cols[0], rows[-1] + 1, cols[-1] + 1
-    obj_mask = obj_mask[i0:i1, j0:j1]
-    pts = grid.xyz[i0:i1, j0:j1][obj_mask].astype(np.float64)
+    box = obj_mask[i0:i1, j0:j1]
+    pts = grid.xyz[i0:i1, j0:j1][box].astype(np.float64)
     nrm_grid = grid.normals[i0:i1, j0:j1]
     if not nrm_grid.any():
         # from the object's points alone: along its silhouette, normals mixed with the table's points agree with
         # none of its faces, and the score below gave a face's silhouette strip to its neighbour (tetrahedron 1005,
         # clean dev seed 1000: the side's outline took in a wedge of the next face, IoU 0.43; docs/perception.md,
         # session 27)
-        nrm_grid = crop_normals(grid, i0, j0, i1, j1, within=full_mask)
-    nrm = nrm_grid[obj_mask].astype(np.float64)
+        nrm_grid = crop_normals(grid, i0, j0, i1, j1, within=obj_mask)
+    nrm = nrm_grid[box].astype(np.float64)
     if len(pts) < min_points:
         return []
     dist_m = noise_threshold(float(np.median(pts[:, 2])))
     need = max(min_points, min(int(min_frac * len(pts)), max_need))
     free = np.ones(len(pts), bool)
-    h, w = obj_mask.shape
+    h, w = box.shape
     planes: list[Plane] = []
-    flat = np.flatnonzero(obj_mask)  # the object's cells as flat indices, in the order of ``pts``
+    flat = np.flatnonzero(box)  # the object's cells as flat indices, in the order of ``pts``
     for _ in range(max_planes):
         idx = np.nonzero(free)[0]
         if len(idx) < need:
@@ -73,7 +72,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
         m = np.zeros((h, w), bool)
         m.flat[flat[idx[inl]]] = True
         piece = _largest_piece(m)
-        sel = piece[obj_mask] & free
+        sel = piece[box] & free
         if np.count_nonzero(sel) < need:
             break
         plane = refine(pts[sel])
@@ -93,7 +92,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
         m = np.zeros((h, w), bool)
         m.flat[flat[ok & (best == k)]] = True
         m = _largest_piece(m)
-        sel = m[obj_mask]
+        sel = m[box]
         if np.count_nonzero(sel) < need:
             continue
         p = refine(pts[sel])
@@ -101,7 +100,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
         pieces.append(DepthPlane(p, m, pts[sel].astype(np.float32), rms))
     out = []
     for d in merge_strips(pieces, dist_m):
-        full = np.zeros(full_shape, bool)
+        full = np.zeros(obj_mask.shape, bool)
         full[i0:i1, j0:j1] = d.mask
         out.append(DepthPlane(d.plane, full, d.points, d.rms_m))
     out.sort(key=lambda d: -np.count_nonzero(d.mask))

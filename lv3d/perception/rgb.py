@@ -1,5 +1,6 @@
 """Faces from colour alone: edges -> segments -> planar graph -> bounded minimal cycles -> validated polygons,
-plus the thin faces beside them that the graph cannot trace (thin.py), grouped into objects by shared edges."""
+plus the thin faces beside them that the graph cannot trace (thin.py) and, colour alone, the parts of the solids'
+silhouettes that no face covers (untraced.py), grouped into objects by shared edges."""
 
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from .silhouette import foreground, regions_of, silhouette_segments
 from .split import reflex_corners, split_by_diagonal, split_concave
 from .step_edge import fork_cut, smoothed_gradients, step_cut, step_lines
 from .thin import thin_faces
+from .untraced import untraced_faces
 
 
 @dataclass(frozen=True)
@@ -108,7 +110,10 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     traced whole, or a concave traced outline before it is split, is cut along a faint straight edge from one of its
     corners (step_edge.step_cut), and a convex one that no such line cuts is cut at a fork of three faint edges from
     three of its corners (step_edge.fork_cut: a solid showing three faces of one colour): most colour-only
-    misses on noisy renders are corners the segments stop short of and two faces of one colour traced as one. Faces
+    misses on noisy renders are corners the segments stop short of and two faces of one colour traced as one. The
+    parts of the silhouettes left outside every face, each of a colour of its own or a whole solid none of whose
+    faces was traced, are then faces too (untraced.untraced_faces: slivers whose corners the graph collapsed; clean
+    rgb recall rose on 4 of 6 dev seeds and fell on none; docs/perception.md, session 28). Faces
     of the colour of the image's border (floor texture, shadows, painted lines) are then dropped
     (background.background_faces): most false colour-only faces on noisy renders are such; those much smoother than
     the floor of their hue are kept (background.smooth_faces: an object of the table's hue). With depth (rgbd), the
@@ -139,11 +144,11 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     frame = (0, 0, cw - 1, ch - 1)
     cands = []
     # made-up edge keys (k, k), k < 0: a cut the graph lacks, shared by the parts either side of it (so that they
-    # count as neighbours), or a thin face's contact with the faces beside it (_thin_cands)
+    # count as neighbours), or a thin face's contact with the faces beside it (_touching_cands)
     made_up = ((k, k) for k in itertools.count(-1, -1))
     # made-up keys of cuts along an image edge (split_by_diagonal, step_cut, fork_cut): never joined back
     image_cuts = set()
-    measured = {}  # index in cands -> step_edge.StepLines of a whole traced face, when measured already
+    measured = {}  # index in cands -> step_edge.StepLines (or None: none) of a whole traced face, when measured
     for f in bounded_faces(g):
         traced_area = area(f.polygon)
         if traced_area < min_area_px or traced_area > max_area_frac * w * h:
@@ -162,7 +167,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         # Canny's gradient, which the faint edge is under. Stricter than step_cut on whole faces (a step 10 times its
         # control, 12 clear samples: a short edge ending on a side keeps few); the parts, their corners found again,
         # are then split as before (docs/perception.md, session 23)
-        lines = step_lines(poly, sgrads) if colour_alone and reflex_corners(poly) else None
+        concave = colour_alone and bool(reflex_corners(poly))
+        lines = step_lines(poly, sgrads) if concave else None
         stepped = step_cut(poly, sgrads, min_area_px, rel_step=10.0, min_samples=12, lines=lines) \
             if lines is not None else None
         pieces = [q for part in (map(_outline, stepped) if stepped else [poly])
@@ -171,7 +177,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         if len(pieces) == 1:
             pieces = split_by_diagonal(poly, grad, min_area_px)
         if len(pieces) == 1:
-            measured[len(cands)] = lines  # step_cut tests these lines again below, as a whole face
+            if concave:
+                measured[len(cands)] = lines  # step_cut tests these lines again below, as a whole face
             cands.append((poly, f.edges, sup, a, True))
             continue
         # the cut is an edge the graph lacks: a shared made-up edge key makes the parts neighbours
@@ -196,9 +203,10 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
             continue
         parts = None
         if colour_alone and whole:
-            lines = measured.get(i) or step_lines(poly, sgrads)
-            parts = step_cut(poly, sgrads, min_area_px, lines=lines)
-            if parts is None:
+            lines = measured[i] if i in measured else step_lines(poly, sgrads)
+            # no line to cut along (step_lines found none): step_cut would find none either
+            parts = step_cut(poly, sgrads, min_area_px, lines=lines) if lines is not None else None
+            if parts is None and lines is not None:
                 # a short faint edge keeps few clear samples; it is taken with 10 when it steps 10 times its control
                 # (a small face of one colour with its neighbour: triangular prism 1002's 509 px face, 10 samples,
                 # a step 89 times its control; docs/perception.md, session 26)
@@ -213,8 +221,11 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         kept += [_part(q, es, cut, g.vertices, dist) for q in map(_outline, parts)]
     cands = _join_on_graph_edges(kept, g.vertices, dist, image_cuts)
     n_traced = len(cands)
-    cands += _thin_cands(cands, segs, dist, min_area_px, made_up)
+    cands += _touching_cands(cands, thin_faces(segs, dist, [c[0] for c in cands], min_area_px), dist, made_up)
     cands = _join_thin_to_traced(cands, n_traced, dist)
+    if colour_alone:
+        untraced = untraced_faces(solids, [c[0] for c in cands], dist, crop, min_area_px, max_area_frac * w * h)
+        cands += _touching_cands(cands, untraced, dist, made_up)
     hues = [None] * len(cands)  # each face's chromaticity, for background_faces and _same_solid (colour alone)
     if colour_alone and cands:
         hues = [face_chromaticity(np.asarray(c[0], np.float64), chroma) for c in cands]
@@ -340,13 +351,12 @@ def _touch_length(a: np.ndarray, b: np.ndarray, tol_px: float) -> float:
     return float(np.count_nonzero(d <= tol_px))
 
 
-def _thin_cands(cands: list, segs: np.ndarray, dist: np.ndarray, min_area_px: float, made_up,
-                touch_px: float = 2.5) -> list:
-    """Thin faces (thin.py) beside the kept candidates, as candidates: each shares a made-up edge key (the next of
-    ``made_up``) with every candidate whose outline runs within ``touch_px`` of its own, so that they group and
-    count as neighbours."""
+def _touching_cands(cands: list, polys: list[np.ndarray], dist: np.ndarray, made_up, touch_px: float = 2.5) -> list:
+    """Faces found beside the kept candidates (``polys``: thin.py's slivers, untraced.py's parts of a silhouette),
+    as candidates: each shares a made-up edge key (the next of ``made_up``) with every candidate whose outline runs
+    within ``touch_px`` of its own, so that they group and count as neighbours."""
     out = []
-    for q in thin_faces(segs, dist, [c[0] for c in cands], min_area_px):
+    for q in polys:
         key = next(made_up)
         pts = sample_boundary(q, 1.0)
         for n, c in enumerate(cands):

@@ -19,7 +19,7 @@ from .polygons import (area, clockwise, distance_to_segments, is_simple, mean_wi
                        sample_boundary)
 
 
-def _outline_distance(polys: list[np.ndarray], shape: tuple[int, int]) -> np.ndarray:
+def outline_distance_map(polys: list[np.ndarray], shape: tuple[int, int]) -> np.ndarray:
     """Distance (H, W) float32 in pixels from each pixel to the nearest outline of ``polys`` (one distance
     transform: looked up for many points, far cheaper than a point-polygon test each)."""
     lines = np.zeros(shape, np.uint8)
@@ -105,7 +105,7 @@ def thin_faces(segs: np.ndarray, dist: np.ndarray, found: list[np.ndarray], min_
     shape = dist.shape
     corners = np.unique(np.round(np.concatenate(found, axis=0), 3), axis=0)
     occupied = None  # the found polygons' pixels, drawn only once a sliver gets that far
-    to_found = _outline_distance(found, shape)
+    to_found = outline_distance_map(found, shape)
     length = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
     # a segment with no found corner near its line and extent bounds no sliver, alone or kinked: skip it early
     u = (segs[:, 2:] - segs[:, :2]) / np.maximum(length, 1e-9)[:, None]
