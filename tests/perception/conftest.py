@@ -1,5 +1,6 @@
 """Small scenes made by the test code itself: a box on a table, ray-cast analytically."""
 
+import cv2
 import numpy as np
 import pytest
 
@@ -74,3 +75,22 @@ def cell_grid(z: np.ndarray) -> PointGrid:
     i, j = np.mgrid[0:z.shape[0], 0:z.shape[1]]
     xyz = np.stack([j * 0.002 * z, i * 0.002 * z, z], -1).astype(np.float32)
     return PointGrid(xyz, np.zeros_like(xyz), np.ones(z.shape, bool), 1)
+
+
+# a box drawn in colour with a sliver of a right face, 6-8 px wide, seen nearly edge-on (corners in pixels)
+A, B, C, D, E, F, F2 = (150, 30), (240, 60), (231, 100), (140, 70), (140, 170), (230, 200), (236, 200)
+TOP, FRONT, SLIVER = np.array([A, B, C, D], float), np.array([D, C, F, E], float), np.array([B, F2, F, C], float)
+
+
+def sliver_box(with_sliver: bool = True, table: bool = False) -> np.ndarray:
+    """(240, 320, 3) uint8: the box's TOP, FRONT and (``with_sliver``) SLIVER on a grey floor, on a green table
+    around it with ``table``; Gaussian noise of sigma 2, seeded."""
+    img = np.full((240, 320, 3), (200, 200, 190), np.uint8)
+    if table:
+        cv2.fillPoly(img, [np.array([(100, 15), (290, 15), (290, 220), (100, 220)], np.int32)], (60, 150, 60))
+    cv2.fillPoly(img, [TOP.astype(np.int32)], (200, 60, 60))
+    cv2.fillPoly(img, [FRONT.astype(np.int32)], (140, 40, 40))
+    if with_sliver:
+        cv2.fillPoly(img, [SLIVER.astype(np.int32)], (90, 20, 20))
+    noise = np.random.default_rng(0).normal(0.0, 2.0, img.shape)
+    return np.clip(img + noise, 0, 255).astype(np.uint8)

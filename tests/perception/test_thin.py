@@ -5,19 +5,8 @@ from lv3d.perception.edges import channel_edges, channels, edge_distance
 from lv3d.perception.polygons import rasterize
 from lv3d.perception.thin import thin_faces
 
-# a box drawn with a sliver of a right face, 6-8 px wide, seen nearly edge-on
-A, B, C, D, E, F, F2 = (150, 30), (240, 60), (231, 100), (140, 70), (140, 170), (230, 200), (236, 200)
-TOP, FRONT, SLIVER = np.array([A, B, C, D], float), np.array([D, C, F, E], float), np.array([B, F2, F, C], float)
-
-
-def _image(with_sliver: bool = True) -> np.ndarray:
-    img = np.full((240, 320, 3), (200, 200, 190), np.uint8)
-    cv2.fillPoly(img, [TOP.astype(np.int32)], (200, 60, 60))
-    cv2.fillPoly(img, [FRONT.astype(np.int32)], (140, 40, 40))
-    if with_sliver:
-        cv2.fillPoly(img, [SLIVER.astype(np.int32)], (90, 20, 20))
-    noise = np.random.default_rng(0).normal(0.0, 2.0, img.shape)
-    return np.clip(img + noise, 0, 255).astype(np.uint8)
+from .conftest import B, C, F, F2, FRONT, SLIVER, TOP
+from .conftest import sliver_box as _image
 
 
 def _dist(img: np.ndarray) -> np.ndarray:

@@ -6,22 +6,8 @@ from lv3d.perception.polygons import rasterize
 from lv3d.perception.silhouette import foreground
 from lv3d.perception.untraced import untraced_faces
 
-# a box with a sliver of a right face, 6-8 px wide, seen nearly edge-on (as in test_thin)
-A, B, C, D, E, F, F2 = (150, 30), (240, 60), (231, 100), (140, 70), (140, 170), (230, 200), (236, 200)
-TOP, FRONT, SLIVER = np.array([A, B, C, D], float), np.array([D, C, F, E], float), np.array([B, F2, F, C], float)
-FLOOR = (200, 200, 190)
-
-
-def _image(with_sliver: bool = True, table: bool = False) -> np.ndarray:
-    img = np.full((240, 320, 3), FLOOR, np.uint8)
-    if table:
-        cv2.fillPoly(img, [np.array([(100, 15), (290, 15), (290, 220), (100, 220)], np.int32)], (60, 150, 60))
-    cv2.fillPoly(img, [TOP.astype(np.int32)], (200, 60, 60))
-    cv2.fillPoly(img, [FRONT.astype(np.int32)], (140, 40, 40))
-    if with_sliver:
-        cv2.fillPoly(img, [SLIVER.astype(np.int32)], (90, 20, 20))
-    noise = np.random.default_rng(0).normal(0.0, 2.0, img.shape)
-    return np.clip(img + noise, 0, 255).astype(np.uint8)
+from .conftest import A, B, C, D, E, F, F2, FRONT, SLIVER, TOP
+from .conftest import sliver_box as _image
 
 
 def _run(img: np.ndarray, found: list[np.ndarray], **kw) -> list[np.ndarray]:
