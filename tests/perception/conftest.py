@@ -94,3 +94,8 @@ def sliver_box(with_sliver: bool = True, table: bool = False) -> np.ndarray:
         cv2.fillPoly(img, [SLIVER.astype(np.int32)], (90, 20, 20))
     noise = np.random.default_rng(0).normal(0.0, 2.0, img.shape)
     return np.clip(img + noise, 0, 255).astype(np.uint8)
+
+
+def mask_iou(a: np.ndarray, b: np.ndarray) -> float:
+    """Intersection over union of two (H, W) bool masks."""
+    return float(np.count_nonzero(a & b) / np.count_nonzero(a | b))

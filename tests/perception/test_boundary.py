@@ -4,9 +4,7 @@ import numpy as np
 from lv3d.perception.boundary import mask_polygon
 from lv3d.perception.polygons import rasterize
 
-
-def _iou(a: np.ndarray, b: np.ndarray) -> float:
-    return float(np.count_nonzero(a & b) / np.count_nonzero(a | b))
+from .conftest import mask_iou as _iou
 
 
 def test_an_edge_on_face_keeps_the_corners_that_hold_its_area():

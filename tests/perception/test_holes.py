@@ -5,6 +5,8 @@ from lv3d.perception.edges import channel_edges, channels, edge_distance
 from lv3d.perception.holes import hole_faces
 from lv3d.perception.polygons import rasterize
 
+from .conftest import mask_iou as _iou
+
 SHAPE = (200, 240)
 # the object's faces that depth saw, and beside them a strip seen nearly edge-on, with no depth reading
 OBJECT = np.array([(80, 40), (180, 50), (175, 160), (85, 150)], float)
@@ -17,10 +19,6 @@ def _dist(strip_colour=(60, 20, 20)) -> np.ndarray:
     cv2.fillPoly(img, [STRIP.astype(np.int32)], strip_colour)
     img = np.clip(img + np.random.default_rng(0).normal(0.0, 2.0, img.shape), 0, 255).astype(np.uint8)
     return edge_distance(np.maximum.reduce([channel_edges(c).edges for c in channels(img)]))
-
-
-def _iou(a: np.ndarray, b: np.ndarray) -> float:
-    return np.count_nonzero(a & b) / np.count_nonzero(a | b)
 
 
 def test_hole_beside_the_object_on_colour_edges_is_a_face():

@@ -4,13 +4,13 @@ import numpy as np
 from lv3d.perception.polygons import rasterize
 from lv3d.perception.rgb import rgb_faces
 
+from .conftest import mask_iou
+
 
 def _best_iou(res, poly, shape):
     """The best IoU of any face found in ``res`` with polygon ``poly``, both rasterised on an image of ``shape``."""
     want = rasterize(poly, shape)
-    ious = [np.count_nonzero(got & want) / np.count_nonzero(got | want)
-            for got in (rasterize(f.polygon, shape) for f in res.faces)]
-    return max(ious, default=0.0)
+    return max((mask_iou(rasterize(f.polygon, shape), want) for f in res.faces), default=0.0)
 
 
 def _canvas():

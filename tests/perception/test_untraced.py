@@ -7,6 +7,7 @@ from lv3d.perception.silhouette import foreground
 from lv3d.perception.untraced import untraced_faces
 
 from .conftest import A, B, C, D, E, F, F2, FRONT, SLIVER, TOP
+from .conftest import mask_iou
 from .conftest import sliver_box as _image
 
 
@@ -16,8 +17,7 @@ def _run(img: np.ndarray, found: list[np.ndarray], **kw) -> list[np.ndarray]:
 
 
 def _iou(poly: np.ndarray, truth: np.ndarray) -> float:
-    a, b = rasterize(poly, (240, 320)), rasterize(truth, (240, 320))
-    return np.count_nonzero(a & b) / np.count_nonzero(a | b)
+    return mask_iou(rasterize(poly, (240, 320)), rasterize(truth, (240, 320)))
 
 
 def test_sliver_of_its_own_shade_beside_found_faces_is_what_the_silhouette_has_left():
