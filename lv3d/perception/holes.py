@@ -9,21 +9,34 @@ face's own edges, on the object's side (the neighbour face) and on the table's. 
 it is a convex region (its polygon covers it and nothing more), runs along the object for a good part of its
 outline, and its outline lies on colour edges (a hole of missing readings on a plain surface, as sensors also
 leave, has no edge along the part of its outline that crosses the table or the object).
+
+Depth alone (:func:`unread_faces`) has no colour to confirm a hole with, but the readings around it: they stop at
+the face's own edges, so the points just outside a hole that is an unread face lie on one plane, the face's, and
+that plane is seen nearly edge-on (which is why the sensor read nothing there). A blob of missing readings on the
+table or on a face has that surface's plane around it instead, and one inside the object is surrounded by it,
+where a face seen edge-on lies along the object's silhouette.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import cv2
 import numpy as np
 
+from ..plane import Plane
 from ..rgbd import RGBD
 from ..scene import Face
 from .boundary import grow_convex
+from .cloud import PointGrid
 from .edges import edge_support
 from .polygons import area, clockwise, drop_short_sides, rasterize
+from .support import noise_threshold, ransac_plane
 
 
 _FILL = (0.85, 1.15)  # region area over its polygon's area: a convex region that the polygon describes
+# a plane seen within this angle of face-on is one the sensor reads: a RealSense reads to about 78 degrees
+_UNREAD_DEG = 70.0
 
 
 def hole_faces(no_reading: np.ndarray, object_px: np.ndarray, edge_dist: np.ndarray, min_area_px: float = 150.0,
@@ -33,10 +46,19 @@ def hole_faces(no_reading: np.ndarray, object_px: np.ndarray, edge_dist: np.ndar
 
     ``no_reading``: (H, W) bool, pixels without a depth reading; ``object_px``: (H, W) bool, the depth object's
     pixels; ``edge_dist``: (H, W) float, distance (px) to the nearest colour edge pixel. A hole qualifies when
-    its area is at least ``min_area_px``, at least ``min_contact`` of its outline pixels touch the object, it
-    does not touch the crop's border (the object or the hole is cut off there), its area over its polygon's is
-    within ``fill`` (a convex region), and at least ``min_support`` of its polygon's outline is on colour
-    edges."""
+    it is one of :func:`hole_regions` (``min_area_px``, ``min_contact``, ``fill``) and at least ``min_support`` of
+    its polygon's outline is on colour edges."""
+    return [poly for poly, _ in hole_regions(no_reading, object_px, min_area_px, min_contact, fill)
+            if edge_support(poly, edge_dist) >= min_support]
+
+
+def hole_regions(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float = 150.0,
+                 min_contact: float = 0.25, fill: tuple[float, float] = _FILL) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The holes in the depth image (H, W) that may be faces, as (polygon (n, 2) pixels clockwise, region (H, W)
+    bool): connected regions of ``no_reading`` outside ``object_px`` (both (H, W) bool) of at least
+    ``min_area_px``, at least ``min_contact`` of whose outline pixels touch the object, not touching the crop's
+    border (the object or the hole is cut off there), whose area over their polygon's is within ``fill`` (a
+    convex region)."""
     h, w = no_reading.shape
     near_obj = cv2.dilate(object_px.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
     n, lab, stats, _ = cv2.connectedComponentsWithStats((no_reading & ~object_px).astype(np.uint8), connectivity=8)
@@ -56,10 +78,75 @@ def hole_faces(no_reading: np.ndarray, object_px: np.ndarray, edge_dist: np.ndar
         poly += np.array([x, y], float)
         if not fill[0] <= a / max(area(poly), 1e-9) <= fill[1]:
             continue
-        if edge_support(poly, edge_dist) < min_support:
-            continue
-        out.append(poly)
+        out.append((poly, lab == k))
     return out
+
+
+class UnreadFace(NamedTuple):
+    """A face depth did not read (:func:`unread_faces`): its ``polygon`` (n, 2) pixels, the ``plane`` through its
+    rim, the rim ``points`` (m, 3) metres on that plane, their RMS distance ``rms_m`` to it, and the indices of the
+    object's planes it meets (``neighbours``)."""
+
+    polygon: np.ndarray
+    plane: Plane
+    points: np.ndarray
+    rms_m: float
+    neighbours: list[int]
+
+
+def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plane_masks: list[np.ndarray],
+                 known: list[Plane], box: tuple[int, int, int, int], min_graze_deg: float = _UNREAD_DEG,
+                 min_apart_deg: float = 20.0, min_on_plane: float = 0.6, min_rim: int = 30,
+                 max_on_object: float = 0.55, min_contact: int = 4, seed: int = 0) -> list[UnreadFace]:
+    """Faces of one object that depth alone infers from the holes beside it (:func:`hole_regions`) where no
+    colour confirms them: the readings stop at a face's own edges, on the object's neighbouring faces and on the
+    table, so the points just outside a hole that is an unread face lie on the face's plane. A hole is taken for
+    a face when at least ``min_on_plane`` of its rim points (read pixels within 2 px of it, at least ``min_rim``)
+    lie on one plane (RANSAC within the noise threshold of their depth) that is seen at ``min_graze_deg`` or more
+    from face-on (a plane the sensor reads well cannot be the reason for a hole: a blob of missing readings on a
+    face or on the table has that face's or the table's plane as its rim) and stands at least ``min_apart_deg``
+    from every plane in ``known`` (the object's planes and the support). ``depth``: (H, W) metres (0 = no
+    reading); ``grid``: its point grid; ``object_px``: (v1 - v0, u1 - u0) bool, the object's pixels in ``box`` =
+    (u0, v0, u1, v1); ``plane_masks``: the object's planes' grid masks, for the planes each face meets (at least
+    ``min_contact`` rim points on a plane's mask). Polygons are in full-frame pixels."""
+    u0, v0, u1, v1 = box
+    crop = depth[v0:v1, u0:u1]
+    read = np.isfinite(crop) & (crop > 0)
+    rng = np.random.default_rng(seed)
+    s = grid.stride
+    out = []
+    for poly, region in hole_regions(~read, object_px):
+        around = cv2.dilate(region.astype(np.uint8), np.ones((5, 5), np.uint8)).astype(bool) & ~region
+        if np.count_nonzero(around & object_px) > max_on_object * np.count_nonzero(around):
+            continue
+        rim = around & read
+        vv, uu = np.nonzero(rim)
+        i, j = np.minimum((vv + v0) // s, grid.shape[0] - 1), np.minimum((uu + u0) // s, grid.shape[1] - 1)
+        ok = grid.valid[i, j]
+        if np.count_nonzero(ok) < min_rim:
+            continue
+        i, j = i[ok], j[ok]
+        pts = grid.xyz[i, j].astype(np.float64)
+        plane, inl = ransac_plane(pts, noise_threshold(float(np.median(pts[:, 2]))), rng)
+        if np.count_nonzero(inl) < min_on_plane * len(pts):
+            continue
+        centre = pts[inl].mean(axis=0)
+        if _angle_deg(plane.n, centre) < min_graze_deg:
+            continue
+        if any(_angle_deg(plane.n, q.n) < min_apart_deg or _angle_deg(plane.n, q.n) > 180 - min_apart_deg
+               for q in known):
+            continue
+        on = pts[inl]
+        rms = float(np.sqrt(np.mean(plane.distance(on) ** 2)))
+        meets = [k for k, m in enumerate(plane_masks) if np.count_nonzero(m[i[inl], j[inl]]) >= min_contact]
+        out.append(UnreadFace(poly + np.array([u0, v0], float), plane, on, rms, meets))
+    return out
+
+
+def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle (degrees, 0 to 90) between the lines along vectors ``a`` and ``b``."""
+    c = abs(float(a @ b)) / max(float(np.linalg.norm(a) * np.linalg.norm(b)), 1e-12)
+    return float(np.degrees(np.arccos(min(1.0, c))))
 
 
 def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[int], frame: RGBD,

@@ -16,7 +16,7 @@ from .boundary import grid_to_pixels
 from .confirm import replace_unconfirmed, unconfirmed
 from .face_plane import angle_deg, fit_face_plane
 from .fuse import match_faces
-from .holes import add_hole_faces
+from .holes import add_hole_faces, unread_faces
 from .plane_outline import simplify_on_plane
 from .polygons import area, rasterize
 from .rgb import RGBFace, rgb_faces
@@ -43,7 +43,7 @@ def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 
     dres = depth_scene(frame, seed=seed)
     scene = Scene(scene_id, modality, frame.intrinsics, support_plane=dres.support, timings_ms=dict(dres.timings_ms))
     if modality == "depth":
-        scene.objects = [_depth_object(scene_id, k + 1, o, dres) for k, o in enumerate(dres.objects)]
+        scene.objects = [_depth_object(scene_id, k + 1, o, dres, frame) for k, o in enumerate(dres.objects)]
         return scene
     scene.objects = _fused_objects(frame, scene_id, dres, scene.timings_ms)
     if not scene.objects:
@@ -113,7 +113,9 @@ def _object_pixels(o: DepthObjectResult, stride: int) -> tuple[int, tuple[float,
     return int(len(ij) * stride * stride), (float(ij[:, 1].mean() * stride), float(ij[:, 0].mean() * stride))
 
 
-def _depth_object(scene_id: str, k: int, o: DepthObjectResult, dres: DepthResult) -> SceneObject:
+def _depth_object(scene_id: str, k: int, o: DepthObjectResult, dres: DepthResult, frame: RGBD) -> SceneObject:
+    """The object's planes as faces, and the faces beside it that depth did not read (holes.unread_faces: on
+    realsense renders most faces depth alone missed had no reading at all, docs/perception.md, session 29)."""
     stride = dres.grid.stride
     faces, index = [], {}
     for i, (p, poly) in enumerate(zip(o.planes, o.polygons)):
@@ -122,6 +124,16 @@ def _depth_object(scene_id: str, k: int, o: DepthObjectResult, dres: DepthResult
         index[i] = face_id(scene_id, k, len(faces) + 1)
         faces.append(Face(index[i], poly, "depth", plane=p.plane, points=p.points, plane_rms_m=p.rms_m))
     adj = [(index[a], index[b]) for a, b in o.adjacency if a in index and b in index]
+    h, w = frame.shape
+    u0, v0, u1, v1 = o.box_px
+    box = (max(0, u0 - _CROP_MARGIN_PX), max(0, v0 - _CROP_MARGIN_PX),
+           min(w, u1 + _CROP_MARGIN_PX), min(h, v1 + _CROP_MARGIN_PX))
+    known = [p.plane for p in o.planes] + ([dres.support] if dres.support is not None else [])
+    for f in unread_faces(frame.depth, dres.grid, grid_to_pixels(o.obj.mask, stride, box),
+                          [p.mask for p in o.planes], known, box, seed=k):
+        fid = face_id(scene_id, k, len(faces) + 1)
+        faces.append(Face(fid, f.polygon, "depth", plane=f.plane, points=f.points, plane_rms_m=f.rms_m))
+        adj += [(index[a], fid) for a in f.neighbours if a in index]
     count, centroid = _object_pixels(o, stride)
     return SceneObject(object_id(scene_id, k), faces, adj, count, centroid)
 

@@ -90,3 +90,69 @@ def test_a_face_that_swallowed_the_hole_gives_it_up_and_one_that_is_the_hole_kee
     faces = [Face("", OBJECT, "rgb"), Face("", STRIP, "rgb")]
     assert add_hole_faces(faces, set(), [0, 1], frame, box, obj, _dist()) == []
     assert np.array_equal(faces[1].polygon, STRIP)
+
+
+def _grazing_cuboid(grazing_deg: float = 78.0):
+    """A cuboid one of whose faces (truth id 5, 4254 px) is seen beyond 78 degrees from face-on: a sensor that
+    reads no further leaves it without a reading. Returns the frame and its face-id mask (k = truth face k - 1)."""
+    from lv3d.render import render_scene
+    from lv3d.render.noise import noise_config
+
+    return render_scene("cuboid", 2001, noise=noise_config("clean", grazing_deg=grazing_deg))
+
+
+def test_face_depth_did_not_read_is_found_from_its_rim_with_its_plane_and_neighbours():
+    from lv3d.perception import perceive
+
+    frame, faces = _grazing_cuboid()
+    unread = faces == 6
+    assert not np.any(frame.depth[unread] > 0)
+    normal = np.asarray(frame.meta["truth"]["faces"][2]["plane"]["normal"])
+    (obj,) = [o for o in perceive(frame, "depth").objects if o.faces]
+    ious = [_iou(rasterize(f.polygon, unread.shape), unread) for f in obj.faces]
+    face = obj.faces[int(np.argmax(ious))]
+    assert max(ious) >= 0.85 and face.sides == 4 and face.provenance == "depth"
+    assert np.degrees(np.arccos(min(1.0, abs(face.plane.n @ normal)))) < 3.0
+    # it meets both faces depth read
+    assert sum(face.id in pair for pair in obj.adjacency) == 2
+
+
+def _unread(frame, **checks) -> list:
+    """holes.unread_faces beside the largest depth object of ``frame``."""
+    from lv3d.perception.boundary import grid_to_pixels
+    from lv3d.perception.depth import depth_scene
+    from lv3d.perception.holes import unread_faces
+
+    dres = depth_scene(frame)
+    o = dres.objects[0]
+    (h, w), (u0, v0, u1, v1) = frame.shape, o.box_px
+    box = (max(0, u0 - 14), max(0, v0 - 14), min(w, u1 + 14), min(h, v1 + 14))
+    known = [p.plane for p in o.planes] + [dres.support]
+    return unread_faces(frame.depth, dres.grid, grid_to_pixels(o.obj.mask, dres.grid.stride, box),
+                        [p.mask for p in o.planes], known, box, **checks)
+
+
+def test_missing_readings_on_the_table_or_inside_a_face_are_no_face():
+    from dataclasses import replace
+
+    frame, faces = _grazing_cuboid(grazing_deg=90.0)  # every face read
+    solid = faces > 0
+    depth = frame.depth.copy()
+    # a blob on the table against the object's left side: its rim is mostly the table
+    outside = cv2.distanceTransform((~solid).astype(np.uint8), cv2.DIST_L2, 5)
+    vs, us = np.nonzero(solid)
+    band = np.argwhere((outside > 4.5) & (outside < 5.5))
+    band = band[band[:, 1] < us.mean()]
+    v, u = band[np.argmin(np.abs(band[:, 0] - vs.mean()))]
+    cv2.circle(depth, (int(u), int(v)), 9, 0.0, -1)
+    # a blob inside the largest face: the object surrounds it
+    inside = cv2.distanceTransform((faces == 3).astype(np.uint8), cv2.DIST_L2, 5)
+    v, u = np.unravel_index(int(np.argmax(inside)), inside.shape)
+    cv2.circle(depth, (int(u), int(v)), 8, 0.0, -1)
+    blotted = replace(frame, depth=depth)
+    assert _unread(blotted) == []
+    # both are holes beside the object: the plane of their rims tells them from faces, and the object around the
+    # second does on its own
+    (table,) = _unread(blotted, min_graze_deg=0.0, min_apart_deg=0.0)
+    assert solid[int(table.polygon[:, 1].mean()), int(table.polygon[:, 0].mean())] == 0
+    assert len(_unread(blotted, min_graze_deg=0.0, min_apart_deg=0.0, max_on_object=1.0)) == 2
