@@ -14,7 +14,10 @@ Depth alone (:func:`unread_faces`) has no colour to confirm a hole with, but the
 the face's own edges, so the points just outside a hole that is an unread face lie on one plane, the face's, and
 that plane is seen nearly edge-on (which is why the sensor read nothing there). A blob of missing readings on the
 table or on a face has that surface's plane around it instead, and one inside the object is surrounded by it,
-where a face seen edge-on lies along the object's silhouette.
+where a face seen edge-on lies along the object's silhouette. Geometry cannot tell such a face from a sensor's
+occlusion shadow (a band the projector does not light beside an object, which the renders do not model and real
+Kinect frames show): with colour (rgbd) an unread face is kept only where colour edges run along more than the
+object's side of it (:func:`add_hole_faces`).
 """
 
 from __future__ import annotations
@@ -97,49 +100,114 @@ class UnreadFace(NamedTuple):
 def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plane_masks: list[np.ndarray],
                  known: list[Plane], box: tuple[int, int, int, int], min_graze_deg: float = _UNREAD_DEG,
                  min_apart_deg: float = 20.0, min_on_plane: float = 0.6, min_rim: int = 30,
-                 max_on_object: float = 0.55, min_contact: int = 4, seed: int = 0) -> list[UnreadFace]:
-    """Faces of one object that depth alone infers from the holes beside it (:func:`hole_regions`) where no
-    colour confirms them: the readings stop at a face's own edges, on the object's neighbouring faces and on the
-    table, so the points just outside a hole that is an unread face lie on the face's plane. A hole is taken for
-    a face when at least ``min_on_plane`` of its rim points (read pixels within 2 px of it, at least ``min_rim``)
-    lie on one plane (RANSAC within the noise threshold of their depth) that is seen at ``min_graze_deg`` or more
-    from face-on (a plane the sensor reads well cannot be the reason for a hole: a blob of missing readings on a
-    face or on the table has that face's or the table's plane as its rim) and stands at least ``min_apart_deg``
-    from every plane in ``known`` (the object's planes and the support). ``depth``: (H, W) metres (0 = no
-    reading); ``grid``: its point grid; ``object_px``: (v1 - v0, u1 - u0) bool, the object's pixels in ``box`` =
-    (u0, v0, u1, v1); ``plane_masks``: the object's planes' grid masks, for the planes each face meets (at least
-    ``min_contact`` rim points on a plane's mask). Polygons are in full-frame pixels."""
+                 max_on_object: float = 0.55, min_contact: int = 4, max_planes: int = 3,
+                 seed: int = 0) -> list[UnreadFace]:
+    """Faces of one object that depth alone infers from the holes beside it where no colour confirms them: the
+    readings stop at a face's own edges, on the object's neighbouring faces and on the table, so the points just
+    outside a hole that is an unread face lie on the face's plane.
+
+    A hole of :func:`hole_regions` is taken for a face when at least ``min_on_plane`` of its rim points (read
+    pixels within 2 px of it, at least ``min_rim``) lie on one plane (RANSAC within the noise threshold of their
+    depth) that is seen at ``min_graze_deg`` or more from face-on (a plane the sensor reads well cannot be the
+    reason for a hole: a blob of missing readings on a face or on the table has that face's or the table's plane as
+    its rim) and stands at least ``min_apart_deg`` from every plane in ``known`` (the object's planes and the
+    support), and when the object makes at most ``max_on_object`` of what surrounds it (a face seen edge-on lies
+    along the object's silhouette; a hole the object surrounds is a blob on one of its faces).
+
+    A hole that runs into another (two faces seen edge-on side by side, or a face and a blob of missing readings)
+    is not convex, or reaches the crop's border: up to ``max_planes`` planes are peeled off its rim, and each that
+    passes those tests gives the face where the hole lies within the hull of that plane's rim points, when that
+    part is itself a hole :func:`hole_regions` would take.
+
+    ``depth``: (H, W) metres (0 = no reading); ``grid``: its point grid; ``object_px``: (v1 - v0, u1 - u0) bool,
+    the object's pixels in ``box`` = (u0, v0, u1, v1); ``plane_masks``: the object's planes' grid masks, for the
+    planes each face meets (at least ``min_contact`` rim points on a plane's mask). Polygons are in full-frame
+    pixels."""
     u0, v0, u1, v1 = box
     crop = depth[v0:v1, u0:u1]
     read = np.isfinite(crop) & (crop > 0)
     rng = np.random.default_rng(seed)
     s = grid.stride
-    out = []
-    for poly, region in hole_regions(~read, object_px):
-        around = cv2.dilate(region.astype(np.uint8), np.ones((5, 5), np.uint8)).astype(bool) & ~region
+    off = np.array([u0, v0], float)
+    ring = np.ones((5, 5), np.uint8)
+
+    def rim(region: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """The read pixels (v, u) around ``region``, their grid cells (i, j) and points (m, 3); None when the
+        object surrounds it."""
+        around = cv2.dilate(region.astype(np.uint8), ring).astype(bool) & ~region
         if np.count_nonzero(around & object_px) > max_on_object * np.count_nonzero(around):
-            continue
-        rim = around & read
-        vv, uu = np.nonzero(rim)
+            return None
+        vv, uu = np.nonzero(around & read)
         i, j = np.minimum((vv + v0) // s, grid.shape[0] - 1), np.minimum((uu + u0) // s, grid.shape[1] - 1)
         ok = grid.valid[i, j]
-        if np.count_nonzero(ok) < min_rim:
-            continue
-        i, j = i[ok], j[ok]
-        pts = grid.xyz[i, j].astype(np.float64)
+        return vv[ok], uu[ok], np.stack([i[ok], j[ok]]), grid.xyz[i[ok], j[ok]].astype(np.float64)
+
+    def face_plane(pts: np.ndarray, need: int) -> tuple[Plane, np.ndarray] | None:
+        """The plane of the most of ``pts`` and its inliers, when at least ``need`` and a plane depth missed."""
         plane, inl = ransac_plane(pts, noise_threshold(float(np.median(pts[:, 2]))), rng)
-        if np.count_nonzero(inl) < min_on_plane * len(pts):
+        if np.count_nonzero(inl) < max(need, 3):
+            return None
+        if _angle_deg(plane.n, pts[inl].mean(axis=0)) < min_graze_deg:
+            return None
+        if any(_angle_deg(plane.n, q.n) < min_apart_deg for q in known):
+            return None
+        return plane, inl
+
+    def face(poly: np.ndarray, plane: Plane, pts: np.ndarray, ij: np.ndarray) -> UnreadFace:
+        rms = float(np.sqrt(np.mean(plane.distance(pts) ** 2)))
+        meets = [k for k, m in enumerate(plane_masks) if np.count_nonzero(m[ij[0], ij[1]]) >= min_contact]
+        return UnreadFace(poly + off, plane, pts, rms, meets)
+
+    out = []
+    convex = hole_regions(~read, object_px)
+    for poly, region in convex:
+        r = rim(region)
+        if r is None or len(r[3]) < min_rim:
             continue
-        centre = pts[inl].mean(axis=0)
-        if _angle_deg(plane.n, centre) < min_graze_deg:
+        found = face_plane(r[3], int(np.ceil(min_on_plane * len(r[3]))))
+        if found is not None:
+            plane, inl = found
+            out.append(face(poly, plane, r[3][inl], r[2][:, inl]))
+    taken = np.zeros(read.shape, bool)
+    for _, region in convex:
+        taken |= region
+    for region in _merged_holes(~read & ~taken, object_px):
+        r = rim(region)
+        if r is None:
             continue
-        if any(_angle_deg(plane.n, q.n) < min_apart_deg or _angle_deg(plane.n, q.n) > 180 - min_apart_deg
-               for q in known):
+        vv, uu, ij, pts = r
+        for _ in range(max_planes):
+            if len(pts) < min_rim:
+                break
+            found = face_plane(pts, min_rim)
+            if found is None:
+                break
+            plane, inl = found
+            hull = np.zeros(read.shape, np.uint8)
+            cv2.fillPoly(hull, [cv2.convexHull(np.stack([uu[inl], vv[inl]], axis=1).astype(np.int32))], 1)
+            part = hole_regions(region & hull.astype(bool), object_px)
+            if len(part) == 1 and rim(part[0][1]) is not None:
+                known = known + [plane]
+                out.append(face(part[0][0], plane, pts[inl], ij[:, inl]))
+            vv, uu, ij, pts = vv[~inl], uu[~inl], ij[:, ~inl], pts[~inl]
+    return out
+
+
+def _merged_holes(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float = 150.0,
+                  min_contact: float = 0.25) -> list[np.ndarray]:
+    """The regions (H, W) bool of ``no_reading`` outside ``object_px`` of at least ``min_area_px`` along the object
+    (at least ``min_contact`` of their outline pixels touch it) that :func:`hole_regions` did not take."""
+    near_obj = cv2.dilate(object_px.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    n, lab, stats, _ = cv2.connectedComponentsWithStats((no_reading & ~object_px).astype(np.uint8), connectivity=8)
+    out = []
+    for k in range(1, n):
+        if stats[k, cv2.CC_STAT_AREA] < min_area_px:
             continue
-        on = pts[inl]
-        rms = float(np.sqrt(np.mean(plane.distance(on) ** 2)))
-        meets = [k for k, m in enumerate(plane_masks) if np.count_nonzero(m[i[inl], j[inl]]) >= min_contact]
-        out.append(UnreadFace(poly + np.array([u0, v0], float), plane, on, rms, meets))
+        m = lab == k
+        edge = m & ~cv2.erode(m.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
+                              borderValue=0).astype(bool)
+        if np.count_nonzero(edge & near_obj) >= min_contact * max(1, np.count_nonzero(edge)):
+            out.append(m)
     return out
 
 
@@ -152,12 +220,16 @@ def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:
 def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[int], frame: RGBD,
                    box: tuple[int, int, int, int], object_px: np.ndarray, edge_dist: np.ndarray,
                    max_taken: float = 0.3, max_share: float = 0.5,
-                   masks: dict[int, np.ndarray] | None = None) -> list[int]:
+                   masks: dict[int, np.ndarray] | None = None, unread: list[UnreadFace] = (),
+                   min_unread_support: float = 0.5) -> list[int]:
     """Faces seen so edge-on that depth has no reading there (:func:`hole_faces`), appended to ``faces`` with
-    provenance 'rgb' (the outline is checked on colour edges; no plane), each made a neighbour (in ``pairs``)
-    of the kept faces it touches. Returns their indices. ``box``: the crop (u0, v0, u1, v1) pixels that
-    ``object_px`` (the object's pixels) and ``edge_dist`` cover; ``masks``: the ``keep`` faces' masks in that crop
-    when the caller has them already (index -> (H, W) bool; updated in place), else they are drawn here.
+    provenance 'rgb' (the outline is checked on colour edges; no plane), then the ``unread`` faces
+    (:func:`unread_faces`, full-frame polygons) that colour did not confirm but that lie on colour edges for at
+    least ``min_unread_support`` of their outline, with provenance 'depth' and the plane through their rim, each
+    made a neighbour (in ``pairs``) of the kept faces it touches. Returns their indices.
+    ``box``: the crop (u0, v0, u1, v1) pixels that ``object_px`` (the object's pixels) and ``edge_dist`` cover;
+    ``masks``: the ``keep`` faces' masks in that crop when the caller has them already (index -> (H, W) bool;
+    updated in place), else they are drawn here.
 
     A hole that the kept faces cover for at most ``max_taken`` of its pixels is a face beside them. One that a
     single kept face covers, as a part of at most ``max_share`` of that face, is a face the colour outline
@@ -174,7 +246,14 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
     if masks is None:
         masks = {i: rasterize(faces[i].polygon - off, shape) for i in keep}
     added = []
-    for poly in hole_faces(no_reading, object_px, edge_dist):
+    # an unread face that colour confirmed too is covered by the colour face added first
+    found = [(poly, Face("", poly + off, "rgb")) for poly in hole_faces(no_reading, object_px, edge_dist)]
+    # an unread face needs colour edges along more of its outline than the object's side alone: a sensor's
+    # occlusion shadow beside an object (a band without readings that depth alone takes for a face: the Kinect's
+    # beside the bottle in milk_cartoon_all_small_clorox, on 0.40 of its outline) has none where it crosses the table
+    found += [(u.polygon - off, Face("", u.polygon, "depth", plane=u.plane, points=u.points, plane_rms_m=u.rms_m))
+              for u in unread if edge_support(u.polygon - off, edge_dist) >= min_unread_support]
+    for poly, face in found:
         hole = rasterize(poly, shape)
         a = max(1, np.count_nonzero(hole))
         cover = {i: np.count_nonzero(hole & m) for i, m in masks.items()}
@@ -184,7 +263,7 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
                 continue
         grown = cv2.dilate(hole.astype(np.uint8), np.ones((5, 5), np.uint8)).astype(bool)
         new = len(faces)
-        faces.append(Face("", poly + off, "rgb"))
+        faces.append(face)
         pairs |= {(i, new) for i, m in masks.items() if np.count_nonzero(grown & m) >= 4}
         masks[new] = hole
         added.append(new)

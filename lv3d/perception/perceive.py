@@ -16,7 +16,7 @@ from .boundary import grid_to_pixels
 from .confirm import replace_unconfirmed, unconfirmed
 from .face_plane import angle_deg, fit_face_plane
 from .fuse import match_faces
-from .holes import add_hole_faces, unread_faces
+from .holes import UnreadFace, add_hole_faces, unread_faces
 from .plane_outline import simplify_on_plane
 from .polygons import area, rasterize
 from .rgb import RGBFace, rgb_faces
@@ -124,18 +124,29 @@ def _depth_object(scene_id: str, k: int, o: DepthObjectResult, dres: DepthResult
         index[i] = face_id(scene_id, k, len(faces) + 1)
         faces.append(Face(index[i], poly, "depth", plane=p.plane, points=p.points, plane_rms_m=p.rms_m))
     adj = [(index[a], index[b]) for a, b in o.adjacency if a in index and b in index]
-    h, w = frame.shape
-    u0, v0, u1, v1 = o.box_px
-    box = (max(0, u0 - _CROP_MARGIN_PX), max(0, v0 - _CROP_MARGIN_PX),
-           min(w, u1 + _CROP_MARGIN_PX), min(h, v1 + _CROP_MARGIN_PX))
-    known = [p.plane for p in o.planes] + ([dres.support] if dres.support is not None else [])
-    for f in unread_faces(frame.depth, dres.grid, grid_to_pixels(o.obj.mask, stride, box),
-                          [p.mask for p in o.planes], known, box, seed=k):
+    box = _crop_box(o, frame.shape)
+    for f in _unread(frame, dres, o, box, grid_to_pixels(o.obj.mask, stride, box), seed=k):
         fid = face_id(scene_id, k, len(faces) + 1)
         faces.append(Face(fid, f.polygon, "depth", plane=f.plane, points=f.points, plane_rms_m=f.rms_m))
         adj += [(index[a], fid) for a in f.neighbours if a in index]
     count, centroid = _object_pixels(o, stride)
     return SceneObject(object_id(scene_id, k), faces, adj, count, centroid)
+
+
+def _crop_box(o: DepthObjectResult, shape: tuple[int, int]) -> tuple[int, int, int, int]:
+    """The depth object's box (u0, v0, u1, v1) grown by the crop margin, inside an image of ``shape`` (h, w)."""
+    h, w = shape
+    u0, v0, u1, v1 = o.box_px
+    return (max(0, u0 - _CROP_MARGIN_PX), max(0, v0 - _CROP_MARGIN_PX),
+            min(w, u1 + _CROP_MARGIN_PX), min(h, v1 + _CROP_MARGIN_PX))
+
+
+def _unread(frame: RGBD, dres: DepthResult, o: DepthObjectResult, box: tuple[int, int, int, int],
+            object_px: np.ndarray, seed: int) -> list[UnreadFace]:
+    """The faces beside depth object ``o`` that depth did not read (holes.unread_faces), searched in ``box``, where
+    ``object_px`` are the object's pixels."""
+    known = [p.plane for p in o.planes] + ([dres.support] if dres.support is not None else [])
+    return unread_faces(frame.depth, dres.grid, object_px, [p.mask for p in o.planes], known, box, seed=seed)
 
 
 def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[str, float]) -> list[SceneObject]:
@@ -146,9 +157,7 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         timings.setdefault(key, 0.0)
     out = []
     for k, o in enumerate(dres.objects, start=1):
-        u0, v0, u1, v1 = o.box_px
-        box = (max(0, u0 - _CROP_MARGIN_PX), max(0, v0 - _CROP_MARGIN_PX),
-               min(w, u1 + _CROP_MARGIN_PX), min(h, v1 + _CROP_MARGIN_PX))
+        box = _crop_box(o, (h, w))
         res = rgb_faces(frame.color, box=box)
         for key, v in res.timings_ms.items():
             timings[key] += v
@@ -240,8 +249,9 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         merged = set(alias) | set(alias.values())
         keep = [i for i in _reliable(faces, edge_on) if i not in alias and (i not in piece or i in merged)]
         keep, masks = _drop_covered(faces, keep, shape, off)
-        keep += add_hole_faces(faces, pairs, keep, frame, box, grid_to_pixels(o.obj.mask, stride, box),
-                                res.edge_dist, masks=masks)
+        object_px = grid_to_pixels(o.obj.mask, stride, box)
+        keep += add_hole_faces(faces, pairs, keep, frame, box, object_px, res.edge_dist, masks=masks,
+                               unread=_unread(frame, dres, o, box, object_px, seed=k))
         pairs = {(a, b) for a, b in pairs if a in keep and b in keep}
         _refine_outlines(faces, keep, frame.intrinsics)
         # stable ids: faces largest first

@@ -92,6 +92,26 @@ def test_a_face_that_swallowed_the_hole_gives_it_up_and_one_that_is_the_hole_kee
     assert np.array_equal(faces[1].polygon, STRIP)
 
 
+def test_unread_face_in_rgbd_needs_colour_edges_beyond_the_object_side_and_defers_to_colour():
+    from lv3d.perception.holes import UnreadFace, add_hole_faces
+    from lv3d.plane import Plane
+    from lv3d.scene import Face
+
+    frame, obj = _frame_and_object()
+    box = (0, 0, SHAPE[1], SHAPE[0])
+    unread = [UnreadFace(STRIP.copy(), Plane.from_arrays((1.0, 0.0, 0.2), -0.1), np.zeros((3, 3)), 0.001, [0])]
+    # a band of the table's colour (an occlusion shadow): an edge along the object's side only
+    faces = [Face("", OBJECT, "depth")]
+    assert add_hole_faces(faces, set(), [0], frame, box, obj, _dist((200, 190, 170)), unread=unread) == []
+    assert add_hole_faces(faces, set(), [0], frame, box, obj, _dist((200, 190, 170)), unread=unread,
+                          min_unread_support=0.0) == [1]
+    assert faces[1].provenance == "depth" and faces[1].plane == unread[0].plane
+    # a strip of a colour of its own: colour's hole face comes first and the unread face adds nothing
+    faces = [Face("", OBJECT, "depth")]
+    assert add_hole_faces(faces, set(), [0], frame, box, obj, _dist(), unread=unread) == [1]
+    assert faces[1].provenance == "rgb"
+
+
 def _grazing_cuboid(grazing_deg: float = 78.0):
     """A cuboid one of whose faces (truth id 5, 4254 px) is seen beyond 78 degrees from face-on: a sensor that
     reads no further leaves it without a reading. Returns the frame and its face-id mask (k = truth face k - 1)."""
@@ -156,3 +176,22 @@ def test_missing_readings_on_the_table_or_inside_a_face_are_no_face():
     (table,) = _unread(blotted, min_graze_deg=0.0, min_apart_deg=0.0)
     assert solid[int(table.polygon[:, 1].mean()), int(table.polygon[:, 0].mean())] == 0
     assert len(_unread(blotted, min_graze_deg=0.0, min_apart_deg=0.0, max_on_object=1.0)) == 2
+
+
+def test_unread_face_is_found_where_missing_readings_on_the_table_run_into_it():
+    from dataclasses import replace
+
+    frame, faces = _grazing_cuboid()
+    unread = faces == 6
+    # a blob of missing readings on the table against the unread face, away from the faces depth read
+    to_unread = cv2.distanceTransform((~unread).astype(np.uint8), cv2.DIST_L2, 5)
+    to_read = cv2.distanceTransform(((faces == 0) | unread).astype(np.uint8), cv2.DIST_L2, 5)
+    band = np.argwhere((to_unread > 4.5) & (to_unread < 5.5) & (faces == 0))
+    v, u = band[np.argmax(to_read[band[:, 0], band[:, 1]])]
+    depth = frame.depth.copy()
+    cv2.circle(depth, (int(u), int(v)), 10, 0.0, -1)
+    blotted = replace(frame, depth=depth)
+    # the hole is no longer convex: only the planes peeled off its rim find the face in it
+    assert _unread(blotted, max_planes=0) == []
+    ious = [_iou(rasterize(f.polygon, unread.shape), unread) for f in _unread(blotted)]
+    assert max(ious, default=0.0) >= 0.8
