@@ -6,10 +6,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .polygons import clockwise, simplify
-
-# a corner cutting off more than this fraction of the face's area is kept however little it turns (polygons.simplify)
-_KEEP_AREA = 0.1
+from .polygons import KEEP_AREA, clockwise, simplify
 
 
 def mask_polygon(grid_mask: np.ndarray, stride: int, image_shape: tuple[int, int], eps_frac: float = 0.035,
@@ -37,7 +34,7 @@ def mask_polygon(grid_mask: np.ndarray, stride: int, image_shape: tuple[int, int
     # a face seen edge-on is a lens whose corners lie a few px off their neighbours' chord and turn by little, yet
     # hold much of its area: pentagonal prism 1007's end (clean dev seed 1000) lost two of five and half its area
     # (docs/perception.md, session 27)
-    poly = simplify(approx.astype(np.float64), keep_area_frac=_KEEP_AREA)
+    poly = simplify(approx.astype(np.float64), keep_area_frac=KEEP_AREA)
     if convex and len(poly) >= 3:
         # the contour runs through the outermost samples' pixels; each sample stands for a stride x stride
         # block starting there, so the face reaches (stride - 1) / 2 px further on average: on a face a few

@@ -8,6 +8,10 @@ import math
 import cv2
 import numpy as np
 
+# a corner cutting off more than this fraction of a face's area is kept however little it turns (simplify's
+# keep_area_frac, for traced colour outlines and depth mask outlines)
+KEEP_AREA = 0.1
+
 
 def signed_area(poly: np.ndarray) -> float:
     """Shoelace area in pixels^2; positive when the vertices run clockwise in the image (v down)."""

@@ -14,7 +14,7 @@ from .background import background_faces, chromaticity, face_chromaticity, log_g
 from .edges import channel_edges, channels, edge_distance, edge_support
 from .faces import bounded_faces, build_graph
 from .gaps import close_gaps
-from .polygons import (area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
+from .polygons import (KEEP_AREA, area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
                        sample_boundary, simplify)
 from .segments import detect_color_segments, union_find_labels
 from .silhouette import foreground, regions_of, silhouette_segments
@@ -44,8 +44,6 @@ class RGBResult:
     edge_dist: np.ndarray             # (h, w) px from each pixel of the searched box to the nearest edge
 
 
-# a corner cutting off more than this fraction of a face's area is kept however little it turns (polygons.simplify)
-_KEEP_AREA = 0.1
 # a part cut off a traced face at most this wide (twice its area over its perimeter, px) is outlined anew from the
 # traced vertices it holds
 _THIN_PART_PX = 12.0
@@ -55,8 +53,8 @@ _TILE_TOL = 1e-6
 
 def _outline(poly: np.ndarray) -> np.ndarray:
     """A traced face's outline with only its corners, short sides dropped, clockwise; a corner holding more than
-    ``_KEEP_AREA`` of the face's area stays however little it turns (polygons.simplify)."""
-    return clockwise(drop_short_sides(simplify(poly, keep_area_frac=_KEEP_AREA)))
+    ``KEEP_AREA`` of the face's area stays however little it turns (polygons.simplify)."""
+    return clockwise(drop_short_sides(simplify(poly, keep_area_frac=KEEP_AREA)))
 
 
 def _traced_part(traced: np.ndarray, outline: np.ndarray, piece: np.ndarray) -> np.ndarray:

@@ -94,9 +94,10 @@ def untraced_faces(solids: np.ndarray, found: list[np.ndarray], dist: np.ndarray
             c = _grown(inside > 0, own, sides, window, solids[v0:v1, u0:u1], grow_px) + np.array([u0, v0])
         poly = cv2.approxPolyDP(c, tol_px, True).reshape(-1, 2).astype(np.float64)
         poly = clockwise(drop_short_sides(simplify(poly, keep_area_frac=keep_area_frac)))
-        if len(poly) >= 3 and reflex_corners(poly) and mean_width(poly) <= max_thin_px:
+        reflex = len(poly) >= 3 and bool(reflex_corners(poly))
+        if reflex and mean_width(poly) <= max_thin_px:
             continue
-        if len(poly) >= 3 and not reflex_corners(poly):
+        if len(poly) >= 3 and not reflex:
             poly = grow_convex(poly, 0.5)
         if len(poly) < 3 or not is_simple(poly) or area(poly) < min_area_px:
             continue
