@@ -62,27 +62,37 @@ def hole_regions(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: flo
     ``min_area_px``, at least ``min_contact`` of whose outline pixels touch the object, not touching the crop's
     border (the object or the hole is cut off there), whose area over their polygon's is within ``fill`` (a
     convex region)."""
+    return _holes(no_reading, object_px, min_area_px, min_contact, fill)[0]
+
+
+def _holes(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float = 150.0, min_contact: float = 0.25,
+           fill: tuple[float, float] = _FILL) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[np.ndarray]]:
+    """The regions of ``no_reading`` along the object as :func:`hole_regions` takes them, and the regions (H, W)
+    bool it leaves (touching the crop's border, or not convex)."""
     h, w = no_reading.shape
     near_obj = cv2.dilate(object_px.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
     n, lab, stats, _ = cv2.connectedComponentsWithStats((no_reading & ~object_px).astype(np.uint8), connectivity=8)
-    out = []
+    taken, left = [], []
     for k in range(1, n):
         x, y, bw, bh, a = stats[k]
-        if a < min_area_px or x == 0 or y == 0 or x + bw >= w or y + bh >= h:
+        if a < min_area_px:
             continue
         m = lab[y:y + bh, x:x + bw] == k
         ring = m & ~cv2.erode(m.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
                               borderValue=0).astype(bool)
         if np.count_nonzero(ring & near_obj[y:y + bh, x:x + bw]) < min_contact * max(1, np.count_nonzero(ring)):
             continue
-        poly = _outline(m)
+        poly = None if x == 0 or y == 0 or x + bw >= w or y + bh >= h else _outline(m)
+        if poly is not None:
+            poly += np.array([x, y], float)
+            if not fill[0] <= a / max(area(poly), 1e-9) <= fill[1]:
+                poly = None
+        region = lab == k
         if poly is None:
-            continue
-        poly += np.array([x, y], float)
-        if not fill[0] <= a / max(area(poly), 1e-9) <= fill[1]:
-            continue
-        out.append((poly, lab == k))
-    return out
+            left.append(region)
+        else:
+            taken.append((poly, region))
+    return taken, left
 
 
 class UnreadFace(NamedTuple):
@@ -159,7 +169,7 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
         return UnreadFace(poly + off, plane, pts, rms, meets)
 
     out = []
-    convex = hole_regions(~read, object_px)
+    convex, merged = _holes(~read, object_px)
     for poly, region in convex:
         r = rim(region)
         if r is None or len(r[3]) < min_rim:
@@ -168,10 +178,7 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
         if found is not None:
             plane, inl = found
             out.append(face(poly, plane, r[3][inl], r[2][:, inl]))
-    taken = np.zeros(read.shape, bool)
-    for _, region in convex:
-        taken |= region
-    for region in _merged_holes(~read & ~taken, object_px):
+    for region in merged:
         r = rim(region)
         if r is None:
             continue
@@ -190,24 +197,6 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
                 known = known + [plane]
                 out.append(face(part[0][0], plane, pts[inl], ij[:, inl]))
             vv, uu, ij, pts = vv[~inl], uu[~inl], ij[:, ~inl], pts[~inl]
-    return out
-
-
-def _merged_holes(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float = 150.0,
-                  min_contact: float = 0.25) -> list[np.ndarray]:
-    """The regions (H, W) bool of ``no_reading`` outside ``object_px`` of at least ``min_area_px`` along the object
-    (at least ``min_contact`` of their outline pixels touch it) that :func:`hole_regions` did not take."""
-    near_obj = cv2.dilate(object_px.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
-    n, lab, stats, _ = cv2.connectedComponentsWithStats((no_reading & ~object_px).astype(np.uint8), connectivity=8)
-    out = []
-    for k in range(1, n):
-        if stats[k, cv2.CC_STAT_AREA] < min_area_px:
-            continue
-        m = lab == k
-        edge = m & ~cv2.erode(m.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
-                              borderValue=0).astype(bool)
-        if np.count_nonzero(edge & near_obj) >= min_contact * max(1, np.count_nonzero(edge)):
-            out.append(m)
     return out
 
 
