@@ -33,6 +33,7 @@ from ..scene import Face
 from .boundary import grow_convex
 from .cloud import PointGrid
 from .edges import edge_support
+from .face_plane import angle_deg
 from .polygons import area, clockwise, drop_short_sides, rasterize
 from .support import noise_threshold, ransac_plane
 
@@ -157,9 +158,10 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
         plane, inl = ransac_plane(pts, noise_threshold(float(np.median(pts[:, 2]))), rng)
         if np.count_nonzero(inl) < max(need, 3):
             return None
-        if _angle_deg(plane.n, pts[inl].mean(axis=0)) < min_graze_deg:
+        ray = pts[inl].mean(axis=0)  # the angle it is seen at, from face-on
+        if np.degrees(np.arccos(min(1.0, abs(float(plane.n @ ray)) / float(np.linalg.norm(ray))))) < min_graze_deg:
             return None
-        if any(_angle_deg(plane.n, q.n) < min_apart_deg for q in known):
+        if any(angle_deg(plane, q) < min_apart_deg for q in known):
             return None
         return plane, inl
 
@@ -198,12 +200,6 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
                 out.append(face(part[0][0], plane, pts[inl], ij[:, inl]))
             vv, uu, ij, pts = vv[~inl], uu[~inl], ij[:, ~inl], pts[~inl]
     return out
-
-
-def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:
-    """Angle (degrees, 0 to 90) between the lines along vectors ``a`` and ``b``."""
-    c = abs(float(a @ b)) / max(float(np.linalg.norm(a) * np.linalg.norm(b)), 1e-12)
-    return float(np.degrees(np.arccos(min(1.0, c))))
 
 
 def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[int], frame: RGBD,
