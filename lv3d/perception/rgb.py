@@ -19,7 +19,7 @@ from .polygons import (KEEP_AREA, area, clockwise, drop_short_sides, is_simple, 
 from .segments import detect_color_segments, union_find_labels
 from .silhouette import foreground, regions_of, silhouette_segments
 from .split import reflex_corners, split_by_diagonal, split_concave
-from .step_edge import fork_cut, smoothed_gradients, step_cut, step_lines
+from .step_edge import fork_cut, side_cut, smoothed_gradients, step_cut, step_lines
 from .thin import thin_faces
 from .untraced import untraced_faces
 
@@ -201,16 +201,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
             continue
         parts = None
         if colour_alone and whole:
-            lines = measured[i] if i in measured else step_lines(poly, sgrads)
-            # no line to cut along (step_lines found none): step_cut would find none either
-            parts = step_cut(poly, sgrads, min_area_px, lines=lines) if lines is not None else None
-            if parts is None and lines is not None:
-                # a short faint edge keeps few clear samples; it is taken with 10 when it steps 10 times its control
-                # (a small face of one colour with its neighbour: triangular prism 1002's 509 px face, 10 samples,
-                # a step 89 times its control; docs/perception.md, session 26)
-                parts = step_cut(poly, sgrads, min_area_px, rel_step=10.0, min_samples=10, lines=lines)
-            if parts is None:
-                parts = fork_cut(poly, sgrads, min_area_px)
+            parts = _faint_cut(poly, sgrads, min_area_px, measured[i] if i in measured else step_lines(poly, sgrads))
         if parts is None:
             kept.append((poly, es, sup, a))
             continue
@@ -223,7 +214,16 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     cands = _join_thin_to_traced(cands, n_traced, dist)
     if colour_alone:
         untraced = untraced_faces(solids, [c[0] for c in cands], dist, crop, min_area_px, max_area_frac * w * h)
-        cands += _touching_cands(cands, untraced, dist, made_up)
+        cut_up = [_faint_cut(q, sgrads, min_area_px, step_lines(q, sgrads)) or [q] for q in untraced]
+        new = _touching_cands(cands, [q for parts in cut_up for q in parts], dist, made_up)
+        start = 0
+        for parts in cut_up:
+            if len(parts) > 1:  # the parts of one cut are neighbours
+                cut = next(made_up)
+                for k in range(start, start + len(parts)):
+                    new[k] = (new[k][0], new[k][1] | {cut}, new[k][2], new[k][3])
+            start += len(parts)
+        cands += new
     hues = [None] * len(cands)  # each face's chromaticity, for background_faces and _same_solid (colour alone)
     if colour_alone and cands:
         hues = [face_chromaticity(np.asarray(c[0], np.float64), chroma) for c in cands]
@@ -247,6 +247,24 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     t3 = time.perf_counter()
     timings = {"edges": (t1 - t0) * 1e3, "segments": (t2 - t1) * 1e3, "faces": (t3 - t2) * 1e3}
     return RGBResult(faces, ordered, adjacency, timings, dist)
+
+
+def _faint_cut(poly: np.ndarray, sgrads: np.ndarray, min_area_px: float, lines) -> list[np.ndarray] | None:
+    """The parts of a face ``poly`` cut along faint edges (step_edge.py), or None: along a line from a corner
+    (``lines``: its step_edge.step_lines, None where there are none), at a fork of three lines from three corners,
+    or along a line from side to side."""
+    # no line to cut along (step_lines found none): step_cut would find none either
+    parts = step_cut(poly, sgrads, min_area_px, lines=lines) if lines is not None else None
+    if parts is None and lines is not None:
+        # a short faint edge keeps few clear samples; it is taken with 10 when it steps 10 times its control
+        # (a small face of one colour with its neighbour: triangular prism 1002's 509 px face, 10 samples,
+        # a step 89 times its control; docs/perception.md, session 26)
+        parts = step_cut(poly, sgrads, min_area_px, rel_step=10.0, min_samples=10, lines=lines)
+    if parts is None:
+        parts = fork_cut(poly, sgrads, min_area_px)
+    if parts is None:
+        parts = side_cut(poly, sgrads, min_area_px)
+    return parts
 
 
 def _same_solid(pairs: list[tuple[int, int]], polys: list[np.ndarray], hue: list[np.ndarray], solids: np.ndarray,

@@ -2,7 +2,7 @@ import cv2
 import numpy as np
 
 from lv3d.perception.polygons import area
-from lv3d.perception.step_edge import fork_cut, smoothed_gradients, step_cut, step_lines
+from lv3d.perception.step_edge import fork_cut, side_cut, smoothed_gradients, step_cut, step_lines
 
 # a cube's top and front faces traced as one outline: their shared edge runs from the outline's corner (40, 80)
 # to a point in the middle of its right side, (160, 80), not to a corner
@@ -80,3 +80,39 @@ def test_a_silhouette_of_one_shade_or_a_concave_outline_has_no_fork():
     assert fork_cut(HEXAGON, _fork_grads((104.0, 104.0, 104.0)), min_area_px=150.0) is None
     notched = np.concatenate([HEXAGON[:3], [[120.0, 110.0]], HEXAGON[3:]])  # a reflex corner: not one solid's
     assert fork_cut(notched, _fork_grads((110.0, 104.0, 100.0)), min_area_px=150.0) is None
+
+
+# a cube's top and front faces traced as one rectangle: their left sides and right sides run on in one line each,
+# so the edge between them runs from a point of the left side, (40, 85), to a point of the right side, (160, 75)
+RECTANGLE = np.array([[40.0, 30.0], [160.0, 30.0], [160.0, 170.0], [40.0, 170.0]])
+SLANTED_TOP = np.array([[40.0, 30.0], [160.0, 30.0], [160.0, 75.0], [40.0, 85.0]])
+
+
+def _side_grads(top_level: float, rest_level: float, noise: float = 4.0, ramp: float = 0.0, seed: int = 5):
+    rng = np.random.default_rng(seed)
+    img = np.full((200, 200), rest_level, np.float64)
+    mask = np.zeros((200, 200), np.uint8)
+    cv2.fillPoly(mask, [np.round(SLANTED_TOP).astype(np.int32)], 1)
+    img[mask.astype(bool)] = top_level
+    img += ramp * np.arange(200)[:, None] + rng.normal(0.0, noise, img.shape)
+    chan = cv2.GaussianBlur(np.clip(img, 0, 255).astype(np.uint8), (3, 3), 0)
+    return smoothed_gradients([chan, chan, chan])
+
+
+def test_a_faint_step_from_side_to_side_is_cut_where_no_corner_line_runs():
+    # 10 grey levels apart on a noise-free render (clean dev seed 3000's cube, about 15): too faint for the edge
+    # map, while the flat faces' own lines do not step at all
+    grads = _side_grads(130.0, 120.0, noise=0.0)
+    assert step_cut(RECTANGLE, grads, min_area_px=150.0) is None  # no line from a corner runs along the edge
+    parts = side_cut(RECTANGLE, grads, min_area_px=150.0)
+    assert parts is not None and [len(p) for p in parts] == [4, 4]
+    ends = sorted((p for p in parts[0] if not any(np.array_equal(p, c) for c in RECTANGLE)), key=lambda p: p[0])
+    assert np.hypot(*(ends[0] - [40.0, 85.0])) <= 2.0 and np.hypot(*(ends[1] - [160.0, 75.0])) <= 2.0
+    assert abs(sum(area(p) for p in parts) - area(RECTANGLE)) < 1.0
+
+
+def test_noise_alone_or_a_shading_ramp_is_not_cut_from_side_to_side():
+    assert side_cut(RECTANGLE, _side_grads(120.0, 120.0), min_area_px=150.0) is None
+    ramp = _side_grads(20.0, 20.0, ramp=1.2, noise=0.0)
+    assert side_cut(RECTANGLE, ramp, min_area_px=150.0, rel_step=0.0) is not None
+    assert side_cut(RECTANGLE, ramp, min_area_px=150.0) is None
