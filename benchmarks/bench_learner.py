@@ -1,7 +1,7 @@
 """The learner's accuracy under noise and its speed; prints each figure beside its target (issue 5).
 
     .venv/bin/python benchmarks/bench_learner.py [--seed 778] [--per-class 30] [--root /tmp/lv3d_bench]
-        [--quick | --noise | --few-shot [--draws 16]] [--modality depth] [--settings '{"extra_literals": 0}']
+        [--quick | --noise | --few-shot [--draws 16]] [--modality depth|rgb] [--settings '{"extra_literals": 0}']
 
 Data: two DEV data sets (never the study's seed 0), 640x480 like the study, rendered from the same
 seed with the clean and the realsense preset, their pipeline and ground-truth rgbd facts cached by
@@ -189,8 +189,8 @@ def main(argv=None) -> int:
                     help="realsense class tasks of 1, 2, 4 positives (1.5 negatives each, one of each other class at least) only")
     ap.add_argument("--draws", type=int, default=None,
                     help="--few-shot: draws a fold at every task size (default 4, 4, 2)")
-    ap.add_argument("--modality", default="rgbd", choices=("rgbd", "depth"),
-                    help="whose facts every row learns from (depth: made with dev_facts.py --modalities depth)")
+    ap.add_argument("--modality", default="rgbd", choices=("rgbd", "depth", "rgb"),
+                    help="whose facts every row learns from (depth, rgb: made with dev_facts.py --modalities depth, rgb)")
     ap.add_argument("--settings", type=json.loads, default=None, help="learner settings (JSON) for every fit")
     a = ap.parse_args(argv)
     if a.seed == 0:

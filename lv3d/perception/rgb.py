@@ -107,11 +107,13 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     a printed carton comes out as one object per colour: _same_solid), and a kept face whose outline the graph
     traced whole, or a concave traced outline before it is split, is cut along a faint straight edge from one of its
     corners (step_edge.step_cut), and a convex one that no such line cuts is cut at a fork of three faint edges from
-    three of its corners (step_edge.fork_cut: a solid showing three faces of one colour): most colour-only
-    misses on noisy renders are corners the segments stop short of and two faces of one colour traced as one. The
-    parts of the silhouettes left outside every face, each of a colour of its own or a whole solid none of whose
-    faces was traced, are then faces too (untraced.untraced_faces: slivers whose corners the graph collapsed; clean
-    rgb recall rose on 4 of 6 dev seeds and fell on none; docs/perception.md, session 28). Faces
+    three of its corners (step_edge.fork_cut: a solid showing three faces of one colour), or else along a faint edge
+    from side to side that steps far above its control (step_edge.side_cut: a cube's top and front whose left and
+    right sides run on in one line each): most colour-only misses on noisy renders are corners the segments stop
+    short of and two faces of one colour traced as one. The parts of the silhouettes left outside every face, each
+    of a colour of its own or a whole solid none of whose faces was traced, are then faces too
+    (untraced.untraced_faces: slivers whose corners the graph collapsed; clean rgb recall rose on 4 of 6 dev seeds
+    and fell on none; docs/perception.md, session 28), each cut from side to side as above (session 30). Faces
     of the colour of the image's border (floor texture, shadows, painted lines) are then dropped
     (background.background_faces): most false colour-only faces on noisy renders are such; those much smoother than
     the floor of their hue are kept (background.smooth_faces: an object of the table's hue). With depth (rgbd), the
@@ -214,7 +216,9 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     cands = _join_thin_to_traced(cands, n_traced, dist)
     if colour_alone:
         untraced = untraced_faces(solids, [c[0] for c in cands], dist, crop, min_area_px, max_area_frac * w * h)
-        cut_up = [_faint_cut(q, sgrads, min_area_px, step_lines(q, sgrads)) or [q] for q in untraced]
+        # a whole solid none of whose faces was traced is cut from side to side where its faces' shared edge
+        # steps clearly; the corner and fork cuts, looser, cost realsense multi-class accuracy (docs/perception.md)
+        cut_up = [side_cut(q, sgrads, min_area_px) or [q] for q in untraced]
         new = _touching_cands(cands, [q for parts in cut_up for q in parts], dist, made_up)
         start = 0
         for parts in cut_up:

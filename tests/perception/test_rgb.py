@@ -110,3 +110,20 @@ def test_a_short_faint_edge_that_steps_clearly_cuts_a_small_face_off():
     assert len(res.faces) == 2 and min(_best_iou(res, p, img.shape[:2]) for p in (small, large)) > 0.8
     cv2.fillPoly(img, [np.round(small).astype(np.int32)], (116, 125, 97))  # one colour: no edge, no cut
     assert len(rgb_faces(img, colour_alone=True).faces) == 1
+
+
+def test_a_faint_edge_from_side_to_side_cuts_two_faces_of_one_colour_apart(monkeypatch):
+    # cube 3003 of the clean dev renders: its top and front faces, 10 grey levels apart, traced as one outline whose
+    # left sides and right sides run on in one line each; their edge ends on those sides, at no corner
+    top = np.array([(40, 30), (160, 30), (160, 75), (40, 85)])
+    front = np.array([(40, 85), (160, 75), (160, 170), (40, 170)])
+    img = np.full((240, 320, 3), (120, 80, 50), np.uint8)
+    for poly, colour in ((top, (170, 165, 115)), (front, (160, 155, 105))):
+        cv2.fillPoly(img, [poly.astype(np.int32)], colour)
+
+    res = rgb_faces(img, colour_alone=True)
+    assert len(res.faces) == 2 and min(_best_iou(res, p, img.shape[:2]) for p in (top, front)) > 0.95
+    # the edge map and the corner cuts miss this edge: without the side-to-side cut the two faces are one
+    import lv3d.perception.rgb as rgb
+    monkeypatch.setattr(rgb, "side_cut", lambda *a, **k: None)
+    assert len(rgb_faces(img, colour_alone=True).faces) == 1
