@@ -218,7 +218,8 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         untraced = untraced_faces(solids, [c[0] for c in cands], dist, crop, min_area_px, max_area_frac * w * h)
         # a whole solid none of whose faces was traced is cut from side to side where its faces' shared edge
         # steps clearly; the corner and fork cuts, looser, cost realsense multi-class accuracy (docs/perception.md)
-        cut_up = [side_cut(q, sgrads, min_area_px) or [q] for q in untraced]
+        cut_up = [[_outline(x) for x in parts] if (parts := side_cut(q, sgrads, min_area_px)) else [q]
+                  for q in untraced]
         new = _touching_cands(cands, [q for parts in cut_up for q in parts], dist, made_up)
         start = 0
         for parts in cut_up:

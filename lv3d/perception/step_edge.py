@@ -268,7 +268,7 @@ def side_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: 
     their sides, and the best that passes the test is taken (``min_samples`` clear samples, a step of
     ``min_step`` and ``rel_step`` times its control); the parts must be at least ``min_area_px``.
     ``rel_step`` is far above step_cut's: thousands of lines are tried, and noise steps on some. On realsense
-    dev seed 2000 (10 a class), none of the 33 cuts that passed at 3 times gave two true faces, the strongest
+    dev seed 2000 (10 a class), none of the 32 cuts that passed at 3 times gave two true faces, the strongest
     stepping 14.9 times its control; on clean renders, whose faces are flat, the true cuts stepped over 10000
     times (docs/perception.md, session 30)."""
     p = np.asarray(poly, np.float64)
@@ -313,7 +313,8 @@ def side_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: 
     second = np.concatenate([b[None], p[sb + 1:], p[:sa + 1], a[None]])
     if min(area(first), area(second)) < min_area_px:
         return None
-    return [first, second]
+    # an end moved onto a corner repeats it
+    return [q[np.hypot(*(q - np.roll(q, 1, axis=0)).T) > 1e-9] for q in (first, second)]
 
 
 def _unit(d: np.ndarray) -> np.ndarray:
