@@ -10,11 +10,13 @@ OUTLINE = np.array([[40.0, 30.0], [160.0, 30.0], [160.0, 170.0], [40.0, 170.0], 
 TOP = np.array([[40.0, 30.0], [160.0, 30.0], [160.0, 80.0], [40.0, 80.0]])
 
 
-def _grads(top_level: float, rest_level: float, noise: float = 4.0, ramp: float = 0.0, seed: int = 3):
+def _grads(top_level: float, rest_level: float, noise: float = 4.0, ramp: float = 0.0, seed: int = 3,
+           top: np.ndarray = TOP):
+    """smoothed_gradients of a 200 x 200 image of ``rest_level`` with the polygon ``top`` at ``top_level``."""
     rng = np.random.default_rng(seed)
     img = np.full((200, 200), rest_level, np.float64)
     mask = np.zeros((200, 200), np.uint8)
-    cv2.fillPoly(mask, [np.round(TOP).astype(np.int32)], 1)
+    cv2.fillPoly(mask, [np.round(top).astype(np.int32)], 1)
     img[mask.astype(bool)] = top_level
     img += ramp * np.arange(200)[:, None] + rng.normal(0.0, noise, img.shape)
     chan = cv2.GaussianBlur(np.clip(img, 0, 255).astype(np.uint8), (3, 3), 0)
@@ -88,15 +90,8 @@ RECTANGLE = np.array([[40.0, 30.0], [160.0, 30.0], [160.0, 170.0], [40.0, 170.0]
 SLANTED_TOP = np.array([[40.0, 30.0], [160.0, 30.0], [160.0, 75.0], [40.0, 85.0]])
 
 
-def _side_grads(top_level: float, rest_level: float, noise: float = 4.0, ramp: float = 0.0, seed: int = 5):
-    rng = np.random.default_rng(seed)
-    img = np.full((200, 200), rest_level, np.float64)
-    mask = np.zeros((200, 200), np.uint8)
-    cv2.fillPoly(mask, [np.round(SLANTED_TOP).astype(np.int32)], 1)
-    img[mask.astype(bool)] = top_level
-    img += ramp * np.arange(200)[:, None] + rng.normal(0.0, noise, img.shape)
-    chan = cv2.GaussianBlur(np.clip(img, 0, 255).astype(np.uint8), (3, 3), 0)
-    return smoothed_gradients([chan, chan, chan])
+def _side_grads(top_level: float, rest_level: float, noise: float = 4.0, ramp: float = 0.0):
+    return _grads(top_level, rest_level, noise=noise, ramp=ramp, seed=5, top=SLANTED_TOP)
 
 
 def test_a_faint_step_from_side_to_side_is_cut_where_no_corner_line_runs():
