@@ -218,16 +218,14 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         untraced = untraced_faces(solids, [c[0] for c in cands], dist, crop, min_area_px, max_area_frac * w * h)
         # a whole solid none of whose faces was traced is cut from side to side where its faces' shared edge
         # steps clearly; the corner and fork cuts, looser, cost realsense multi-class accuracy (docs/perception.md)
-        cut_up = [[_outline(x) for x in parts] if (parts := side_cut(q, sgrads, min_area_px)) else [q]
-                  for q in untraced]
-        new = _touching_cands(cands, [q for parts in cut_up for q in parts], dist, made_up)
-        start = 0
-        for parts in cut_up:
-            if len(parts) > 1:  # the parts of one cut are neighbours
+        new = []
+        for q in untraced:
+            parts = side_cut(q, sgrads, min_area_px)
+            group = _touching_cands(cands, [_outline(x) for x in parts] if parts else [q], dist, made_up)
+            if parts:  # the parts of one cut are neighbours
                 cut = next(made_up)
-                for k in range(start, start + len(parts)):
-                    new[k] = (new[k][0], new[k][1] | {cut}, new[k][2], new[k][3])
-            start += len(parts)
+                group = [(p, es | {cut}, sup, a) for p, es, sup, a in group]
+            new += group
         cands += new
     hues = [None] * len(cands)  # each face's chromaticity, for background_faces and _same_solid (colour alone)
     if colour_alone and cands:

@@ -1,6 +1,7 @@
 import cv2
 import numpy as np
 
+from lv3d.perception import rgb
 from lv3d.perception.polygons import rasterize
 from lv3d.perception.rgb import rgb_faces
 
@@ -124,6 +125,5 @@ def test_a_faint_edge_from_side_to_side_cuts_two_faces_of_one_colour_apart(monke
     res = rgb_faces(img, colour_alone=True)
     assert len(res.faces) == 2 and min(_best_iou(res, p, img.shape[:2]) for p in (top, front)) > 0.95
     # the edge map and the corner cuts miss this edge: without the side-to-side cut the two faces are one
-    import lv3d.perception.rgb as rgb
     monkeypatch.setattr(rgb, "side_cut", lambda *a, **k: None)
     assert len(rgb_faces(img, colour_alone=True).faces) == 1
