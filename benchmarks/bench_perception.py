@@ -176,7 +176,10 @@ class Rows:
     def __init__(self, path: Path | None):
         self.path, self.done = path, {}
         self.version = source_digest(_ROW_SOURCES)
-        if path is None or not path.exists():
+        if path is None:
+            return
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if not path.exists():
             return
         lines = path.read_text().splitlines()
         for n, line in enumerate(lines, 1):

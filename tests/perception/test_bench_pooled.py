@@ -29,7 +29,7 @@ def test_bad_seeds_stop_before_any_work(seeds, says, capsys):
 
 
 def test_rows_resume_without_perceiving_again(tmp_path, monkeypatch, capsys):
-    rows = tmp_path / "rows.jsonl"
+    rows = tmp_path / "new" / "rows.jsonl"  # its folder is made
     argv = ["--per-class", "1", "--presets", "clean", "--modalities", "rgb", "--seeds", "7,9", "--rows", str(rows)]
     assert bench.main(argv) == 0
     first = capsys.readouterr().out
