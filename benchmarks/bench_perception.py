@@ -19,7 +19,7 @@ recall by a point; recall is printed seed by seed too. Recall, precision and sid
 with a 95% interval from a bootstrap over scenes (faces of one scene are not independent). With ``--rows FILE``,
 each scene's evaluation is appended to FILE (JSON lines) as it is made, and a run with the same FILE skips the
 scenes already there that the same code evaluated under the same settings: a long run stopped part way goes on
-where it stopped.
+where it stopped. A kept scene's rgbd timings are those measured when it was made, perhaps on a busier machine.
 """
 
 from __future__ import annotations
