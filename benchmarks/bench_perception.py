@@ -132,20 +132,20 @@ def evaluate(scene, frame, faces_mask, min_face_px: int) -> dict:
     return out
 
 
+# the pooled ratios of summed per-scene counts (summarise), and those bootstrapped for intervals (interval)
+_RATIOS = {"recall": ("found", "gt_faces"), "precision": ("det_ok", "det_faces"), "sides": ("sides_ok", "found")}
+
+
 def summarise(rows: list[dict]) -> dict:
     s = {k: sum(r[k] for r in rows) for k in ("gt_faces", "found", "det_faces", "det_ok", "sides_ok", "target_hit",
                                                "gt_read", "found_read")}
     cat = {k: [x for r in rows for x in r[k]] for k in ("vertex_err", "normal_err", "dihedral_err")}
     med = lambda xs: float(np.median(xs)) if xs else float("nan")  # noqa: E731
-    return {"recall": s["found"] / max(1, s["gt_faces"]), "precision": s["det_ok"] / max(1, s["det_faces"]),
-            "sides": s["sides_ok"] / max(1, s["found"]), "vertex_med": med(cat["vertex_err"]),
+    return {**{k: s[num] / max(1, s[den]) for k, (num, den) in _RATIOS.items()}, "vertex_med": med(cat["vertex_err"]),
             "normal_med": med(cat["normal_err"]), "dihedral_med": med(cat["dihedral_err"]),
             "dihedral_n": len(cat["dihedral_err"]), "target": s["target_hit"] / max(1, len(rows)),
             "recall_read": s["found_read"] / max(1, s["gt_read"]), "read_share": s["gt_read"] / max(1, s["gt_faces"]),
             "scenes": len(rows)}
-
-
-_RATIOS = {"recall": ("found", "gt_faces"), "precision": ("det_ok", "det_faces"), "sides": ("sides_ok", "found")}
 
 
 def interval(rows: list[dict], key: str, seed: int = 0) -> tuple[float, float]:
