@@ -44,8 +44,16 @@ def read_color(path: Path) -> np.ndarray:
     return cv2.cvtColor(img, cv2.COLOR_BGR2RGB)
 
 
-def read_depth(path: Path, depth_scale_m: float) -> np.ndarray:
-    """A 16-bit depth image (PNG or TIFF) times ``depth_scale_m`` -> float32 metres; 0 stays 'no reading'."""
+# Plausible median depth of a frame, in metres: the working range of consumer RGB-D sensors (Kinect,
+# RealSense, structured light and time of flight read from about 0.15 m to about 8 m). A median outside it
+# means the depth was read in the wrong unit (millimetres taken as metres, or the reverse).
+DEPTH_RANGE_M = (0.15, 8.0)
+
+
+def read_depth(path: Path, depth_scale_m: float, scale_option: str = "--depth-scale") -> np.ndarray:
+    """A 16-bit depth image (PNG or TIFF) times ``depth_scale_m`` -> float32 metres; 0 stays 'no reading'.
+    A median reading outside :data:`DEPTH_RANGE_M` is an InputError that suggests a scale (named as
+    ``scale_option``, the option or key the user sets it with)."""
     path = Path(path)
     if not path.is_file():
         raise InputError(path, "depth image not found")
@@ -60,15 +68,37 @@ def read_depth(path: Path, depth_scale_m: float) -> np.ndarray:
         depth = np.nan_to_num(raw, nan=0.0, posinf=0.0, neginf=0.0) * np.float32(depth_scale_m)
     else:
         raise InputError(path, f"depth must be uint16 (or float32), not {raw.dtype}")
-    if not np.any(depth > 0):
+    valid = depth[depth > 0]
+    if valid.size == 0:
         raise InputError(path, "depth is all zero (no readings)")
+    _check_depth_range(path, float(np.median(valid)), depth_scale_m, scale_option)
     return depth
 
 
+def _check_depth_range(path: Path, median_m: float, scale: float, scale_option: str) -> None:
+    lo, hi = DEPTH_RANGE_M
+    if lo <= median_m <= hi:
+        return
+    # the power of ten per unit that puts the median nearest the middle of the range (geometric mean)
+    raw_median = median_m / scale
+    exponent = round(np.log10(np.sqrt(lo * hi)) - np.log10(raw_median))
+    suggested = 10.0 ** min(exponent, 0)  # at most 1 m per unit
+    if lo <= raw_median * suggested <= hi and suggested != scale:
+        fix = f"try {scale_option} {suggested:g}" if scale_option.startswith("--") else \
+            f"set {scale_option} to {suggested:g}"
+        advice = f"wrong depth unit? {fix}"
+    else:
+        advice = f"check the depth unit ({scale_option})"
+    raise InputError(path, f"median depth {median_m:.4g} m (at depth scale {scale:g} m per unit) is outside "
+                           f"the {lo:g}-{hi:g} m an RGB-D sensor reads; {advice}")
+
+
 def load_frame(color_path: Path, depth_path: Path | None, intrinsics: Intrinsics | None,
-               depth_scale_m: float = 0.001, name: str | None = None, meta: dict | None = None) -> RGBD:
+               depth_scale_m: float = 0.001, name: str | None = None, meta: dict | None = None,
+               scale_option: str = "--depth-scale") -> RGBD:
     """Load and validate one frame. Without ``depth_path`` the depth is all zeros (rgb-only use) and, without
-    ``intrinsics`` too, the intrinsics are nominal (:meth:`Intrinsics.nominal`)."""
+    ``intrinsics`` too, the intrinsics are nominal (:meth:`Intrinsics.nominal`). ``scale_option`` names where
+    the user sets the depth scale, for the error on depth in the wrong unit."""
     color = read_color(color_path)
     h, w = color.shape[:2]
     if intrinsics is None:
@@ -78,12 +108,12 @@ def load_frame(color_path: Path, depth_path: Path | None, intrinsics: Intrinsics
     if (intrinsics.width, intrinsics.height) != (w, h):
         raise InputError(color_path, f"image is {w}x{h} but the intrinsics are for "
                                      f"{intrinsics.width}x{intrinsics.height}")
-    if not (1e-6 < depth_scale_m < 1.0):
+    if not (1e-6 < depth_scale_m <= 1.0):
         raise InputError(depth_path or color_path, f"absurd depth scale {depth_scale_m} m per unit")
     if depth_path is None:
         depth = np.zeros((h, w), np.float32)
     else:
-        depth = read_depth(depth_path, depth_scale_m)
+        depth = read_depth(depth_path, depth_scale_m, scale_option)
         if depth.shape != (h, w):
             raise InputError(depth_path, f"depth is {depth.shape[1]}x{depth.shape[0]} but colour is {w}x{h}")
     return RGBD(color, depth, intrinsics, name or Path(color_path).stem, meta or {})
@@ -116,7 +146,7 @@ def load_item(item_dir: Path) -> RGBD:
         raise InputError(meta_path, "no intrinsics")
     k = Intrinsics.from_dict(meta["intrinsics"], str(meta_path))
     return load_frame(item_dir / "color.png", item_dir / "depth.png", k, float(meta.get("depth_scale_m", 0.001)),
-                      name=meta.get("id", item_dir.name), meta=meta)
+                      name=meta.get("id", item_dir.name), meta=meta, scale_option="depth_scale_m in meta.json")
 
 
 # Real frames in ../shared/data/real/pcl-kinect: name -> (colour file, depth file)
@@ -139,4 +169,4 @@ def load_real(folder: Path, name: str) -> RGBD:
         raise InputError(folder, f"no frame {name!r}; found: {', '.join(files) or 'none'}")
     k, scale = read_intrinsics(Path(folder) / "intrinsics.json", name)
     c, d = files[name]
-    return load_frame(c, d, k, scale, name=name)
+    return load_frame(c, d, k, scale, name=name, scale_option=f"depth_scale_m of {name!r} in intrinsics.json")

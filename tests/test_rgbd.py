@@ -6,7 +6,7 @@ import pytest
 
 from lv3d.camera import Intrinsics
 from lv3d.errors import InputError
-from lv3d.rgbd import load_frame, load_real, read_intrinsics, real_frame_files
+from lv3d.rgbd import DEPTH_RANGE_M, load_frame, load_real, read_intrinsics, real_frame_files
 
 
 def _write(tmp_path, w=64, h=48, depth=None):
@@ -67,3 +67,67 @@ def test_colour_alone_takes_nominal_intrinsics(tmp_path):
     assert f.intrinsics == Intrinsics.nominal(64, 48)
     assert (f.intrinsics.cx, f.intrinsics.cy) == (31.5, 23.5)
     assert not f.depth.any()
+
+
+@pytest.mark.parametrize("raw, scale, median, suggested", [
+    (1200, 1.0, "1200 m", "--depth-scale 0.001"),   # millimetres read as metres
+    (900, 0.0001, "0.09 m", "--depth-scale 0.001"),  # millimetres read as tenths of a millimetre
+    (12000, 0.001, "12 m", "--depth-scale 0.0001"),  # tenths of a millimetre read as millimetres
+])
+def test_depth_in_the_wrong_unit_names_the_file_and_the_scale(tmp_path, raw, scale, median, suggested):
+    depth = np.full((48, 64), raw, np.uint16)
+    depth[:10] = 0  # no reading: left out of the median
+    c, d = _write(tmp_path, depth=depth)
+    with pytest.raises(InputError) as e:
+        load_frame(c, d, Intrinsics(60, 60, 32, 24, 64, 48), scale)
+    msg = str(e.value)
+    assert "d.png" in msg and "--depth-scale" in msg and median in msg and suggested in msg, msg
+    assert "\n" not in msg
+
+
+def test_depth_in_the_right_unit_loads(tmp_path):
+    lo, hi = DEPTH_RANGE_M
+    assert (lo, hi) == (0.15, 8.0)
+    depth = np.zeros((48, 64), np.uint16)
+    depth[:, :40] = 650  # the median is taken over readings only: 0.65 m, with 0 in over a third of the image
+    c, d = _write(tmp_path, depth=depth)
+    f = load_frame(c, d, Intrinsics(60, 60, 32, 24, 64, 48), 0.001)
+    assert np.isclose(np.median(f.depth[f.depth > 0]), 0.65)
+
+
+def test_float_depth_in_metres_takes_scale_one(tmp_path):
+    c, _ = _write(tmp_path)
+    d = tmp_path / "d.tiff"
+    cv2.imwrite(str(d), np.full((48, 64), 1.5, np.float32))
+    k = Intrinsics(60, 60, 32, 24, 64, 48)
+    with pytest.raises(InputError, match=r"d\.tiff.*0\.0015 m.*--depth-scale 1\b"):
+        load_frame(c, d, k, 0.001)
+    assert np.allclose(load_frame(c, d, k, 1.0).depth, 1.5)
+
+
+def test_extract_reports_the_wrong_scale_in_one_line(tmp_path, capsys):
+    from lv3d.cli import main
+
+    c, d = _write(tmp_path, depth=np.full((48, 64), 1200, np.uint16))
+    k = tmp_path / "k.json"
+    k.write_text(json.dumps(Intrinsics(60, 60, 32, 24, 64, 48).to_dict()))
+    out = tmp_path / "o"
+    rc = main(["extract", str(c), "--depth", str(d), "--intrinsics", str(k), "--depth-scale", "1", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 2 and len(err.strip().splitlines()) == 1
+    assert "d.png" in err and "--depth-scale 0.001" in err
+    assert not out.exists()
+
+
+def test_a_data_set_item_names_its_meta_json_key(tmp_path):
+    from lv3d.rgbd import load_item
+
+    item = tmp_path / "s000000"
+    item.mkdir()
+    _write(item, depth=np.full((48, 64), 1200, np.uint16))
+    (item / "c.png").rename(item / "color.png")
+    (item / "d.png").rename(item / "depth.png")
+    (item / "meta.json").write_text(json.dumps({"intrinsics": Intrinsics(60, 60, 32, 24, 64, 48).to_dict(),
+                                                "depth_scale_m": 1.0}))
+    with pytest.raises(InputError, match=r"depth\.png.*set depth_scale_m in meta\.json to 0\.001"):
+        load_item(item)
