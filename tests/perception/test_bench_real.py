@@ -1,0 +1,215 @@
+"""The real-frame benchmark's figures on tiny hand-made scenes and masks, and its command line."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import benchmarks.bench_real as bench
+from lv3d.camera import Intrinsics
+from lv3d.facts import Fact, SceneFacts
+from lv3d.plane import Plane
+from lv3d.rgbd import RGBD
+from lv3d.scene import Face, Scene, SceneObject
+
+
+OSD = Path(__file__).resolve().parents[3] / "shared" / "data" / "real" / "osd-learn"
+H, W = 60, 80
+K = Intrinsics(fx=100.0, fy=100.0, cx=39.5, cy=29.5, width=W, height=H)
+
+
+def _rect(u0, v0, u1, v1):
+    """A rectangle's polygon covering pixel columns u0..u1 and rows v0..v1."""
+    return np.array([(u0, v0), (u1, v0), (u1, v1), (u0, v1)], float)
+
+
+def _obj(oid, rects, adjacency=()):
+    faces = [Face(f"{oid}_f{j + 1}", _rect(*r), "depth") for j, r in enumerate(rects)]
+    return SceneObject(oid, faces, list(adjacency))
+
+
+def _lab(obj, u, v, shape="box", partial=False, stacked=False, frame="f0"):
+    return bench.Label(frame, obj, u, v, shape, partial, stacked)
+
+
+def _mask(u0, v0, u1, v1):
+    m = np.zeros((H, W), bool)
+    m[v0:v1 + 1, u0:u1 + 1] = True
+    return m
+
+
+def test_frames_sort_naturally():
+    assert sorted(["learn10", "learn2", "learn1", "learn0"], key=bench.natural_key) == \
+        ["learn0", "learn1", "learn2", "learn10"]
+
+
+def test_the_object_under_a_pixel_is_the_one_with_most_faces_there_ties_to_the_first():
+    a = _obj("o1", [(0, 0, 40, 40)])
+    b = _obj("o2", [(20, 20, 60, 50), (30, 30, 60, 50)])
+    covers = [bench.face_cover(o, (H, W)) for o in (a, b)]
+    assert covers[1][35, 35] == 2 and covers[0][35, 35] == 1
+    assert bench.held_object(covers, 35, 35) == 1   # two of o2's faces cover it, one of o1's
+    assert bench.held_object(covers, 25, 25) == 0   # one face each: the first listed
+    assert bench.held_object(covers, 5, 5) == 0
+    assert bench.held_object(covers, 75, 55) is None
+
+
+def test_recall_needs_iou_one_half_and_split_needs_two_holders_of_a_fifth():
+    label = np.zeros((H, W), np.uint16)
+    label[_mask(0, 0, 19, 19)] = 1          # 400 px
+    label[_mask(40, 0, 79, 19)] = 2         # 800 px
+    label[_mask(0, 40, 9, 49)] = 3          # 100 px, missed
+    masks = [_mask(0, 0, 19, 21),           # IoU 400/440 with object 1
+             _mask(40, 0, 59, 19),          # half of object 2 (IoU 0.5)
+             _mask(60, 0, 79, 19)]          # the other half
+    n, matched, split = bench.gt_matches(label, masks)
+    assert (n, matched, split) == (3, 2, 1)
+    _, matched, split = bench.gt_matches(label, [_mask(0, 0, 79, 29)])  # one blob over objects 1 and 2
+    assert matched == 0 and split == 0
+
+
+def test_merged_with_masks_needs_a_fifth_of_the_other_and_without_masks_its_pixel():
+    regions = [np.nonzero(_mask(0, 0, 9, 9)), np.nonzero(_mask(20, 0, 29, 9))]  # 100 px each
+    big = _mask(0, 0, 21, 9)    # all of the first, 20 % of the second
+    small = _mask(0, 0, 20, 9)  # 10 % of the second
+    assert bench.merged_flags([0, None], [big], regions) == [True, False]  # not found: not merged
+    assert bench.merged_flags([0, None], [small], regions) == [False, False]
+    pixels = [(np.array([5]), np.array([5])), (np.array([5]), np.array([21]))]  # (rows, cols) of (u, v)
+    assert bench.merged_flags([0, 0], [big], pixels) == [True, True]
+    assert bench.merged_flags([0, 0], [small], pixels) == [False, True]
+
+
+def _standing(h0, h1, n=400, seed=0):
+    """Camera-frame points of an object whose heights above the plane y = 0.3 (normal up) span h0..h1 metres."""
+    rng = np.random.default_rng(seed)
+    h = rng.uniform(h0, h1, n)
+    return np.stack([rng.uniform(-0.1, 0.1, n), 0.3 - h, rng.uniform(0.8, 1.0, n)], 1)
+
+
+def test_support_is_where_objects_stand_nothing_sinks_and_a_stack_counts():
+    table = Plane.from_arrays((0.0, -1.0, 0.0), 0.3)  # y = 0.3, the camera's side above it
+    assert table.distance(_standing(0.1, 0.1, 1))[0] == pytest.approx(0.1)
+    on, floating, sunk = _standing(0.0, 0.1), _standing(0.5, 0.6), _standing(-0.1, 0.05)
+    assert bench.support_ok(table, [on]) is True
+    assert bench.support_ok(table, [on, _standing(0.1, 0.2)]) is True   # a box on a box
+    assert bench.support_ok(table, [floating]) is False                  # the floor under the table
+    assert bench.support_ok(table, [on, sunk]) is False                  # a box top taken for the table
+    assert bench.support_ok(None, [on]) is False
+    assert bench.support_ok(table, [on[:10]]) is None                    # too few points to say
+    far = _standing(0.03, 0.2) + np.array([0, 0, 3.0])                   # 4 m away: noise allows more
+    assert bench.support_ok(table, [far]) is True
+
+
+def test_pair_confidences_take_each_adjacent_pair_once_and_absent_facts_as_zero():
+    o = _obj("o1", [(0, 0, 5, 5)] * 3, [("o1_f1", "o1_f2"), ("o1_f2", "o1_f1"), ("o1_f1", "o1_f3")])
+    perp = {("o1_f1", "o1_f2"): 0.8, ("o1_f3", "o1_f1"): 0.3}
+    assert bench.pair_confidences(o, perp) == [0.8, 0.3]
+    assert bench.pair_confidences(o, {}) == [0.0, 0.0]
+
+
+def _scene(modality="depth"):
+    """A box of three faces (two perpendicular pairs) at left and a cylinder read as two faces at right, on a
+    flat table seen straight on at 1 m (heights from the plane z = 1 do not matter here)."""
+    box = _obj("s0_o1", [(2, 2, 20, 20), (21, 2, 35, 20), (2, 21, 20, 30)],
+               [("s0_o1_f1", "s0_o1_f2"), ("s0_o1_f1", "s0_o1_f3")])
+    cyl = _obj("s0_o2", [(45, 5, 60, 40), (61, 5, 75, 40)], [("s0_o2_f1", "s0_o2_f2")])
+    support = Plane.from_arrays((0.0, 0.0, -1.0), 1.0) if modality != "rgb" else None
+    scene = Scene("s0", modality, K, [box, cyl], support)
+    facts = [Fact("perpendicular", ("s0_o1_f1", "s0_o1_f2"), 0.9), Fact("perpendicular", ("s0_o1_f2", "s0_o1_f1"), 0.9),
+             Fact("perpendicular", ("s0_o2_f1", "s0_o2_f2"), 0.6)]
+    if modality == "rgb":
+        facts = []
+    depth = np.full((H, W), 1.0, np.float32)
+    frame = RGBD(np.zeros((H, W, 3), np.uint8), depth, K)
+    return scene, SceneFacts("s0", modality, facts), frame
+
+
+def test_a_frame_counts_each_labelled_object_once_and_the_figures_follow():
+    scene, facts, frame = _scene()
+    labels = [_lab(1, 10, 10, "box"), _lab(2, 50, 20, "cylinder"), _lab(3, 78, 58, "bowl"),
+              _lab(4, 30, 10, "box", partial=True)]  # the bowl is not found; box 4 lies on box 1's object
+    label = np.zeros((H, W), np.uint16)
+    label[_mask(2, 2, 20, 30)] = 1
+    label[_mask(45, 5, 75, 40)] = 2
+    label[_mask(70, 50, 79, 59)] = 3
+    label[_mask(21, 2, 35, 20)] = 4
+    row = bench.evaluate_frame(scene, facts, frame, labels, label)
+    assert (row["labelled"], row["found"]) == (4, 3)
+    assert row["merged"] == 2          # boxes 1 and 4 share one perceived object
+    assert (row["gt"], row["matched"], row["split"]) == (4, 2, 0)  # box 4's mask is a third of its object
+    assert row["support"] is True      # every object lies on the plane z = 1 m
+    assert (row["boxes"], row["box_over"], row["box_unocc"], row["box_perp"]) == (2, 0, 1, 1)
+    assert (row["round"], row["round_prism"]) == (2, 1)
+    assert row["pairs_p"] == [0.6] and row["pairs_y"] == [0.0]  # the merged box object is left out
+
+    f = bench.summarise([dict(row, ms=50.0), dict(row, ms=150.0)], "depth")
+    assert set(f) == set(bench.KEYS) | set(bench.EXTRA_KEYS)
+    assert f["object_recall"] == 0.5 and f["merged_frac"] == 0.5 and f["split_frac"] == 0.0
+    assert f["support_ok_frac"] == 1.0 and f["box_perpendicular_frac"] == 1.0
+    assert f["box_overfaced_frac"] == 0.0 and f["cylinder_as_prism_frac"] == 0.5
+    assert f["perpendicular_ece"] == pytest.approx(0.6)
+    assert f["ms_median"] == 100.0 and f["labelled_found"] == 0.75
+
+
+def test_ece_pools_box_and_cylinder_pairs_and_rgb_leaves_plane_figures_null():
+    scene, facts, frame = _scene()
+    labels = [_lab(1, 10, 10, "box"), _lab(2, 50, 20, "cylinder")]
+    row = bench.evaluate_frame(scene, facts, frame, labels, None)  # no masks: pixels decide
+    assert row["gt"] is None and row["merged"] == 0
+    assert sorted(zip(row["pairs_p"], row["pairs_y"])) == [(0.0, 1.0), (0.6, 0.0), (0.9, 1.0)]
+    f = bench.summarise([dict(row, ms=1.0)], "depth")
+    # bins: 0.0 (conf 0, truth 1), 0.6 (0.6, 0), 0.9 (0.9, 1): (1 + 0.6 + 0.1) / 3
+    assert f["perpendicular_ece"] == pytest.approx(1.7 / 3, abs=1e-4)
+    assert f["object_recall"] is None and f["split_frac"] is None
+
+    scene, facts, frame = _scene("rgb")
+    row = bench.evaluate_frame(scene, facts, frame, labels, None)
+    f = bench.summarise([dict(row, ms=1.0)], "rgb")
+    for key in ("support_ok_frac", "box_perpendicular_frac", "cylinder_as_prism_frac", "perpendicular_ece"):
+        assert f[key] is None
+    assert f["box_overfaced_frac"] == 0.0 and f["labelled_found"] == 1.0
+
+
+def test_the_table_puts_each_figure_beside_its_target():
+    f = {k: None for k in bench.KEYS + bench.EXTRA_KEYS}
+    text = bench.table("t", {"depth": dict(f, merged_frac=0.2, object_recall=0.95),
+                             "rgbd": dict(f, ms_median=80.0)}, ["depth", "rgbd"])
+    lines = {line.split()[0]: line for line in text.splitlines()[2:]}
+    assert "0.200 MISS" in lines["merged_frac"] and "<= 0.05" in lines["merged_frac"]
+    assert "0.950 ok" in lines["object_recall"]
+    assert "80.0 ok" in lines["ms_median"] and lines["split_frac"].rstrip().endswith("-")
+
+
+@pytest.mark.parametrize("missing", ["objects.csv", "intrinsics.json"])
+def test_a_folder_without_its_files_is_one_line_naming_it(tmp_path, capsys, missing):
+    (tmp_path / "f0_rgb.png").write_bytes(b"")
+    (tmp_path / "f0_depth_mm.png").write_bytes(b"")
+    for name in {"objects.csv", "intrinsics.json"} - {missing}:
+        (tmp_path / name).write_text("frame,object,u,v,shape,partial,stacked,notes\n" if name.endswith("csv") else "{}")
+    assert bench.main([str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(tmp_path) in err[0] and missing in err[0]
+
+
+def test_unknown_modality_stops_at_the_command_line(capsys):
+    with pytest.raises(SystemExit) as e:
+        bench.main(["--modalities", "depth,lidar"])
+    assert e.value.code == 2 and "choose among" in capsys.readouterr().err
+
+
+@pytest.mark.real
+def test_one_osd_frame_end_to_end_writes_every_figure(tmp_path, capsys):
+    osd = OSD
+    if not (osd / "objects.csv").is_file():
+        pytest.skip(f"real OSD frames not found at {osd} (../shared/data/real/osd-learn)")
+    out = tmp_path / "bench.json"
+    assert bench.main([str(osd), "--limit", "1", "--modalities", "depth", "--json", str(out)]) == 0
+    d = json.loads(out.read_text())
+    keys = set(bench.KEYS) | set(bench.EXTRA_KEYS)
+    assert set(d) == {"pooled", "folders"} and set(d["folders"]) == {"osd-learn"}
+    assert set(d["pooled"]) == {"depth"} and set(d["pooled"]["depth"]) == keys
+    fig = d["folders"]["osd-learn"]["depth"]
+    assert set(fig) == keys
+    assert fig["object_recall"] is not None and fig["ms_median"] > 0 and fig["cylinder_as_prism_frac"] is None
+    assert "object_recall" in capsys.readouterr().out
