@@ -26,6 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from lv3d.errors import InputError  # noqa: E402
 from lv3d.experiment.config import LOGIC_SYSTEMS, conditions, load_config  # noqa: E402
 from lv3d.experiment.runner import _write_json, fold_path, result_key  # noqa: E402
+from lv3d.output import claim  # noqa: E402
 
 
 def read_rows(path: Path) -> dict[tuple[str, str, int], dict[str, dict]]:
@@ -49,6 +50,7 @@ def restore(config: Path, results: Path, out: Path, overrides: list[str] = ()) -
     cfg = load_config(config, list(overrides))
     cells = read_rows(results)
     written = 0
+    claim(out, (config, results))  # the study's --out: refused unless new, empty or lv3d's own
     for cname, ccfg in conditions(cfg, config).items():
         for s in ccfg["systems"]:
             if s in LOGIC_SYSTEMS:

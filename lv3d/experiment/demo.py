@@ -108,7 +108,9 @@ def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int,
     from ..render.noise import noise_config
 
     noise_config(noise)  # an unknown preset is an InputError before anything is written
-    out.mkdir(parents=True, exist_ok=True)
+    from ..output import claim
+
+    claim(out)  # a new, empty or lv3d-written folder, filled in place (a rerun reuses its data and facts)
     click.echo(f"1. rendering {per_class} images of each of {', '.join(CLASSES)} ({noise} noise)")
     data = data_mod.ensure_dataset(cfg, out)
     items = data_mod.read_items(data)

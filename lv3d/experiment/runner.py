@@ -18,6 +18,7 @@ import numpy as np
 import yaml
 from tqdm import tqdm
 
+from ..output import claim
 from . import data as data_mod
 from .code_version import learner_version
 from .config import LOGIC_SYSTEMS, conditions, digest, load_config
@@ -163,7 +164,7 @@ def run_study(config: Path, out: Path, overrides: list[str] = (), progress: bool
     config, out = Path(config), Path(out)
     cfg = load_config(config, list(overrides))
     conds = conditions(cfg, config)
-    out.mkdir(parents=True, exist_ok=True)
+    claim(out, (config,), own=_is_study)  # a new, empty or lv3d-written folder; filled in place, so it resumes
     (out / "config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
     jobs = [(c, s, k) for c in conds for s in conds[c]["systems"] for k in range(conds[c]["folds"])]
     ran = skipped = 0
@@ -207,6 +208,11 @@ def run_study(config: Path, out: Path, overrides: list[str] = (), progress: bool
     bar.close()
     summary = write_report(out, cfg, conds)
     return {"ran": ran, "skipped": skipped, "report": summary}
+
+
+def _is_study(folder: Path) -> bool:
+    """A study's work folder (its config.yaml and folds/) is lv3d's own, marker or not."""
+    return (folder / "config.yaml").is_file() and (folder / "folds").is_dir()
 
 
 def _finished_keys(out: Path) -> dict[str, Path]:

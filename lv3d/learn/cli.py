@@ -77,13 +77,16 @@ _facts = click.option("--facts", type=click.Choice(["truth", "pipeline"]), defau
 @click.option("--time-limit", type=float, default=None, help="seconds per class")
 def fit(data: Path, modality: str, facts: str, classes: str | None, out: Path, seed: int, time_limit: float | None):
     """Learn one program per class and save them as .pl files in OUT."""
+    from ..output import check_out, replacing
     from .model import Model
 
+    check_out(out, (data,))  # before any work: a file, a folder lv3d did not write or one holding the data
     wanted = [c.strip() for c in classes.split(",")] if classes else None
     scenes, labels = _dataset_scenes(data, modality, facts)
     settings = {"time_limit": time_limit} if time_limit else None
     model = Model.fit(scenes, labels, settings=settings, seed=seed, classes=wanted)
-    model.save(out)
+    with replacing(out, (data,)) as tmp:  # written beside OUT, then moved into its place
+        model.save(tmp)
     for c, p in model.programs.items():
         click.echo(f"% {c}: covers {p.score['tp']}/{p.score['n_pos']} positives, "
                    f"{p.score['fp']}/{p.score['n_neg']} negatives\n{p}\n")

@@ -3,15 +3,13 @@
 from __future__ import annotations
 
 import json
-import os
-import shutil
-import tempfile
 from pathlib import Path
 
 import click
 import cv2
 
 from ..errors import InputError
+from ..output import check_out, replacing
 
 
 @click.command()
@@ -40,6 +38,8 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
     for image in (color, depth if modality != "rgb" else None):
         if image is not None and not Path(image).is_file():
             raise InputError(image, "image not found")
+    inputs = (color, depth, intrinsics)
+    check_out(out_dir, inputs)  # before any work: a file, a folder lv3d did not write or one holding an input
     frame_name = Path(color).stem.removesuffix("_rgb")
     # colour alone reads no depth: without a file, load_frame fills in nominal intrinsics
     k, scale = read_intrinsics(intrinsics, frame_name) if intrinsics is not None else (None, 0.001)
@@ -53,31 +53,17 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
         from ..describe import describe  # written beside grounding; imported only when asked for
 
         facts_obj = describe(scene, frame)
-    _write_atomically(Path(out_dir), scene, draw_overlay(frame.color, scene), facts_obj)
+    _write(Path(out_dir), inputs, scene, draw_overlay(frame.color, scene), facts_obj)
     click.echo(f"{out_dir}: {len(scene.objects)} objects, "
                f"{sum(len(o.faces) for o in scene.objects)} faces, target {scene.target().id}")
 
 
-def _write_atomically(out_dir: Path, scene, overlay_rgb, facts_obj) -> None:
-    """Write everything into a temporary folder beside ``out_dir``, then move it into place, so that an
-    error never leaves half the outputs behind."""
-    out_dir = out_dir.resolve()
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
-    try:
+def _write(out_dir: Path, inputs, scene, overlay_rgb, facts_obj) -> None:
+    """Write everything into a temporary folder beside ``out_dir``, then move it into place
+    (:func:`lv3d.output.replacing`), so that an error never leaves half the outputs behind."""
+    with replacing(out_dir, inputs) as tmp:
         (tmp / "scene.json").write_text(json.dumps(scene.to_dict(), indent=1, default=float))
         if not cv2.imwrite(str(tmp / "overlay.png"), cv2.cvtColor(overlay_rgb, cv2.COLOR_RGB2BGR)):
             raise InputError(out_dir, "cannot write overlay.png")
         if facts_obj is not None:
             facts_obj.write(tmp)
-        if out_dir.exists():
-            # replace an earlier run's outputs: move the old folder aside first, drop it after the rename
-            old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old.", dir=out_dir.parent))
-            os.replace(out_dir, old / "x")
-            os.replace(tmp, out_dir)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, out_dir)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise

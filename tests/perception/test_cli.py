@@ -70,3 +70,19 @@ def test_extract_names_the_missing_image_before_looking_up_its_intrinsics(tmp_pa
     assert rc == 2
     err = capsys.readouterr().err
     assert "nope_rgb.png: image not found" in err and not (tmp_path / "o").exists()
+
+
+def test_extract_replaces_its_own_output_and_nothing_else(tmp_path, box_frame, capsys):
+    from lv3d.output import MARKER
+
+    c, d, k = _write_frame(tmp_path, box_frame[0])
+    out = tmp_path / "out"
+    args = ["extract", str(c), "--depth", str(d), "--intrinsics", str(k), "--out", str(out)]
+    assert main(args + ["--facts"]) == 0 and (out / "facts.pl").is_file() and (out / MARKER).is_file()
+    assert main(args) == 0  # a rerun into lv3d's own output replaces it
+    assert sorted(p.name for p in out.iterdir()) == [MARKER, "overlay.png", "scene.json"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["box_depth.png", "box_rgb.png", "k.json", "out"]
+    (out / MARKER).unlink()  # no longer marked as lv3d's: refused, left as it is
+    capsys.readouterr()
+    assert main(args) == 2 and "lv3d did not write" in capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == ["overlay.png", "scene.json"]

@@ -1,0 +1,176 @@
+"""Output folders: lv3d writes only into folders of its own and never removes what it did not write.
+
+Every folder a command writes (``--out``) carries the marker file :data:`MARKER`. An ``--out`` is taken
+when it does not exist, is an empty folder, or carries the marker; it is refused, with a one-line
+:class:`InputError` and before any work, when it is a regular file, a non-empty folder without the marker,
+or a folder that is or holds one of the command's inputs.
+
+Two ways to write:
+
+- :func:`replacing` (``lv3d extract``, ``lv3d learn fit``): everything is written into a temporary folder
+  beside ``--out``, which then takes ``--out``'s place; the folder it replaces is removed only when it
+  carries the marker (or is empty). An error at any point leaves ``--out`` as it was and no temporary
+  folder behind.
+- :func:`claim` (``lv3d experiment run``, ``lv3d demo``): the folder is checked, made and marked, then
+  filled in place, one complete file at a time, so that a rerun resumes from what is there.
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+import shutil
+import tempfile
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from .errors import InputError
+
+MARKER = ".lv3d-output"
+_MARKER_TEXT = "This folder was written by lv3d; lv3d may replace or add to it when run with this --out again.\n"
+
+
+def is_own(path: Path) -> bool:
+    """Whether ``path`` is a folder written by lv3d (it carries :data:`MARKER`)."""
+    return (Path(path) / MARKER).is_file()
+
+
+def check_out(out: Path, inputs: Iterable[Path | None] = (), option: str = "--out",
+              own: Callable[[Path], bool] | None = None) -> Path:
+    """``out`` resolved (symbolic links followed), or an InputError when lv3d must not write there.
+    ``inputs``: the paths the command reads (files or folders; None is skipped). ``own``: recognises a folder
+    of this command's output that carries no marker (its layout is lv3d's own)."""
+    target = Path(out).expanduser().resolve()
+    where = f"{option} {out}"
+    if target.parent == target:
+        raise InputError(where, "is the root of the file system; choose a folder of its own")
+    for p in inputs:
+        if p is None:
+            continue
+        rp = Path(p).expanduser().resolve()
+        if rp == target or target in rp.parents:
+            what = "is" if rp == target else "holds"
+            raise InputError(where, f"{what} the input {p}; choose a folder of its own for the output")
+    _refuse_foreign(target, where, own)
+    return target
+
+
+def _refuse_foreign(target: Path, where: str, own: Callable[[Path], bool] | None = None) -> None:
+    if target.exists() or target.is_symlink():
+        if not target.is_dir():
+            raise InputError(where, "exists and is not a folder; lv3d writes a folder here and will not "
+                                    "overwrite it")
+        if not (is_own(target) or _is_empty(target) or (own is not None and own(target))):
+            raise InputError(where, f"is a folder with files lv3d did not write (no {MARKER} file in it); "
+                                    "choose a new or empty folder")
+
+
+def _is_empty(folder: Path) -> bool:
+    try:
+        return not any(folder.iterdir())
+    except OSError as e:
+        raise InputError(folder, f"cannot read the folder: {e.strerror}") from None
+
+
+def _writable_tree(folder: Path) -> str | None:
+    """The first folder at or under ``folder`` that this process cannot change (None when all can be)."""
+    for root, dirs, _ in os.walk(folder):
+        if not os.access(root, os.W_OK | os.X_OK):
+            return root
+    return None
+
+
+def _existing_parent(path: Path) -> Path:
+    p = path.parent
+    while not p.exists():
+        p = p.parent
+    return p
+
+
+def _make_parent(target: Path, where: str) -> None:
+    parent = _existing_parent(target)
+    if not parent.is_dir():
+        raise InputError(where, f"{parent} is not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InputError(where, f"cannot write in {parent} (read-only)")
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(where, f"cannot create {target.parent}: {e.strerror}") from None
+
+
+def claim(out: Path, inputs: Iterable[Path | None] = (), option: str = "--out",
+          own: Callable[[Path], bool] | None = None) -> Path:
+    """Check ``out`` (:func:`check_out`), make it and mark it as lv3d's, for a command that fills it in place.
+    Returns the resolved folder."""
+    target = check_out(out, inputs, option, own)
+    where = f"{option} {out}"
+    if target.is_dir():
+        if not os.access(target, os.W_OK | os.X_OK):
+            raise InputError(where, "is read-only")
+    else:
+        _make_parent(target, where)
+        try:
+            target.mkdir()
+        except OSError as e:
+            raise InputError(where, f"cannot create the folder: {e.strerror}") from None
+    if not is_own(target):
+        try:
+            (target / MARKER).write_text(_MARKER_TEXT)
+        except OSError as e:
+            raise InputError(where, f"cannot write in the folder: {e.strerror}") from None
+    return target
+
+
+@contextmanager
+def replacing(out: Path, inputs: Iterable[Path | None] = (), option: str = "--out") -> Iterator[Path]:
+    """Yield a new, empty temporary folder beside ``out`` to write the outputs into; when the block ends
+    without an error the folder gets the marker and takes ``out``'s place. On any error ``out`` is left as it
+    was and the temporary folder is removed."""
+    target = check_out(out, inputs, option)
+    where = f"{option} {out}"
+    if target.is_dir():
+        blocked = _writable_tree(target)
+        if blocked is not None:
+            raise InputError(where, f"cannot replace it: {blocked} is read-only")
+    _make_parent(target, where)
+    try:
+        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.partial-", dir=target.parent))
+    except OSError as e:
+        raise InputError(where, f"cannot write beside it: {e.strerror}") from None
+    try:
+        yield tmp
+        (tmp / MARKER).write_text(_MARKER_TEXT)
+        _swap_in(tmp, target, where)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def _swap_in(new: Path, target: Path, where: str) -> None:
+    """Move the folder ``new`` to ``target``; an earlier ``target`` (lv3d's own or empty) is removed after."""
+    if not (target.exists() or target.is_symlink()):
+        try:
+            os.rename(new, target)
+        except OSError as e:
+            raise InputError(where, f"cannot move the output into place: {e.strerror}") from None
+        return
+    _refuse_foreign(target, where)  # still lv3d's own or empty: nothing else is ever moved aside
+    old = target.parent / f".{target.name}.old-{os.getpid()}-{secrets.token_hex(4)}"
+    try:
+        os.rename(target, old)  # within one folder: needs no write access to the folder moved
+    except OSError as e:
+        raise InputError(where, f"cannot replace it: {e.strerror}") from None
+    try:
+        os.rename(new, target)
+    except BaseException as e:
+        os.rename(old, target)  # put the earlier output back
+        if isinstance(e, OSError):
+            raise InputError(where, f"cannot move the output into place: {e.strerror}") from None
+        raise
+    try:
+        shutil.rmtree(old)
+    except OSError as e:
+        raise InputError(where, f"written, but the earlier output moved to {old} could not be removed: "
+                                f"{e.strerror}; remove it by hand") from None
