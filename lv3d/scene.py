@@ -44,13 +44,16 @@ class Face:
 
 @dataclass
 class SceneObject:
-    """One segmented object: its faces and the pairs of them that share an edge."""
+    """One segmented object: its faces and the pairs of them that share an edge. ``mask``: the object's segment,
+    (H, W) bool over the image, where perception segmented it as a region (depth); None where the object is
+    only its faces (colour alone). Not serialised."""
 
     id: str
     faces: list[Face] = field(default_factory=list)
     adjacency: list[tuple[str, str]] = field(default_factory=list)
     pixel_count: int = 0
     centroid_px: tuple[float, float] = (0.0, 0.0)
+    mask: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def face(self, face_id: str) -> Face:
         return next(f for f in self.faces if f.id == face_id)
@@ -70,6 +73,7 @@ class Scene:
     objects: list[SceneObject] = field(default_factory=list)
     support_plane: Plane | None = None
     timings_ms: dict[str, float] = field(default_factory=dict)
+    dropped_objects: int = 0  # objects found beyond perception's cap on objects (the smallest), not described
 
     def target(self) -> SceneObject | None:
         """The object a label speaks of: the one nearest the image centre (the camera is aimed at it; clutter
@@ -95,4 +99,5 @@ class Scene:
                 "intrinsics": self.intrinsics.to_dict(),
                 "support_plane": self.support_plane.to_dict() if self.support_plane else None,
                 "target": t.id if t else None, "objects": [o.to_dict() for o in self.objects],
+                "dropped_objects": self.dropped_objects,
                 "timings_ms": self.timings_ms}

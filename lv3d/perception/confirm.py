@@ -87,5 +87,5 @@ def renumber(objects: list[SceneObject], scene_id: str) -> list[SceneObject]:
         ids = {f.id: face_id(scene_id, k, j) for j, f in enumerate(o.faces, start=1)}
         faces = [dataclasses.replace(f, id=ids[f.id]) for f in o.faces]
         adj = sorted(tuple(sorted((ids[a], ids[b]))) for a, b in o.adjacency)
-        out.append(SceneObject(object_id(scene_id, k), faces, adj, o.pixel_count, o.centroid_px))
+        out.append(SceneObject(object_id(scene_id, k), faces, adj, o.pixel_count, o.centroid_px, o.mask))
     return out

@@ -10,7 +10,7 @@ from ..errors import InputError
 from ..facts import MODALITIES, face_id, object_id
 from ..rgbd import RGBD
 from ..scene import Face, Scene, SceneObject
-from .depth import DepthObjectResult, DepthResult, depth_scene
+from .depth import MAX_OBJECTS, DepthObjectResult, DepthResult, depth_scene
 from .edge_on import on_unclaimed_plane, points_dropped
 from .boundary import grid_to_pixels
 from .confirm import replace_unconfirmed, unconfirmed
@@ -28,20 +28,25 @@ _CROP_MARGIN_PX = 14
 _PART_LEFT_OUT = 0.25
 
 
-def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 0) -> Scene:
+def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 0,
+             max_objects: int = MAX_OBJECTS) -> Scene:
     """Objects and faces of ``frame`` as a system that sees ``modality`` ('rgb', 'depth', 'rgbd') finds them.
 
-    Object ids are ``<scene>_o<k>`` and face ids ``<scene>_o<k>_f<j>``, k and j from 1, objects largest first.
+    At most ``max_objects`` objects found by depth are described (the largest); ``Scene.dropped_objects`` counts
+    the rest. Object ids are ``<scene>_o<k>`` and face ids ``<scene>_o<k>_f<j>``, k and j from 1, objects largest first.
     ``Scene.timings_ms`` holds the time of each stage. Deterministic for a given ``seed``."""
     if modality not in MODALITIES:
         raise InputError("--modality", f"unknown modality {modality!r}; choose one of {', '.join(MODALITIES)}")
+    if not isinstance(max_objects, int) or max_objects < 1:
+        raise InputError("--max-objects", f"must be a whole number of at least 1, got {max_objects!r}")
     _check_frame(frame, modality)
     if modality == "rgb":
         scene = Scene(scene_id, modality, frame.intrinsics, timings_ms={})
         scene.objects = _colour_objects(frame, scene_id, scene.timings_ms)
         return scene
-    dres = depth_scene(frame, seed=seed)
-    scene = Scene(scene_id, modality, frame.intrinsics, support_plane=dres.support, timings_ms=dict(dres.timings_ms))
+    dres = depth_scene(frame, seed=seed, max_objects=max_objects)
+    scene = Scene(scene_id, modality, frame.intrinsics, support_plane=dres.support, timings_ms=dict(dres.timings_ms),
+                  dropped_objects=dres.dropped_objects)
     if modality == "depth":
         scene.objects = [_depth_object(scene_id, k + 1, o, dres, frame) for k, o in enumerate(dres.objects)]
         return scene
@@ -130,7 +135,13 @@ def _depth_object(scene_id: str, k: int, o: DepthObjectResult, dres: DepthResult
         faces.append(Face(fid, f.polygon, "depth", plane=f.plane, points=f.points, plane_rms_m=f.rms_m))
         adj += [(index[a], fid) for a in f.neighbours if a in index]
     count, centroid = _object_pixels(o, stride)
-    return SceneObject(object_id(scene_id, k), faces, adj, count, centroid)
+    return SceneObject(object_id(scene_id, k), faces, adj, count, centroid, _segment(o, stride, frame.shape))
+
+
+def _segment(o: DepthObjectResult, stride: int, shape: tuple[int, int]) -> np.ndarray:
+    """The depth object's cells as a pixel mask over the whole image (h, w)."""
+    h, w = shape
+    return grid_to_pixels(o.obj.mask, stride, (0, 0, w, h))
 
 
 def _crop_box(o: DepthObjectResult, shape: tuple[int, int]) -> tuple[int, int, int, int]:
@@ -263,7 +274,7 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         adj = sorted((min(faces[rank[a]].id, faces[rank[b]].id), max(faces[rank[a]].id, faces[rank[b]].id))
                      for a, b in pairs)
         count, centroid = _object_pixels(o, stride)
-        out.append(SceneObject(object_id(scene_id, k), faces, adj, count, centroid))
+        out.append(SceneObject(object_id(scene_id, k), faces, adj, count, centroid, _segment(o, stride, (h, w))))
         timings["fuse"] += (time.perf_counter() - t0) * 1e3
     return out
 

@@ -1,0 +1,146 @@
+"""Objects cut at concave creases: the local-convexity segmentation of PCL's LCCP (Stein et al. 2014), on an
+object's planes.
+
+1. Patches: the object's planes (planes.object_planes) over-segment its surface; a can's side or a bowl comes
+   as a fan of planes.
+2. Junctions: every pair of touching planes is convex (the surface bends outwards, as at a solid's edge) or
+   concave (it bends inwards, as where one solid stands on or leans against another). With n_i, n_j the
+   normals (towards the camera) and c_i, c_j the centroids of each plane's cells near the junction, it is convex
+   when (n_i - n_j) . (c_i - c_j) > 0.
+3. Solids: planes joined across every junction that is not a sharp concave crease; what is left joined only
+   across such creases is a solid of its own. Cells on no plane go to the solid of the nearest plane cell.
+
+A solid's own concave surface (the inside of a bowl or a mug) stays joined to the rest through its rim, a convex
+junction, as in LCCP; an object with a concave junction too gentle to be a crease between solids is not cut
+at all (``ConvexitySettings.concave_tol_deg``).
+
+Why planes rather than region growing on normals: on Kinect depth the normals turn smoothly across a box's
+edges (the sensor smooths them), so growing from neighbour to neighbour crosses them; a plane's points give its
+normal near a junction with far less noise than any local patch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+from .cloud import PointGrid
+from .planes import DepthPlane
+
+
+@dataclass(frozen=True)
+class ConvexitySettings:
+    """Thresholds of the cut at concave creases (scale-free: angles and fractions of the object's size).
+
+    ``concave_min_deg`` (degrees): the smallest angle between two patches' normals at a concave junction that cuts
+    the object there. Solids rest on flat faces, so where one stands on or against another the crease is about
+    as sharp as the angle between those faces (near 90 deg for boxes and cans).
+    ``concave_tol_deg`` (degrees): a concave junction gentler than ``concave_min_deg`` but sharper than this is a
+    concave surface of one solid; such an object is not cut, since its sharper creases may be that surface's
+    too. LCCP's own concavity tolerance is of this size (10 deg).
+    ``band_frac``: the width of the strip on each side of a junction whose cells give that side's normal and
+    centroid, as a fraction of the object's larger extent on the grid.
+    ``contact_frac``: the least length of a junction, as a fraction of the smaller patch's perimeter (four times
+    the square root of its cell count): patches that touch at a corner are not neighbours.
+    """
+
+    concave_min_deg: float = 55.0
+    concave_tol_deg: float = 10.0
+    band_frac: float = 0.08
+    contact_frac: float = 0.05
+
+
+DEFAULT = ConvexitySettings()
+
+
+def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, settings: ConvexitySettings = DEFAULT
+              ) -> list[tuple[int, int, float]]:
+    """Every pair (a, b, bend) of touching patches (labels a < b): ``bend`` (degrees) is the angle between their
+    normals near the junction, negative where the surface bends inwards there (concave)."""
+    k = int(labels.max())
+    if k < 2:
+        return []
+    ij = np.argwhere(labels > 0)
+    extent = int((ij.max(axis=0) - ij.min(axis=0)).max()) + 1
+    band = max(2, int(round(settings.band_frac * extent)))
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * band + 1, 2 * band + 1))
+    masks = [labels == a for a in range(1, k + 1)]
+    sizes = [int(np.count_nonzero(m)) for m in masks]
+    touch = [cv2.dilate(m.view(np.uint8), np.ones((3, 3), np.uint8), iterations=2).view(bool) for m in masks]
+    out = []
+    for a in range(k):
+        for b in range(a + 1, k):
+            contact = np.count_nonzero(touch[a] & masks[b])
+            if contact < max(3, settings.contact_frac * 4 * np.sqrt(min(sizes[a], sizes[b]))):
+                continue
+            near_b = cv2.dilate(masks[b].view(np.uint8), kernel).view(bool) & masks[a]
+            near_a = cv2.dilate(masks[a].view(np.uint8), kernel).view(bool) & masks[b]
+            na, nb = normals[near_b].sum(axis=0), normals[near_a].sum(axis=0)
+            la, lb = np.linalg.norm(na), np.linalg.norm(nb)
+            if la == 0 or lb == 0:
+                continue
+            na, nb = na / la, nb / lb
+            ca, cb = xyz[near_b].mean(axis=0), xyz[near_a].mean(axis=0)
+            angle = float(np.degrees(np.arccos(np.clip(na @ nb, -1.0, 1.0))))
+            convex = float((na - nb) @ (ca - cb)) > 0
+            out.append((a + 1, b + 1, angle if convex else -angle))
+    return out
+
+
+def _solids(k: int, bends: list[tuple[int, int, float]], settings: ConvexitySettings) -> list[int]:
+    """Solid label of patches 1..k (list index 0 unused), joined across the junctions that are not sharp concave
+    creases; a group with no crease to another group joins the largest group (nothing says it is a solid)."""
+    parent = list(range(k + 1))
+
+    def find(a: int) -> int:
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    for a, b, bend in bends:
+        if bend > -settings.concave_min_deg:
+            parent[find(a)] = find(b)
+    label = [find(a) for a in range(k + 1)]
+    cut = set()
+    for a, b, bend in bends:
+        if bend <= -settings.concave_min_deg and label[a] != label[b]:
+            cut |= {label[a], label[b]}
+    home = label[1] if label[1] in cut else (min(cut) if cut else label[1])
+    return [label[a] if label[a] in cut else home for a in range(k + 1)]
+
+
+def split_at_concave(grid: PointGrid, obj_mask: np.ndarray, planes: list[DepthPlane],
+                     settings: ConvexitySettings = DEFAULT) -> list[np.ndarray]:
+    """The object's cells ``obj_mask`` (h, w) bool on ``grid`` cut into solids at sharp concave creases between its
+    ``planes``; one mask (the object's own) when nothing cuts it."""
+    rows, cols = np.flatnonzero(obj_mask.any(axis=1)), np.flatnonzero(obj_mask.any(axis=0))
+    if len(rows) == 0:
+        return [obj_mask]
+    i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    m = obj_mask[i0:i1, j0:j1]
+    p = grid.xyz[i0:i1, j0:j1].astype(np.float64)
+    n = np.zeros(p.shape)
+    labels = np.zeros(m.shape, np.int32)
+    for k, q in enumerate(planes, start=1):
+        on = q.mask[i0:i1, j0:j1] & m & (labels == 0)
+        labels[on] = k
+        n[on] = q.plane.n
+    bends = junctions(labels, p, n, settings)
+    if not any(b <= -settings.concave_min_deg for _, _, b in bends):
+        return [obj_mask]
+    if any(-settings.concave_min_deg < b < -settings.concave_tol_deg for _, _, b in bends):
+        return [obj_mask]  # a concave surface of one solid (module docstring)
+    solid = np.asarray(_solids(int(labels.max()), bends, settings))
+    # every object cell takes the solid of its nearest plane cell
+    _, (ii, jj) = ndimage.distance_transform_edt(labels == 0, return_indices=True)
+    per_cell = solid[labels[ii, jj]]
+    out = []
+    for s in np.unique(per_cell[m]):
+        full = np.zeros_like(obj_mask)
+        full[i0:i1, j0:j1] = m & (per_cell == s)
+        out.append(full)
+    return out if len(out) > 1 else [obj_mask]
