@@ -10,6 +10,7 @@ from ..rgbd import RGBD
 from .noise import NoiseConfig, as_config, noisy_color, noisy_depth
 from .raycast import Body, ray_lengths, raycast
 from .sampler import FLOOR_Z_M, TABLE_THICKNESS_M, Layout, sample_layout
+from .appearance import design_prints, multi_hue_albedo
 from .shading import environment_colour, object_albedo, shade
 from .solids import CLASSES, Solid, box
 from .truth import scene_truth
@@ -62,8 +63,11 @@ def render_scene(cls: str, seed: int, noise: str | NoiseConfig = "clean", width:
     cfg = as_config(noise)
     k = Intrinsics.realsense_d435(int(width), int(height))
     k.validate("image size")
-    layout_rng, look_rng, noise_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(int(seed)).spawn(3))
-    layout = sample_layout(cls, cfg, k, layout_rng)
+    # one stream per concern; the last three draw only what the appearance and sensor knobs add, so the
+    # knobs of the original presets see the same numbers with them or without
+    layout_rng, look_rng, noise_rng, extra_rng, paint_rng, sensor_rng = (
+        np.random.default_rng(s) for s in np.random.SeedSequence(int(seed)).spawn(6))
+    layout = sample_layout(cls, cfg, k, layout_rng, extra_rng)
     w2c = layout.world_to_camera
 
     roles, bodies, albedo = [], [], []
@@ -71,13 +75,24 @@ def render_scene(cls: str, seed: int, noise: str | NoiseConfig = "clean", width:
         roles.append(role)
         bodies.append(Body(solid, w2c @ to_world))
         albedo.append(np.tile(environment_colour(role, look_rng), (len(solid.faces), 1)))
-    objects = [("target", layout.target)] + [("clutter", c) for c in layout.clutter]
+    objects = [("target", layout.target)] + [("clutter", c) for c in layout.clutter] \
+        + [("contact", c.placed) for c in layout.contacts]
     if layout.occluder is not None:
         objects.append(("occluder", layout.occluder))
+    prints = []
     for role, placed in objects:
         roles.append(role)
-        bodies.append(Body(placed.solid, w2c @ placed.to_world))
-        albedo.append(object_albedo(len(placed.solid.faces), look_rng))
+        body = Body(placed.solid, w2c @ placed.to_world)
+        n_faces = len(placed.solid.faces)
+        alb = object_albedo(n_faces, paint_rng if role == "contact" else look_rng)
+        if cfg.face_hues > 0 and paint_rng.random() < cfg.face_hues:
+            alb = multi_hue_albedo(n_faces, paint_rng)
+        if cfg.printed_faces > 0:
+            first = sum(len(b.solid.faces) for b in bodies)  # the body's first flat face index
+            for face, pr in design_prints(placed.solid, alb, cfg.printed_faces, paint_rng).items():
+                prints.append((first + face, np.linalg.inv(body.to_camera @ pr.frame), pr))
+        bodies.append(body)
+        albedo.append(alb)
     target_index = roles.index("target")
 
     # the light comes from the camera's side of the scene, so the wall behind the table cannot shade it all
@@ -87,19 +102,22 @@ def render_scene(cls: str, seed: int, noise: str | NoiseConfig = "clean", width:
     light_cam = w2c[:3, :3] @ light_world
     hits = raycast(bodies, k, light_cam if cfg.shadows else None, background=3)
 
-    color = shade(hits, layout, roles, albedo, light_cam, cfg, look_rng)
+    color = shade(hits, layout, roles, albedo, light_cam, cfg, look_rng, prints)
     # on a face's plane n . X + offset = 0 with X = z * ray, so |n . ray| / |ray| = |offset| / (z |ray|)
     cos_inc = None
     if cfg.grazing_deg < 90:
         offset = np.take(np.append(hits.face_offset, 1.0).astype(np.float32), hits.gface)
         cos_inc = np.abs(offset) / np.maximum(hits.depth * ray_lengths(k), np.float32(1e-9))
-    depth = noisy_depth(hits.depth, cos_inc, cfg, noise_rng)
+    depth = noisy_depth(hits.depth, cos_inc, cfg, noise_rng, fx=k.fx, sensor_rng=sensor_rng)
     color8 = noisy_color(color, cfg, noise_rng)
     mask = np.where(hits.body == target_index, hits.face + 1, 0).astype(np.uint8)
 
     clutter_bodies = [b for b, r in zip(bodies, roles) if r == "clutter"]
     occluder_body = bodies[roles.index("occluder")] if "occluder" in roles else None
+    contact_index = [i for i, r in enumerate(roles) if r == "contact"]
+    contacts = [(c.relation, bodies[i], np.where(hits.body == i, hits.face + 1, 0).astype(np.uint8))
+                for c, i in zip(layout.contacts, contact_index)]
     meta = {"schema": SCHEMA, "id": scene_id, "intrinsics": k.to_dict(), "depth_scale_m": 0.001,
             "noise": cfg.to_dict(), "seed": int(seed),
-            "truth": scene_truth(layout, bodies[target_index], clutter_bodies, occluder_body, k, mask)}
+            "truth": scene_truth(layout, bodies[target_index], clutter_bodies, occluder_body, k, mask, contacts)}
     return RGBD(color8, depth, k, scene_id, meta), mask

@@ -2,7 +2,10 @@
 
 Depth noise follows a stereo camera like the RealSense D435: sigma(z) = depth_sigma_base_m +
 depth_sigma_k * z^2 (metres), about 1.5 mm at 0.5 m and 5 mm at 1.5 m with ``realsense``.
-Every preset keeps the millimetre quantisation of a uint16 depth PNG.
+Every preset keeps the millimetre quantisation of a uint16 depth PNG. The ``kinect`` and ``realsense``
+depth models add what a triangulating sensor does beyond that noise: no reading where the projector
+(Kinect) or the second imager (RealSense) cannot see the point, a band of failed matches along depth
+edges, and depth quantised in disparity, so that its step grows with z^2.
 """
 
 from __future__ import annotations
@@ -14,7 +17,23 @@ import numpy as np
 
 from ..errors import InputError
 
-PRESETS = ("clean", "mild", "realsense", "hard")
+PRESETS = ("clean", "mild", "realsense", "hard", "realistic", "kinect")
+
+
+@dataclass(frozen=True)
+class DepthModel:
+    """A triangulating depth sensor: the second viewpoint (a projector or a second imager) sits
+    ``baseline_m`` to the right of the camera (+x); depth comes from the disparity f b / z (pixels),
+    measured in steps of ``disparity_step_px``."""
+
+    baseline_m: float
+    disparity_step_px: float
+
+
+# Kinect v1: projector 7.5 cm beside the IR camera, disparity in 1/8 pixel; RealSense D435: 5.0 cm
+# stereo baseline, disparity in 1/32 pixel. "ideal": no sensor geometry (depth as ray cast).
+DEPTH_MODELS = {"ideal": None, "kinect": DepthModel(0.075, 1 / 8), "realsense": DepthModel(0.050, 1 / 32)}
+EDGE_JUMP_M = 0.03  # a depth discontinuity: neighbours more than this far apart in depth (metres)
 
 
 @dataclass(frozen=True)
@@ -38,6 +57,14 @@ class NoiseConfig:
     texture: float = 0.0               # strength of blotchy texture on the table and the objects, 0..1
     table_grain: float = 0.15          # contrast of the table's wood grain (part of every scene)
     shadows: bool = False              # cast shadows of the directional light (edges that are no face edges)
+    # appearance and scene knobs that real table tops have (docs/dataset.md); all off by default
+    printed_faces: float = 0.0         # share of the solids' faces printed with labels, bands and text-like rows
+    face_hues: float = 0.0             # probability that a solid has a different hue on each face
+    touching: float = 0.0              # probability of a second solid standing against the target, in contact
+    stacked: float = 0.0               # probability of a box on the target, or of the target on a box
+    small_table: float = 0.0           # probability of a table 3-20 cm larger than what stands on it (floor beyond)
+    depth_model: str = "ideal"         # sensor geometry: "ideal", "kinect" or "realsense" (DEPTH_MODELS)
+    edge_dropout_px: float = 0.0       # band of missing depth on the far side of depth edges (pixels at 640x480)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -54,6 +81,19 @@ _PRESET_KNOBS = {
     "hard": dict(depth_sigma_base_m=0.002, depth_sigma_k=0.004, hole_blobs=12, hole_radius_px=9.0,
                  grazing_deg=70.0, flying_pixels=0.6, color_sigma=8.0, blur_px=1.3, jpeg_quality=70,
                  exposure=0.25, occluder=0.7, clutter=4, distractor_lines=4, texture=0.4, table_grain=0.4, shadows=True),
+    # a RealSense D435 on a cluttered table of printed packaging: every knob on at a moderate level
+    "realistic": dict(depth_sigma_base_m=0.001, depth_sigma_k=0.0018, hole_blobs=4, grazing_deg=78.0,
+                      flying_pixels=0.3, color_sigma=4.0, blur_px=0.8, jpeg_quality=90, exposure=0.12,
+                      occluder=0.3, clutter=2, distractor_lines=1, texture=0.15, table_grain=0.25, shadows=True,
+                      printed_faces=0.6, face_hues=0.3, touching=0.5, stacked=0.3, small_table=0.5,
+                      depth_model="realsense", edge_dropout_px=2.0),
+    # a Kinect v1: structured-light depth (sigma 1.5 mm at 0.5 m, 4.4 mm at 1.5 m), a soft noisy colour
+    # camera, printed objects
+    "kinect": dict(depth_sigma_base_m=0.001, depth_sigma_k=0.0015, hole_blobs=3, grazing_deg=75.0,
+                   flying_pixels=0.2, color_sigma=5.0, blur_px=1.0, jpeg_quality=85, exposure=0.15,
+                   occluder=0.2, clutter=2, texture=0.1, table_grain=0.25, shadows=True,
+                   printed_faces=0.6, face_hues=0.2, touching=0.3, stacked=0.3, small_table=0.3,
+                   depth_model="kinect", edge_dropout_px=1.5),
 }
 
 
@@ -71,7 +111,8 @@ def noise_config(preset: str = "clean", /, **overrides) -> NoiseConfig:
     return replace(cfg, **overrides)
 
 
-_KINDS = {f.name: f.type for f in fields(NoiseConfig)}  # "float", "int" or "bool" (annotations are strings here)
+_KINDS = {f.name: f.type for f in fields(NoiseConfig)}  # "float", "int", "bool" or "str" (annotations are strings)
+_CHOICES = {"depth_model": tuple(DEPTH_MODELS)}
 
 
 def _check_type(name: str, value) -> None:
@@ -79,9 +120,11 @@ def _check_type(name: str, value) -> None:
     kind = _KINDS[name]
     is_bool = isinstance(value, bool)
     ok = {"bool": is_bool, "int": isinstance(value, int) and not is_bool,
-          "float": isinstance(value, (int, float)) and not is_bool}[kind]
+          "float": isinstance(value, (int, float)) and not is_bool,
+          "str": isinstance(value, str) and value in _CHOICES.get(name, ())}[kind]
     if not ok:
-        says = {"bool": "true or false", "int": "a whole number", "float": "a number"}[kind]
+        says = {"bool": "true or false", "int": "a whole number", "float": "a number",
+                "str": "one of " + ", ".join(_CHOICES.get(name, ()))}[kind]
         raise InputError("noise", f"knob {name!r} takes {says}, got {value!r}")
 
 
@@ -104,13 +147,79 @@ def gaussian(shape: tuple[int, ...], rng: np.random.Generator, sigma: float = 1.
     return out.reshape(shape)
 
 
+def sensor_shadow(depth: np.ndarray, fx: float, baseline_m: float) -> np.ndarray:
+    """(H, W) bool: the pixels whose point the sensor's second viewpoint, ``baseline_m`` to the right of
+    the camera (+x, rectified), cannot see because a nearer surface hides it (a Kinect's projector
+    shadow, a stereo pair's occlusion). ``depth``: ideal (H, W) metres, 0 = nothing; ``fx``: pixels.
+
+    A point at column u with disparity D = fx b / z appears at column u - D in the second view; it is
+    hidden when a pixel to its right lands left of it there (that pixel is then nearer). So the band
+    lies left of every nearer object, on the far side of the depth edge, D_near - D_far pixels wide."""
+    h, w = depth.shape
+    z = depth.astype(np.float32, copy=False)
+    valid = z > 0
+    x2 = np.where(valid, np.arange(w, dtype=np.float32)[None, :] - np.float32(fx * baseline_m)
+                  / np.where(valid, z, np.float32(1)), np.float32(np.inf))
+    right_min = np.full((h, w), np.inf, np.float32)  # min of x2 over the pixels right of each pixel
+    right_min[:, :-1] = np.minimum.accumulate(x2[:, :0:-1], axis=1)[:, ::-1]
+    return valid & (right_min < x2 - np.float32(0.25))  # a quarter pixel: no self-shadow from rounding
+
+
+def edge_dropout(depth: np.ndarray, width_px: float, rng: np.random.Generator) -> np.ndarray:
+    """(H, W) bool: a ragged band, about ``width_px`` pixels wide (0.5-1.5 times that, varying along the
+    edge), on the far side of every depth edge (a jump over EDGE_JUMP_M): there the matching window of
+    a stereo or structured-light sensor straddles two depths and returns nothing."""
+    h, w = depth.shape
+    z = depth.astype(np.float32, copy=False)
+    valid = z > 0
+    reach = int(np.ceil(1.5 * width_px))
+    if reach < 1:
+        return np.zeros((h, w), bool)
+    # the near side of each edge: pixels with a neighbour deeper by more than the jump
+    near_edge = valid & (cv2.dilate(z, np.ones((3, 3), np.uint8)) - z > EDGE_JUMP_M)
+    # the far side: pixels deeper by more than the jump than a near-side edge pixel within reach
+    # (not than any pixel: a steep face would then count as its own far side)
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1, 2 * reach + 1))
+    far = valid & (z - cv2.erode(np.where(near_edge, z, np.float32(1e3)), disc) > EDGE_JUMP_M)
+    if not far.any():
+        return far
+    dist = cv2.distanceTransform((~near_edge).view(np.uint8), cv2.DIST_L2, 3)  # pixels to the nearest
+    jitter = cv2.resize(rng.random((h // 8 + 2, w // 8 + 2), dtype=np.float32), (w, h),
+                        interpolation=cv2.INTER_LINEAR)
+    return far & (dist <= np.float32(width_px) * (np.float32(0.5) + jitter))
+
+
+def quantise_disparity(z: np.ndarray, fx640: float, model: DepthModel) -> np.ndarray:
+    """Depth (H, W) float32 metres (0 = none) rounded to the nearest whole disparity step: disparity
+    d = fx640 b / z in steps of q, so the depth step is about z^2 q / (fx640 b) (Kinect, 615 px: 2.7 mm
+    at 1 m, 6.1 mm at 1.5 m). ``fx640``: the focal length at 640x480 (the sensor's, whatever the render size)."""
+    fb = np.float32(fx640 * model.baseline_m)
+    q = np.float32(model.disparity_step_px)
+    valid = z > 0
+    d = np.round(fb / np.where(valid, z, np.float32(1)) / q) * q
+    return np.where(valid & (d > 0), fb / np.maximum(d, q), np.float32(0)).astype(np.float32)
+
+
 def noisy_depth(depth: np.ndarray, cos_incidence: np.ndarray | None, cfg: NoiseConfig,
-                rng: np.random.Generator) -> np.ndarray:
+                rng: np.random.Generator, fx: float | None = None,
+                sensor_rng: np.random.Generator | None = None) -> np.ndarray:
     """Apply depth nuisances to ideal depth (H, W) float metres (0 = no hit); returns float32 metres
     quantised to whole millimetres. ``cos_incidence``: (H, W) cosine between view ray and surface normal
-    (needed only when ``cfg.grazing_deg`` < 90)."""
+    (needed only when ``cfg.grazing_deg`` < 90). ``fx`` (pixels, this image) and ``sensor_rng`` are needed
+    only by ``cfg.depth_model`` and ``cfg.edge_dropout_px`` (``sensor_rng`` keeps their draws apart from
+    ``rng``'s, so they change nothing else)."""
     h, w = depth.shape
     f32 = np.float32  # float32 throughout: half the memory traffic of float64, and metres need no more
+    model = DEPTH_MODELS[cfg.depth_model]
+    lost = None  # readings the sensor's geometry loses, from the ideal depth
+    if model is not None or cfg.edge_dropout_px > 0:
+        if fx is None or sensor_rng is None:
+            raise ValueError("the depth model and edge dropout need fx and sensor_rng")
+        lost = np.zeros((h, w), bool)
+        if model is not None:
+            lost |= sensor_shadow(depth, fx, model.baseline_m)
+        if cfg.edge_dropout_px > 0:
+            lost |= edge_dropout(depth, cfg.edge_dropout_px * w / 640.0, sensor_rng)
     z = depth.astype(np.float32)  # a copy: changed in place below
     valid = z > 0
     if cfg.flying_pixels > 0:
@@ -128,6 +237,10 @@ def noisy_depth(depth: np.ndarray, cos_incidence: np.ndarray | None, cfg: NoiseC
         sigma += f32(cfg.depth_sigma_base_m)
         sigma *= gaussian((h, w), rng)
         z += sigma
+    if model is not None:
+        z = quantise_disparity(z, fx * 640.0 / w, model)
+    if lost is not None:
+        valid &= ~lost
     if cfg.grazing_deg < 90.0 and cos_incidence is not None:
         valid &= cos_incidence > np.cos(np.radians(cfg.grazing_deg))
     if cfg.hole_blobs > 0:

@@ -9,6 +9,7 @@ import colorsys
 import cv2
 import numpy as np
 
+from .appearance import paint_prints
 from .noise import NoiseConfig
 from .raycast import Hits, ray_planes
 from .sampler import Layout
@@ -121,10 +122,12 @@ def _table(hits: Hits, low: _LowRes, idx: np.ndarray, cam_to_table: np.ndarray, 
 
 
 def shade(hits: Hits, layout: Layout, roles: list[str], albedo: list[np.ndarray], light_cam: np.ndarray,
-          cfg: NoiseConfig, rng: np.random.Generator) -> np.ndarray:
+          cfg: NoiseConfig, rng: np.random.Generator, prints: list | None = None) -> np.ndarray:
     """(H, W, 3) float32 RGB 0..255 of the scene. ``roles``: per body 'table', 'floor', 'wall' or an object
     role; ``albedo``: per body (faces, 3) albedo in 0..1. Albedo and Lambert term are per face (flat
-    faces, directional light), looked up through ``hits.gface``; textures scale them per pixel."""
+    faces, directional light), looked up through ``hits.gface``; printed designs (``prints``, see
+    :func:`lv3d.render.appearance.paint_prints`) replace the albedo where they are; textures scale it
+    per pixel."""
     f32 = np.float32
     ambient = rng.uniform(0.28, 0.42)
     # colour = albedo (per face, RGB) * intensity (per pixel, grey), with intensity =
@@ -164,5 +167,7 @@ def shade(hits: Hits, layout: Layout, roles: list[str], albedo: list[np.ndarray]
         mod[idx] *= f32(1.0) - f32(cfg.texture) * half.up(blotch, idx)
     intensity *= mod.reshape(hits.depth.shape)
     img = np.take(alb_lut, gface, axis=0)
+    if prints:
+        paint_prints(img, hits, prints)
     img *= intensity[..., None]
     return np.clip(img, 0, 255, out=img)

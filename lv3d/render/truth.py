@@ -68,18 +68,24 @@ def object_truth(body: Body, k: Intrinsics, mask: np.ndarray | None) -> dict:
 
 
 def scene_truth(layout: Layout, target: Body, clutter: list[Body], occluder: Body | None,
-                k: Intrinsics, mask: np.ndarray) -> dict:
-    """The "truth" block of meta.json."""
+                k: Intrinsics, mask: np.ndarray, contacts: list[tuple[str, Body, np.ndarray]] = ()) -> dict:
+    """The "truth" block of meta.json. ``contacts``: per solid touching the target its relation
+    ("beside", "on_target", "under_target"), body and face-id mask (like ``mask``)."""
     t = object_truth(target, k, mask)
     r = layout.world_to_camera[:3, :3]
     up = r @ np.array([0, 0, 1.0])  # the table's normal, pointing up and so towards the camera
-    support = plane_of(up, layout.world_to_camera[:3, 3])  # the world origin lies on the table top
+    table = plane_of(up, layout.world_to_camera[:3, 3])  # the world origin lies on the table top
+    # the surface the target stands on: the table top, or the top of the box under it
+    support = plane_of(up, r @ np.array([0, 0, layout.support_z_m]) + layout.world_to_camera[:3, 3])
     t.update(resting_face=layout.target.resting_face, target_pixels=int(np.count_nonzero(mask)),
              support_plane=support.to_dict(),
              camera={"elevation_deg": round(layout.elevation_deg, 3), "azimuth_deg": round(layout.azimuth_deg, 3),
                      "distance_m": round(layout.distance_m, 4)},
              clutter=[object_truth(c, k, None) for c in clutter],
-             occluder=object_truth(occluder, k, None) if occluder is not None else None)
+             occluder=object_truth(occluder, k, None) if occluder is not None else None,
+             table_plane=table.to_dict(),
+             contacts=[{"relation": rel, **object_truth(b, k, m), "pixels": int(np.count_nonzero(m))}
+                       for rel, b, m in contacts])
     return t
 
 

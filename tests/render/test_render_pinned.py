@@ -33,8 +33,8 @@ PINNED = [
     ("hard", "square_pyramid", 4, 160, 120, "901f68fe01e620b0e427e17c1bf5a32996c0972fce51f3d8b06f5e2eebcc2176", "909aee80e42e71eecd3e5b8af4e26337d0aa953c591a6ce114d8bb6e57a8d070", "52d3bef382bc4665373a10dd2bb17e634674ceaceca18da91e8b41a41f6edb35", "1c050bc64e1f7635f29ffee60c6deb1378eaa6e8b206d592383302c4ce3dd901"),
 ]
 
-# truth keys that old presets also carry, with the values they take when no knob adds to the scene
-_ADDED_TRUTH_KEYS = ()
+# truth keys that the old presets carry besides the pinned ones: no contacts, and the target stands on the table
+_ADDED_TRUTH_KEYS = ("contacts", "table_plane")
 
 
 def _sha(b: bytes) -> str:
@@ -49,6 +49,7 @@ def test_old_presets_render_bit_identically(preset, cls, seed, width, height, co
     assert _sha(frame.depth.tobytes()) == depth
     assert _sha(mask.tobytes()) == faces
     t = dict(frame.meta["truth"])
+    assert t["contacts"] == [] and t["table_plane"] == t["support_plane"]
     for key in _ADDED_TRUTH_KEYS:
         t.pop(key)
     assert _sha(json.dumps(t, sort_keys=True).encode()) == truth

@@ -119,4 +119,4 @@ def test_bad_inputs_raise_input_error():
         render_scene("cube", -1)
     with pytest.raises(InputError, match="image size"):
         render_scene("cube", 0, "clean", 4, 4)
-    assert set(PRESETS) == {"clean", "mild", "realsense", "hard"}
+    assert set(PRESETS) == {"clean", "mild", "realsense", "hard", "realistic", "kinect"}
