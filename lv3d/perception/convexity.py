@@ -41,6 +41,9 @@ class ConvexitySettings:
     ``concave_tol_deg`` (degrees): a concave junction gentler than ``concave_min_deg`` but sharper than this is a
     concave surface of one solid; such an object is not cut, since its sharper creases may be that surface's
     too. LCCP's own concavity tolerance is of this size (10 deg).
+    ``max_gap_rel``: two planes meet at a junction only where the cells of each along it lie within this fraction
+    of their depth of the other's plane; across an occluding edge the near surface is a depth step away from the
+    far one and the two do not meet (objects are cut at steps of 2 % of the depth: objects.segment_objects).
     ``band_frac``: the width of the strip on each side of a junction whose cells give that side's normal and
     centroid, as a fraction of the object's larger extent on the grid.
     ``contact_frac``: the least length of a junction, as a fraction of the smaller patch's perimeter (four times
@@ -49,6 +52,7 @@ class ConvexitySettings:
 
     concave_min_deg: float = 55.0
     concave_tol_deg: float = 10.0
+    max_gap_rel: float = 0.01
     band_frac: float = 0.08
     contact_frac: float = 0.05
 
@@ -56,10 +60,11 @@ class ConvexitySettings:
 DEFAULT = ConvexitySettings()
 
 
-def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, settings: ConvexitySettings = DEFAULT
-              ) -> list[tuple[int, int, float]]:
-    """Every pair (a, b, bend) of touching patches (labels a < b): ``bend`` (degrees) is the angle between their
-    normals near the junction, negative where the surface bends inwards there (concave)."""
+def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, offsets: np.ndarray,
+              settings: ConvexitySettings = DEFAULT) -> list[tuple[int, int, float]]:
+    """Every pair (a, b, bend) of planes that meet (labels a < b; ``normals`` (h, w, 3) the plane normal of each
+    cell, ``offsets`` (k,) each plane's offset): ``bend`` (degrees) is the angle between their normals, negative
+    where the surface bends inwards across the junction (concave)."""
     k = int(labels.max())
     if k < 2:
         return []
@@ -76,6 +81,9 @@ def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, settings
             contact = np.count_nonzero(touch[a] & masks[b])
             if contact < max(3, settings.contact_frac * 4 * np.sqrt(min(sizes[a], sizes[b]))):
                 continue
+            if not _meet(xyz, touch[b] & masks[a], normals[masks[b]][0], offsets[b + 1], settings) or \
+                    not _meet(xyz, touch[a] & masks[b], normals[masks[a]][0], offsets[a + 1], settings):
+                continue
             near_b = cv2.dilate(masks[b].view(np.uint8), kernel).view(bool) & masks[a]
             near_a = cv2.dilate(masks[a].view(np.uint8), kernel).view(bool) & masks[b]
             na, nb = normals[near_b].sum(axis=0), normals[near_a].sum(axis=0)
@@ -88,6 +96,14 @@ def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, settings
             convex = float((na - nb) @ (ca - cb)) > 0
             out.append((a + 1, b + 1, angle if convex else -angle))
     return out
+
+
+def _meet(xyz: np.ndarray, along: np.ndarray, n: np.ndarray, d: float, settings: ConvexitySettings) -> bool:
+    """True when the cells ``along`` a junction lie (median) within ``max_gap_rel`` of their depth of plane (n, d)."""
+    p = xyz[along]
+    if len(p) == 0:
+        return False
+    return bool(np.median(np.abs(p @ n + d) / p[:, 2]) <= settings.max_gap_rel)
 
 
 def _solids(k: int, bends: list[tuple[int, int, float]], settings: ConvexitySettings) -> list[int]:
@@ -129,7 +145,8 @@ def split_at_concave(grid: PointGrid, obj_mask: np.ndarray, planes: list[DepthPl
         on = q.mask[i0:i1, j0:j1] & m & (labels == 0)
         labels[on] = k
         n[on] = q.plane.n
-    bends = junctions(labels, p, n, settings)
+    offsets = np.array([0.0] + [q.plane.offset for q in planes])
+    bends = junctions(labels, p, n, offsets, settings)
     if not any(b <= -settings.concave_min_deg for _, _, b in bends):
         return [obj_mask]
     if any(-settings.concave_min_deg < b < -settings.concave_tol_deg for _, _, b in bends):

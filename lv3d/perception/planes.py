@@ -35,11 +35,14 @@ def _largest_piece(mask: np.ndarray) -> np.ndarray:
 
 def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_planes: int = 6,
                   min_frac: float = 0.035, max_need: int = 1500, min_points: int = 25,
-                  max_angle_deg: float = 20.0) -> list[DepthPlane]:
+                  max_angle_deg: float = 20.0, max_misses: int = 3) -> list[DepthPlane]:
     """Planes of the object whose grid cells are ``obj_mask`` (h, w) bool, largest first. A plane needs at least
     ``max(min_points, min(min_frac * object size, max_need))`` points in one connected piece: a share of the object
     keeps strips and noise out (depth.py asks more under heavy depth noise), and ``max_need`` lets a large object's
-    small face in (hexagonal prism 2003's 2179 px side is 4.4% of its 47690 cells; docs/perception.md, session 27)."""
+    small face in (hexagonal prism 2003's 2179 px side is 4.4% of its 47690 cells; docs/perception.md, session 27).
+    A sample whose plane is too small a piece sets its points aside and the search goes on, ``max_misses`` times
+    at most: a curved surface beside the object's planes (a can, a drill, in clutter) must not end the search
+    before the planes behind it are found."""
     rng = np.random.default_rng(seed)
     rows, cols = np.flatnonzero(obj_mask.any(axis=1)), np.flatnonzero(obj_mask.any(axis=0))
     if len(rows) == 0:
@@ -64,17 +67,23 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     h, w = box.shape
     planes: list[Plane] = []
     flat = np.flatnonzero(box)  # the object's cells as flat indices, in the order of ``pts``
-    for _ in range(max_planes):
-        idx = np.nonzero(free)[0]
+    tried = np.ones(len(pts), bool)  # points not set aside by a miss
+    misses = 0
+    while len(planes) < max_planes:
+        idx = np.nonzero(free & tried)[0]
         if len(idx) < need:
             break
         plane, inl = ransac_plane(pts[idx], dist_m, rng, iterations=96, normals=nrm[idx], max_angle_deg=max_angle_deg)
         m = np.zeros((h, w), bool)
         m.flat[flat[idx[inl]]] = True
         piece = _largest_piece(m)
-        sel = piece[box] & free
+        sel = piece[box] & free & tried
         if np.count_nonzero(sel) < need:
-            break
+            misses += 1
+            if misses > max_misses:
+                break
+            tried[idx[inl]] = False
+            continue
         plane = refine(pts[sel])
         planes.append(plane)
         free &= ~sel
