@@ -136,8 +136,9 @@ def design(solid: Solid, face: int, base_rgb, rng: np.random.Generator) -> Print
         size = ext * rng.uniform(0.4, 0.9, 2)
         c = lo + size / 2 + rng.random(2) * (ext - size)
         rgb = _contrasting(ground, rng)
-        shapes.append(Shape("rect", c[0] - size[0] / 2, c[0] + size[0] / 2, c[1] - size[1] / 2, c[1] + size[1] / 2, rgb))
-        ground, region = rgb, (shapes[-1].s0, shapes[-1].s1, shapes[-1].t0, shapes[-1].t1)
+        (s0, t0), (s1, t1) = c - size / 2, c + size / 2
+        shapes.append(Shape("rect", float(s0), float(s1), float(t0), float(t1), rgb))
+        ground, region = rgb, (float(s0), float(s1), float(t0), float(t1))
     elif pick < 0.8:  # a band right across the face, 15-40 % of its height (or width)
         big = 1e3
         along_s = rng.random() < 0.7

@@ -15,7 +15,8 @@ def dataset():
 @dataset.command()
 @click.option("--classes", required=True, help="comma-separated classes, e.g. cube,square_pyramid")
 @click.option("--per-class", type=int, required=True, help="images per class")
-@click.option("--noise", default="clean", show_default=True, help="noise preset: clean, mild, realsense, hard")
+@click.option("--noise", default="clean", show_default=True,
+              help="noise preset: clean, mild, realsense, hard, realistic, kinect (docs/dataset.md)")
 @click.option("--seed", type=int, default=0, show_default=True)
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="data set folder to create")
 @click.option("--workers", type=int, default=None, help="processes (default: all cores)")

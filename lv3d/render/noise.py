@@ -87,7 +87,7 @@ _PRESET_KNOBS = {
                       occluder=0.3, clutter=2, distractor_lines=1, texture=0.15, table_grain=0.25, shadows=True,
                       printed_faces=0.6, face_hues=0.3, touching=0.5, stacked=0.3, small_table=0.5,
                       depth_model="realsense", edge_dropout_px=2.0),
-    # a Kinect v1: structured-light depth (sigma 1.5 mm at 0.5 m, 4.4 mm at 1.5 m), a soft noisy colour
+    # a Kinect v1: structured-light depth (sigma 1.4 mm at 0.5 m, 4.4 mm at 1.5 m), a soft noisy colour
     # camera, printed objects
     "kinect": dict(depth_sigma_base_m=0.001, depth_sigma_k=0.0015, hole_blobs=3, grazing_deg=75.0,
                    flying_pixels=0.2, color_sigma=5.0, blur_px=1.0, jpeg_quality=85, exposure=0.15,

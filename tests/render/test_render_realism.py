@@ -207,3 +207,26 @@ def test_realistic_and_kinect_presets_render_with_exact_truth():
             assert {f["id"] for f in t["faces"]} <= set(np.unique(faces) - 1)
             for c in t["contacts"]:
                 assert c["relation"] in ("beside", "on_target", "under_target")
+
+
+def test_docs_knob_table_lists_every_knob_of_every_preset():
+    from dataclasses import fields
+    from pathlib import Path
+
+    from lv3d.render import NoiseConfig
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "dataset.md").read_text()
+    lines = text[text.index("| knob | clean |"):].split("\n")
+    head = [c.strip() for c in lines[0].strip("|").split("|")]
+    presets = head[1:-1]
+    assert presets == list(PRESETS)
+    rows = {}
+    for line in lines[2:]:
+        if not line.startswith("| `"):
+            break
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        rows[cells[0].strip("`")] = cells[1:-1]
+    assert set(rows) == {f.name for f in fields(NoiseConfig)} - {"preset"}
+    for knob, values in rows.items():
+        for preset, shown in zip(presets, values):
+            assert shown == str(getattr(noise_config(preset), knob)), (knob, preset, shown)
