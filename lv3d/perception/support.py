@@ -8,7 +8,9 @@ must be reproducible bit for bit.
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
+from matplotlib.path import Path
 
 from ..plane import Plane
 
@@ -76,13 +78,19 @@ def noise_threshold(z_m: float) -> float:
 
 
 def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up: float = 0.3,
-                  min_frac: float = 0.08, max_points: int = 4000, min_share: float = 0.35) -> Plane | None:
+                  min_frac: float = 0.08, max_points: int = 4000, min_share: float = 0.35,
+                  stand_rel: float = 0.1, min_standing: float = 0.01) -> Plane | None:
     """The support plane of camera-frame points (m, 3) metres, or None if no plane holds ``min_frac`` of them.
 
-    Up to ``max_planes`` planes are peeled off by RANSAC. Among those whose normal points up in the image
-    (``-n_y >= min_up``, camera y is down) and that hold at least ``min_share`` of the largest such plane's
-    points, the one nearest the camera wins: a table stands above the floor it is on, and an object's top face
-    is nearer still but much smaller. Without an upward plane the largest plane wins."""
+    Up to ``max_planes`` planes are peeled off by RANSAC; the candidates are those whose normal points up in the
+    image (``-n_y >= min_up``, camera y is down). The support is chosen by what stands on it: the candidate with
+    the most points on no plane found (objects) just above it, between its inlier distance and ``stand_rel`` of
+    the scene's median depth, over its own extent (inside the convex hull of its inliers, seen along its
+    normal). The lower parts of the objects on a table lie there; the floor beneath a small table has only the
+    table's legs there, and an object's top face only what is stacked on it. Where no candidate has
+    ``min_standing`` of the points standing on it (an empty table), the nearest of the candidates holding
+    ``min_share`` of the largest one's points wins (a table stands above the floor). Without an upward plane
+    the largest plane wins."""
     rng = np.random.default_rng(seed)
     if len(points) > max_points:
         points = points[np.sort(rng.choice(len(points), max_points, replace=False))]
@@ -91,6 +99,7 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
     dist_m = noise_threshold(float(np.median(points[:, 2])))
     remaining = points
     found: list[tuple[Plane, int]] = []
+    inliers: list[np.ndarray] = []
     for _ in range(max_planes):
         if len(remaining) < min_frac * len(points):
             break
@@ -101,11 +110,34 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
         if count < min_frac * len(points):
             break
         found.append((plane, count))
+        inliers.append(remaining[mask])
         remaining = remaining[~mask]
     up = [(p, c) for p, c in found if -p.normal[1] >= min_up]
+    if up and len(remaining):
+        top = stand_rel * float(np.median(points[:, 2]))
+        standing = [_standing(p, q, remaining, dist_m, top) for (p, _), q in zip(found, inliers)
+                    if -p.normal[1] >= min_up]
+        if max(standing) >= min_standing * len(points):
+            return up[int(np.argmax(standing))][0]
     if up:
         # the top face of a large object near the camera faces up too: a support must also be among the
         # larger upward planes (>= min_share of the largest), and of those the nearest wins
         most = max(c for _, c in up)
         return min((p for p, c in up if c >= min_share * most), key=lambda p: p.offset)
     return found[0][0] if found else None
+
+
+def _standing(plane: Plane, inliers: np.ndarray, others: np.ndarray, low_m: float, high_m: float) -> int:
+    """How many of the points ``others`` (m, 3) lie between ``low_m`` and ``high_m`` above ``plane`` (on the
+    camera's side) and over the convex hull of its ``inliers`` (k, 3), seen along its normal."""
+    h = others @ plane.n + plane.offset
+    near = others[(h > low_m) & (h <= high_m)]
+    if len(near) == 0 or len(inliers) < 3:
+        return 0
+    n = plane.n
+    a = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
+    a /= np.linalg.norm(a)
+    b = np.cross(n, a)
+    hull = cv2.convexHull(np.stack([inliers @ a, inliers @ b], axis=1).astype(np.float32))
+    q = np.stack([near @ a, near @ b], axis=1)
+    return int(np.count_nonzero(Path(hull[:, 0, :].astype(np.float64)).contains_points(q)))
