@@ -230,3 +230,18 @@ def test_docs_knob_table_lists_every_knob_of_every_preset():
     for knob, values in rows.items():
         for preset, shown in zip(presets, values):
             assert shown == str(getattr(noise_config(preset), knob)), (knob, preset, shown)
+
+
+def test_dataset_make_with_the_realistic_preset(tmp_path):
+    import json
+
+    from lv3d.cli import main
+    from lv3d.rgbd import load_item
+
+    out = tmp_path / "real"
+    assert main(["dataset", "make", "--classes", "cube,tetrahedron", "--per-class", "1", "--noise", "realistic",
+                 "--out", str(out), "--workers", "1", "--width", "160", "--height", "120"]) == 0
+    m = json.loads((out / "manifest.json").read_text())
+    assert m["noise"] == "realistic" and m["noise_knobs"]["depth_model"] == "realsense"
+    frame = load_item(out / m["items"][0]["dir"])
+    assert frame.meta["truth"]["class"] == "cube" and "contacts" in frame.meta["truth"]
