@@ -226,6 +226,8 @@ def sample_layout(cls: str, cfg: NoiseConfig, k: Intrinsics, rng: np.random.Gene
     elevation and 0.5-1.5 m away with the whole target in the image, then clutter and an occluder as
     ``cfg`` asks. ``extra_rng`` draws what the knobs ``stacked``, ``touching`` and ``small_table`` add
     (needed only when one is on); ``rng``'s draws are the same with them or without."""
+    if extra_rng is None and (cfg.stacked > 0 or cfg.touching > 0 or cfg.small_table > 0):
+        raise ValueError("the knobs stacked, touching and small_table draw from extra_rng: give one")
     target = _stand(make_solid(cls, rng), rng, rng.uniform(-0.05, 0.05, 2))
     contacts: list[Contact] = []
     if cfg.stacked > 0 and extra_rng.random() < cfg.stacked:
