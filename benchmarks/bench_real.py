@@ -39,8 +39,9 @@ holding >= 20 % of the object's mask pixels.
 
 ``support_ok_frac`` (depth and rgbd): share of frames whose support plane is the surface the labelled objects
 stand on. For every labelled object, its points are the depth readings of its mask shrunk by 1 px (off a
-background that a mask's outline may touch) or, without masks, of its perceived object's pixels (not found: not
-measured); an object with fewer than 100 points is not measured. Its *bottom* is the 1st percentile of the
+background that a mask's outline may touch) or, without masks, of those of its perceived object's pixels that
+are connected to the labelled pixel through depth steps below max(1.5 cm, 3 sigma(z)) (a perceived outline may
+spill over a table's edge onto the floor far below; not found: not measured); an object with fewer than 100 points is not measured. Its *bottom* is the 1st percentile of the
 points' signed height above the support plane (positive on the camera's side; a low percentile, since a tall
 object's lowest 5 % of readings already reach 2-4 cm up its sides on the dev frames), its tolerance max(2 cm, 3 sigma(z)) with
 sigma(z) = 1.2 mm + 1.9 mm (z - 0.4 m)^2 / m^2 the axial noise of a Kinect-class sensor (Nguyen, Izadi and
@@ -122,6 +123,7 @@ SUPPORT_TOL_M = 0.02   # support: the least tolerance of an object's bottom, met
 SUPPORT_NOISE_K = 3.0  # ... or this many times the sensor's axial noise at the object's depth
 BOTTOM_PCT = 1.0       # an object's bottom: this percentile of its points' height above the plane
 MIN_POINTS = 100       # an object with fewer depth points is not measured for the support
+FLOOD_STEP_M = 0.015   # without masks: the largest depth step between neighbours within one surface, metres
 MASK_ERODE_PX = 1      # a ground-truth mask is shrunk by this much before its depth is read
 
 KEYS = ("object_recall", "merged_frac", "split_frac", "support_ok_frac", "box_perpendicular_frac",
@@ -202,7 +204,8 @@ def folder_frames(folder: Path) -> list[str]:
 
 
 def check_folder(folder: Path) -> None:
-    """InputError unless ``folder`` is in the real layout with objects.csv and intrinsics.json."""
+    """InputError unless ``folder`` is in the real layout with objects.csv and intrinsics.json, and every frame
+    objects.csv names is there."""
     folder = Path(folder)
     if not folder.is_dir():
         raise InputError(folder, "not a folder")
@@ -210,8 +213,12 @@ def check_folder(folder: Path) -> None:
         if not (folder / name).is_file():
             raise InputError(folder, f"no {name} (bench_real needs a folder in the layout of "
                                      f"../shared/data/real/README.md)")
-    if not folder_frames(folder):
+    frames = folder_frames(folder)
+    if not frames:
         raise InputError(folder, "no frames (<frame>_rgb.* with <frame>_depth*)")
+    unknown = sorted(set(read_labels(folder / "objects.csv")) - set(frames), key=natural_key)
+    if unknown:
+        raise InputError(folder / "objects.csv", f"names frames that are not in the folder: {', '.join(unknown)}")
 
 
 def read_label_image(path: Path, shape: tuple[int, int]) -> np.ndarray | None:
@@ -343,6 +350,29 @@ def mask_points(frame, mask: np.ndarray) -> np.ndarray:
     return frame.intrinsics.back_project(us, vs, frame.depth[vs, us])
 
 
+def connected_region(depth: np.ndarray, mask: np.ndarray, u: int, v: int) -> np.ndarray:
+    """The pixels of ``mask`` with a depth reading that are connected to (u, v) (4-neighbours) through steps in
+    depth below max(1.5 cm, 3 sigma(z)): the surface the labelled pixel lies on, without what an outline spills
+    over beyond a depth edge (a table's edge, the floor behind). Where (u, v) has no reading, the nearest
+    pixel of the mask with one within 2 % of the image diagonal is the seed. Empty where there is none."""
+    h, w = depth.shape
+    ok = mask & (depth > 0)
+    if not ok[v, u]:
+        r = max(1, int(round(0.02 * np.hypot(h, w))))
+        v0, u0 = max(0, v - r), max(0, u - r)
+        vs, us = np.nonzero(ok[v0:v + r + 1, u0:u + r + 1])
+        if not len(vs):
+            return np.zeros((h, w), bool)
+        i = int(np.argmin((vs + v0 - v) ** 2 + (us + u0 - u) ** 2))
+        v, u = int(vs[i] + v0), int(us[i] + u0)
+    step = max(FLOOD_STEP_M, SUPPORT_NOISE_K * axial_noise_m(float(depth[v, u])))
+    blocked = np.ones((h + 2, w + 2), np.uint8)
+    blocked[1:-1, 1:-1] = ~ok
+    cv2.floodFill(np.ascontiguousarray(depth, np.float32), blocked, (int(u), int(v)), 0, step, step,
+                  4 | cv2.FLOODFILL_MASK_ONLY | (2 << 8))
+    return blocked[1:-1, 1:-1] == 2
+
+
 def evaluate_frame(scene, facts, frame, labels: list[Label], label_img: np.ndarray | None) -> dict:
     """Counts of one frame and modality (no perception here: ``scene`` and ``facts`` are given), summed over
     frames by :func:`summarise`. ``frame`` supplies the depth and intrinsics; ``label_img`` the masks or None."""
@@ -372,7 +402,7 @@ def evaluate_frame(scene, facts, frame, labels: list[Label], label_img: np.ndarr
                               iterations=MASK_ERODE_PX).astype(bool)
                 pts.append(mask_points(frame, m))
             elif k is not None:
-                pts.append(mask_points(frame, masks[k]))
+                pts.append(mask_points(frame, connected_region(frame.depth, masks[k], lab.u, lab.v)))
         row["support"] = support_ok(scene.support_plane, pts)
 
     perp = {tuple(f.args): f.conf for f in facts.facts if f.pred == "perpendicular"}
@@ -485,11 +515,9 @@ def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dic
     from lv3d.perception import perceive
     from lv3d.rgbd import load_real
 
+    check_folder(folder)
     labels = read_labels(folder / "objects.csv")
     frames = folder_frames(folder)
-    unknown = sorted(set(labels) - set(frames), key=natural_key)
-    if unknown:
-        raise InputError(folder / "objects.csv", f"names frames that are not in the folder: {', '.join(unknown)}")
     frames = frames[:limit] if limit else frames
     mine: dict[str, list[dict]] = {m: [] for m in modalities}
     first = load_real(folder, frames[0])
@@ -540,7 +568,6 @@ def main(argv=None) -> int:
             raise InputError(REAL, "no folder with objects.csv (name folders on the command line)")
         for folder in folders:
             check_folder(folder)
-            read_labels(folder / "objects.csv")
     except InputError as e:
         print(f"bench_real.py: error: {e}", file=sys.stderr)
         return 2

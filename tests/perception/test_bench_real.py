@@ -213,3 +213,32 @@ def test_one_osd_frame_end_to_end_writes_every_figure(tmp_path, capsys):
     assert set(fig) == keys
     assert fig["object_recall"] is not None and fig["ms_median"] > 0 and fig["cylinder_as_prism_frac"] is None
     assert "object_recall" in capsys.readouterr().out
+
+
+def test_objects_csv_naming_a_missing_frame_stops_before_any_work(tmp_path, capsys):
+    (tmp_path / "f0_rgb.png").write_bytes(b"")
+    (tmp_path / "f0_depth_mm.png").write_bytes(b"")
+    (tmp_path / "intrinsics.json").write_text("{}")
+    (tmp_path / "objects.csv").write_text("frame,object,u,v,shape,partial,stacked,notes\nf1,1,5,5,box,no,no,\n")
+    assert bench.main([str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "objects.csv" in err[0] and "f1" in err[0]
+
+
+def test_a_malformed_objects_csv_row_is_named(tmp_path):
+    (tmp_path / "objects.csv").write_text("frame,object,u,v,shape,partial,stacked\nf0,1,5,5,cone,no,no\n")
+    with pytest.raises(bench.InputError, match="line 2"):
+        bench.read_labels(tmp_path / "objects.csv")
+
+
+def test_without_masks_the_support_reads_only_the_surface_connected_to_the_labelled_pixel():
+    depth = np.full((H, W), 1.0, np.float32)
+    depth[:, 40:] = 1.7          # beyond a table's edge: the floor, far below
+    depth[10:20, 10:20] = 0.0    # no readings here
+    depth[:, 5] = np.linspace(1.0, 1.05, H)  # a gentle slope stays connected
+    outline = _mask(0, 0, 59, 59)  # a perceived outline spilling over the edge
+    region = bench.connected_region(depth, outline, 30, 30)
+    assert region[:, :40].sum() == 40 * H - 100 and not region[:, 40:].any()
+    assert bench.connected_region(depth, outline, 11, 11).sum() == region.sum()  # no reading: the nearest seed
+    assert not bench.connected_region(depth, outline, 15, 15).any()  # none within 2 % of the diagonal (2 px)
+    assert not bench.connected_region(depth, _mask(10, 10, 19, 19), 15, 15).any()
