@@ -115,8 +115,8 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
     up = [(p, c) for p, c in found if -p.normal[1] >= min_up]
     if up and len(remaining):
         top = stand_rel * float(np.median(points[:, 2]))
-        standing = [_standing(p, q, remaining, dist_m, top) for (p, _), q in zip(found, inliers)
-                    if -p.normal[1] >= min_up]
+        cands = [(p, q) for (p, _), q in zip(found, inliers) if -p.normal[1] >= min_up]
+        standing = [_standing(p, q, remaining, dist_m, top, [c for c in cands if c[0] is not p]) for p, q in cands]
         if max(standing) >= min_standing * len(points):
             return up[int(np.argmax(standing))][0]
     if up:
@@ -127,17 +127,34 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
     return found[0][0] if found else None
 
 
-def _standing(plane: Plane, inliers: np.ndarray, others: np.ndarray, low_m: float, high_m: float) -> int:
-    """How many of the points ``others`` (m, 3) lie between ``low_m`` and ``high_m`` above ``plane`` (on the
-    camera's side) and over the convex hull of its ``inliers`` (k, 3), seen along its normal."""
-    h = others @ plane.n + plane.offset
-    near = others[(h > low_m) & (h <= high_m)]
-    if len(near) == 0 or len(inliers) < 3:
-        return 0
+# the share of a plane's extent (scale about its centre) over which objects count as standing on it
+_INNER = 0.85
+
+
+def _over(plane: Plane, inliers: np.ndarray, points: np.ndarray, shrink: float = 1.0) -> np.ndarray:
+    """Which of ``points`` (m, 3) lie over the convex hull of ``inliers`` (k, 3) of ``plane``, seen along its
+    normal, the hull scaled by ``shrink`` about its centre (m,) bool."""
+    if len(inliers) < 3 or len(points) == 0:
+        return np.zeros(len(points), bool)
     n = plane.n
     a = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
     a /= np.linalg.norm(a)
     b = np.cross(n, a)
-    hull = cv2.convexHull(np.stack([inliers @ a, inliers @ b], axis=1).astype(np.float32))
-    q = np.stack([near @ a, near @ b], axis=1)
-    return int(np.count_nonzero(Path(hull[:, 0, :].astype(np.float64)).contains_points(q)))
+    hull = cv2.convexHull(np.stack([inliers @ a, inliers @ b], axis=1).astype(np.float32))[:, 0, :].astype(np.float64)
+    c = hull.mean(axis=0)
+    hull = c + shrink * (hull - c)
+    return Path(hull).contains_points(np.stack([points @ a, points @ b], axis=1))
+
+
+def _standing(plane: Plane, inliers: np.ndarray, others: np.ndarray, low_m: float, high_m: float,
+              rivals: list[tuple[Plane, np.ndarray]]) -> int:
+    """How many of the points ``others`` (m, 3) stand on ``plane``: between ``low_m`` and ``high_m`` above it (on
+    the camera's side), over the convex hull of its ``inliers`` (k, 3), and not beneath a rival plane (below it
+    and over its inliers' hull: the sides of a table stand on the floor, but hold up the table)."""
+    h = others @ plane.n + plane.offset
+    near = others[(h > low_m) & (h <= high_m)]
+    # the rim of the plane's extent is left out: what rises at its far edge is a wall or a cabinet, not an object
+    keep = _over(plane, inliers, near, _INNER)
+    for p, q in rivals:
+        keep &= ~((near @ p.n + p.offset < -low_m) & _over(p, q, near))
+    return int(np.count_nonzero(keep))
