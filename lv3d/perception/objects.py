@@ -161,9 +161,11 @@ def _split_by_height(labels: np.ndarray, n: int, h_above: np.ndarray, band_m: fl
     out = labels.copy()
     split = np.isin(labels, np.flatnonzero(counts >= 2)) & fg
     out[split] = n + flooded[split] - 1
-    uniq, inv = np.unique(out, return_inverse=True)
-    out = inv.reshape(out.shape).astype(np.int32)
-    return len(uniq), out, _stats(out, len(uniq))
+    ids = np.unique(out[out > 0])
+    lut = np.zeros(int(out.max()) + 1, np.int32)
+    lut[ids] = np.arange(1, len(ids) + 1)
+    out = lut[out]
+    return len(ids) + 1, out, _stats(out, len(ids) + 1)
 
 
 def _stats(labels: np.ndarray, n: int) -> np.ndarray:
