@@ -116,7 +116,10 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
     if up and len(remaining):
         top = stand_rel * float(np.median(points[:, 2]))
         cands = [(p, q) for (p, _), q in zip(found, inliers) if -p.normal[1] >= min_up]
-        standing = [_standing(p, q, remaining, dist_m, top, [c for c in cands if c[0] is not p]) for p, q in cands]
+        # readings of a plane's own surface lie within a few noise widths of it at its own depth (a far floor's
+        # noise is wider than the inlier distance at the scene's median depth): objects stand beyond twice that
+        standing = [_standing(p, q, remaining, max(dist_m, 2 * noise_threshold(float(np.median(q[:, 2])))), top,
+                              [c for c in cands if c[0] is not p]) for p, q in cands]
         if max(standing) >= min_standing * len(points):
             return up[int(np.argmax(standing))][0]
     if up:
