@@ -24,8 +24,11 @@ from ..output import check_out, replacing
 @click.option("--scene-id", default="s000000", show_default=True, help="Scene id, a Prolog atom like s000123.")
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder.")
 @click.option("--facts", is_flag=True, help="Also ground the scene and write facts.json and facts.pl.")
+@click.option("--max-objects", type=click.IntRange(min=1), default=None,
+              help="Describe at most this many objects found by depth, the largest (default 24); the output says "
+              "how many were left out.")
 def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scale: float | None, modality: str,
-            scene_id: str, out_dir: Path, facts: bool) -> None:
+            scene_id: str, out_dir: Path, facts: bool, max_objects: int | None) -> None:
     """Find objects, faces and planes in one frame COLOR; write OUT/scene.json and OUT/overlay.png."""
     from ..rgbd import load_frame, read_intrinsics
     from .overlay import draw_overlay
@@ -45,7 +48,7 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
     k, scale = read_intrinsics(intrinsics, frame_name) if intrinsics is not None else (None, 0.001)
     frame = load_frame(color, depth if modality != "rgb" else None, k,
                        depth_scale if depth_scale is not None else scale, name=frame_name)
-    scene = perceive(frame, modality, scene_id=scene_id)
+    scene = perceive(frame, modality, scene_id=scene_id, **({"max_objects": max_objects} if max_objects else {}))
     if not scene.objects:
         raise InputError(color, "no object found in this frame")
     facts_obj = None
@@ -54,7 +57,8 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
 
         facts_obj = describe(scene, frame)
     _write(Path(out_dir), inputs, scene, draw_overlay(frame.color, scene), facts_obj)
-    click.echo(f"{out_dir}: {len(scene.objects)} objects, "
+    dropped = f" ({scene.dropped_objects} smaller objects left out by --max-objects)" if scene.dropped_objects else ""
+    click.echo(f"{out_dir}: {len(scene.objects)} objects{dropped}, "
                f"{sum(len(o.faces) for o in scene.objects)} faces, target {scene.target().id}")
 
 

@@ -86,3 +86,20 @@ def test_extract_replaces_its_own_output_and_nothing_else(tmp_path, box_frame, c
     capsys.readouterr()
     assert main(args) == 2 and "lv3d did not write" in capsys.readouterr().err
     assert sorted(p.name for p in out.iterdir()) == ["overlay.png", "scene.json"]
+
+
+def test_extract_caps_objects_and_says_how_many_it_left_out(tmp_path, capsys):
+    from lv3d.render import noise_config, render_scene
+
+    frame = render_scene("cube", 0, noise_config("clean", stacked=1.0))[0]  # a box on a box: two objects
+    c, d, k = _write_frame(tmp_path, frame)
+    out = tmp_path / "out"
+    rc = main(["extract", str(c), "--depth", str(d), "--intrinsics", str(k), "--modality", "depth",
+               "--max-objects", "1", "--out", str(out)])
+    assert rc == 0
+    assert "1 smaller objects left out by --max-objects" in capsys.readouterr().out
+    scene = json.loads((out / "scene.json").read_text())
+    assert len(scene["objects"]) == 1 and scene["dropped_objects"] == 1
+    rc = main(["extract", str(c), "--depth", str(d), "--intrinsics", str(k), "--max-objects", "0",
+               "--out", str(tmp_path / "out2")])
+    assert rc == 2 and "--max-objects" in capsys.readouterr().err
