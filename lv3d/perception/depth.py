@@ -1,10 +1,16 @@
-"""Faces from depth alone: point grid -> support plane -> objects above it -> planes per object -> boundary
-polygons, plane adjacency."""
+"""The depth stage: point grid -> support plane -> objects above it -> solids (cut at valleys of height and at
+concave creases) -> planes per solid -> boundary polygons, plane adjacency.
+
+Its thresholds live in one frozen :class:`DepthSettings`, in scale-free units: fractions of the image (its cell
+count or diagonal), fractions of an object's points or of the depth, multiples of the frame's measured noise,
+angles. Pixel counts are derived from them for the frame at hand, so the same settings hold at 320x240 and at
+1280x960.
+"""
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -12,7 +18,7 @@ from ..plane import Plane
 from ..rgbd import RGBD
 from .boundary import mask_polygon
 from .cloud import PointGrid, point_grid, slope_noise
-from .convexity import split_at_concave
+from .convexity import ConvexitySettings, split_at_concave
 from .objects import DepthObject, heavy_noise, segment_objects, support_band
 from .planes import DepthPlane, object_planes, plane_adjacency
 from .plane_outline import simplify_on_plane
@@ -21,13 +27,57 @@ from .snap import add_triple_corners, snap_polygons
 from .support import noise_threshold
 
 
-# the most objects a frame's depth stage describes (largest first): a table-top scene, clutter included, holds
-# fewer; every object costs grounding time. An option of perceive() and `lv3d extract --max-objects`
-MAX_OBJECTS = 24
+@dataclass(frozen=True)
+class DepthSettings:
+    """Thresholds of the depth stage, each with its unit and the reason for its value.
 
-# the share of an object's points a plane needs under heavy depth noise (planes.object_planes' min_frac; its
-# default holds otherwise)
-_NOISY_PLANE_SHARE = 0.06
+    ``max_objects`` (objects): the most objects described, the largest; a table-top scene, clutter included,
+    holds fewer, and every object costs grounding time. The scene counts the rest (``dropped_objects``).
+    ``min_object_frac`` (fraction of the image's cells): the smallest object; below it a piece is a speck of
+    noise or the tip of something cut by the border. 0.0002 is 60 cells of a 640x480 grid.
+    ``max_border`` (fraction of an object's outline): a piece cut by the image border along more of its outline
+    is scenery (a wall, the floor beyond a table, furniture), not an object.
+    ``regrow_frac`` (fraction of the image diagonal): how far an object takes back the foreground cells that
+    depth-jump cuts left out (a face seen edge-on is all jumps); 0.00625 is 5 cells at 640x480.
+    ``plane_share`` / ``noisy_plane_share`` (fraction of an object's points): the smallest plane of an object, and
+    under heavy noise (``objects.heavy_noise``), where a small piece is more often noise than a face.
+    ``plane_max_frac`` (fraction of the image's cells): the share above is capped at this many cells, so that a
+    large object's small face counts; 0.0049 is 1500 cells at 640x480.
+    ``plane_min_frac`` (fraction of the image's cells): no plane has fewer cells; 25 at 640x480.
+    ``seed_bands`` (multiples of the support band, itself four times the support's measured noise): objects stand
+    out of their neighbourhood by more than this; their parts above it seed the split at valleys of height
+    (objects._split_by_height).
+    ``support_stand_rel`` (fraction of the median depth): how high above a candidate support plane points count
+    as objects standing on it (their lower parts), and ``support_inner`` (fraction of its extent, about its
+    centre) over what part of it (support.support_plane).
+    ``convexity``: the cut at concave creases (convexity.ConvexitySettings).
+    """
+
+    max_objects: int = 24
+    min_object_frac: float = 0.0002
+    max_border: float = 0.12
+    regrow_frac: float = 0.00625
+    plane_share: float = 0.035
+    noisy_plane_share: float = 0.06
+    plane_max_frac: float = 0.0049
+    plane_min_frac: float = 0.00008
+    seed_bands: float = 3.0
+    support_stand_rel: float = 0.1
+    support_inner: float = 0.85
+    convexity: ConvexitySettings = field(default_factory=ConvexitySettings)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.max_objects, int) or self.max_objects < 1:
+            raise ValueError(f"max_objects must be a whole number of at least 1, got {self.max_objects!r}")
+        for name in ("min_object_frac", "max_border", "regrow_frac", "plane_share", "noisy_plane_share",
+                     "plane_max_frac", "plane_min_frac", "support_stand_rel", "support_inner"):
+            v = getattr(self, name)
+            if not 0 <= v <= 1:
+                raise ValueError(f"{name} is a fraction in [0, 1], got {v!r}")
+
+
+DEFAULT = DepthSettings()
+MAX_OBJECTS = DEFAULT.max_objects
 
 
 @dataclass(frozen=True)
@@ -52,28 +102,33 @@ class DepthResult:
     dropped_objects: int = 0  # objects found beyond the cap (``max_objects``), smallest first
 
 
-def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int = MAX_OBJECTS) -> DepthResult:
-    """Run the depth stages on one frame; the ``max_objects`` largest objects are described, the number left out
-    is ``dropped_objects``."""
-    if max_objects < 1:
-        raise ValueError(f"max_objects must be at least 1, got {max_objects}")
+def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | None = None,
+                settings: DepthSettings = DEFAULT) -> DepthResult:
+    """Run the depth stages on one frame; the ``settings.max_objects`` largest objects (``max_objects`` overrides
+    it) are described, the number left out is ``dropped_objects``."""
+    if max_objects is not None:
+        settings = replace(settings, max_objects=max_objects)
     t0 = time.perf_counter()
     grid = point_grid(frame.depth, frame.intrinsics, stride, normals=False)
     t1 = time.perf_counter()
-    support = _support(grid, seed)
+    support = _support(grid, seed, settings)
     t2 = time.perf_counter()
     band = support_band(grid, support) if support is not None else None
     # depth noise as a fraction of depth (sigma / z), measured on the frame: object cuts must stand out of it
     noise_rel = slope_noise(frame.depth, frame.intrinsics) / frame.intrinsics.fx
-    objs = segment_objects(grid, support, band_m=band, noise_rel=noise_rel)
-    # under heavy noise a small piece of an object is more often noise than a face: a plane needs a larger share
-    # (3.5% lifts clean depth recall by 0.016-0.031 on dev seeds, but cost the hard preset up to 0.05 of precision;
-    # docs/perception.md, session 27)
-    share = {"min_frac": _NOISY_PLANE_SHARE} if heavy_noise(noise_rel) else {}
-    solids = _solids(grid, support, objs, seed, share)
+    cells = grid.valid.size
+    objs = segment_objects(grid, support, band_m=band, noise_rel=noise_rel,
+                           min_points=max(1, round(settings.min_object_frac * cells)),
+                           max_border=settings.max_border,
+                           regrow=max(1, round(settings.regrow_frac * float(np.hypot(*grid.shape)))),
+                           seed_bands=settings.seed_bands)
+    plane_args = {"min_frac": settings.noisy_plane_share if heavy_noise(noise_rel) else settings.plane_share,
+                  "max_need": max(1, round(settings.plane_max_frac * cells)),
+                  "min_points": max(3, round(settings.plane_min_frac * cells))}
+    solids = _solids(grid, support, objs, seed, plane_args, settings.convexity)
     solids.sort(key=lambda op: (-op[0].size, int(np.argmax(op[0].mask))))
-    dropped = max(0, len(solids) - max_objects)
-    solids = solids[:max_objects]
+    dropped = max(0, len(solids) - settings.max_objects)
+    solids = solids[:settings.max_objects]
     t3 = time.perf_counter()
     h, w = frame.shape
     results = []
@@ -105,16 +160,16 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int = 
     return DepthResult(grid, support, results, timings, dropped)
 
 
-def _solids(grid: PointGrid, support: Plane | None, objs: list[DepthObject], seed: int, share: dict
-            ) -> list[tuple[DepthObject, list[DepthPlane]]]:
+def _solids(grid: PointGrid, support: Plane | None, objs: list[DepthObject], seed: int, plane_args: dict,
+            convexity: ConvexitySettings) -> list[tuple[DepthObject, list[DepthPlane]]]:
     """Each object cut at concave creases into solids (convexity.split_at_concave), each solid with its planes: a
     cut piece gets its planes anew, which may cut it again."""
     out = []
     todo = list(objs)
     while todo:
         o = todo.pop(0)
-        planes = object_planes(grid, o.mask, seed=seed + len(out), **share)
-        pieces = split_at_concave(grid, o.mask, planes)
+        planes = object_planes(grid, o.mask, seed=seed + len(out), **plane_args)
+        pieces = split_at_concave(grid, o.mask, planes, convexity)
         if len(pieces) == 1:
             out.append((o, planes))
         else:
@@ -128,8 +183,9 @@ def _height(grid: PointGrid, support: Plane | None, mask: np.ndarray) -> float:
     return float(np.percentile(grid.xyz[mask].astype(np.float64) @ support.n + support.offset, 95))
 
 
-def _support(grid: PointGrid, seed: int) -> Plane | None:
+def _support(grid: PointGrid, seed: int, settings: DepthSettings = DEFAULT) -> Plane | None:
     from .support import support_plane
 
     # every other grid point is plenty for the support plane
-    return support_plane(grid.xyz[::2, ::2][grid.valid[::2, ::2]].astype(np.float64), seed=seed)
+    return support_plane(grid.xyz[::2, ::2][grid.valid[::2, ::2]].astype(np.float64), seed=seed,
+                         stand_rel=settings.support_stand_rel, inner=settings.support_inner)

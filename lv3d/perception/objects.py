@@ -49,7 +49,7 @@ def heavy_noise(noise_rel: float, rel_jump: float = _REL_JUMP, jump_sigmas: floa
 def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60, min_height_m: float = 0.015,
                     rel_jump: float = _REL_JUMP, max_border: float = 0.12,
                     band_m: float | None = None, regrow: int = 5, noise_rel: float = 0.0,
-                    jump_sigmas: float = _JUMP_SIGMAS) -> list[DepthObject]:
+                    jump_sigmas: float = _JUMP_SIGMAS, seed_bands: float = 3.0) -> list[DepthObject]:
     """Objects above ``support`` on the grid, largest first. Points within the noise band of the support plane
     or below it are removed; the rest splits at depth jumps larger than ``rel_jump`` * depth; pieces with fewer
     than ``min_points`` grid points, lower than ``min_height_m``, or cut by the image border along more than
@@ -89,7 +89,7 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     fg_cut = cv2.morphologyEx(fg_cut.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)).astype(bool)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(fg_cut.astype(np.uint8), connectivity=4)
     if support is not None:
-        n, labels, stats = _split_by_height(labels, n, h_above, band, min_points)
+        n, labels, stats = _split_by_height(labels, n, h_above, band, min_points, seed_bands)
     # foreground cells outside every piece: the cuts themselves, and what the opening removed. A face seen
     # nearly edge-on is all depth jumps between neighbouring cells, and a few cells wide: without these cells
     # it is lost whole
@@ -125,13 +125,8 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     return out
 
 
-# objects stand out of their neighbourhood by more than this many support bands (multiples of the measured
-# noise of the support): their parts above it are the seeds of a split by height
-_SEED_BANDS = 3.0
-
-
 def _split_by_height(labels: np.ndarray, n: int, h_above: np.ndarray, band_m: float, min_points: int,
-                     seed_bands: float = _SEED_BANDS) -> tuple[int, np.ndarray, np.ndarray]:
+                     seed_bands: float = 3.0) -> tuple[int, np.ndarray, np.ndarray]:
     """Pieces of the foreground (``labels`` 1..n-1, 0 = none) parted where they dip towards the support between
     parts that stand higher: a marker-controlled watershed on the height above the support (``h_above``, metres).
 

@@ -79,14 +79,14 @@ def noise_threshold(z_m: float) -> float:
 
 def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up: float = 0.3,
                   min_frac: float = 0.08, max_points: int = 4000, min_share: float = 0.35,
-                  stand_rel: float = 0.1, min_standing: float = 0.01) -> Plane | None:
+                  stand_rel: float = 0.1, min_standing: float = 0.01, inner: float = 0.85) -> Plane | None:
     """The support plane of camera-frame points (m, 3) metres, or None if no plane holds ``min_frac`` of them.
 
     Up to ``max_planes`` planes are peeled off by RANSAC; the candidates are those whose normal points up in the
     image (``-n_y >= min_up``, camera y is down). The support is chosen by what stands on it: the candidate with
     the most points on no plane found (objects) just above it, between its inlier distance and ``stand_rel`` of
-    the scene's median depth, over its own extent (inside the convex hull of its inliers, seen along its
-    normal). The lower parts of the objects on a table lie there; the floor beneath a small table has only the
+    the scene's median depth, over the inner part of its extent (inside the convex hull of its inliers, seen along
+    its normal, scaled by ``inner`` about its centre: what rises at its far edge is a wall or a cabinet). The lower parts of the objects on a table lie there; the floor beneath a small table has only the
     table's legs there, and an object's top face only what is stacked on it. Where no candidate has
     ``min_standing`` of the points standing on it (an empty table), the nearest of the candidates holding
     ``min_share`` of the largest one's points wins (a table stands above the floor). Without an upward plane
@@ -119,7 +119,7 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
         # readings of a plane's own surface lie within a few noise widths of it at its own depth (a far floor's
         # noise is wider than the inlier distance at the scene's median depth): objects stand beyond twice that
         standing = [_standing(p, q, remaining, max(dist_m, 2 * noise_threshold(float(np.median(q[:, 2])))), top,
-                              [c for c in cands if c[0] is not p]) for p, q in cands]
+                              [c for c in cands if c[0] is not p], inner) for p, q in cands]
         if max(standing) >= min_standing * len(points):
             return up[int(np.argmax(standing))][0]
     if up:
@@ -128,10 +128,6 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
         most = max(c for _, c in up)
         return min((p for p, c in up if c >= min_share * most), key=lambda p: p.offset)
     return found[0][0] if found else None
-
-
-# the share of a plane's extent (scale about its centre) over which objects count as standing on it
-_INNER = 0.85
 
 
 def _over(plane: Plane, inliers: np.ndarray, points: np.ndarray, shrink: float = 1.0) -> np.ndarray:
@@ -150,14 +146,13 @@ def _over(plane: Plane, inliers: np.ndarray, points: np.ndarray, shrink: float =
 
 
 def _standing(plane: Plane, inliers: np.ndarray, others: np.ndarray, low_m: float, high_m: float,
-              rivals: list[tuple[Plane, np.ndarray]]) -> int:
+              rivals: list[tuple[Plane, np.ndarray]], inner: float) -> int:
     """How many of the points ``others`` (m, 3) stand on ``plane``: between ``low_m`` and ``high_m`` above it (on
     the camera's side), over the convex hull of its ``inliers`` (k, 3), and not beneath a rival plane (below it
     and over its inliers' hull: the sides of a table stand on the floor, but hold up the table)."""
     h = others @ plane.n + plane.offset
     near = others[(h > low_m) & (h <= high_m)]
-    # the rim of the plane's extent is left out: what rises at its far edge is a wall or a cabinet, not an object
-    keep = _over(plane, inliers, near, _INNER)
+    keep = _over(plane, inliers, near, inner)
     for p, q in rivals:
         keep &= ~((near @ p.n + p.offset < -low_m) & _over(p, q, near))
     return int(np.count_nonzero(keep))

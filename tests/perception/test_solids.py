@@ -62,3 +62,18 @@ def test_the_object_cap_is_an_option_and_counts_what_it_drops():
     assert perceive(frame, "depth").dropped_objects == 0
     with pytest.raises(InputError, match="max-objects"):
         perceive(frame, "depth", max_objects=0)
+
+
+def test_depth_settings_are_checked_and_hold_at_any_image_size():
+    from lv3d.perception.depth import DepthSettings, depth_scene
+
+    with pytest.raises(ValueError, match="max_objects"):
+        DepthSettings(max_objects=0)
+    with pytest.raises(ValueError, match="max_border"):
+        DepthSettings(max_border=1.5)
+    counts = []
+    for w, h in ((320, 240), (640, 480), (960, 720)):
+        frame = render_scene("cube", 1, noise_config("clean", touching=1.0), w, h)[0]
+        res = depth_scene(frame)
+        counts.append((len(res.objects), [len(o.planes) for o in res.objects]))
+    assert counts[0] == counts[1] == counts[2]
