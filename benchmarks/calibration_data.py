@@ -43,7 +43,7 @@ def scene_rows(cls: str, seed: int, preset: str, modalities: list[str]) -> list[
         for (pred, args, p, value), y, f in zip(cands, labels, feats):
             if y is not None:
                 rows.append({"modality": mod, "pred": pred, "p": float(p), "y": bool(y), "cls": cls, "seed": seed,
-                             "value": value, **f})
+                             "source": f"render:{preset}", **f, "value": value})
     return rows
 
 

@@ -1,54 +1,63 @@
-"""Fit the per-(modality, predicate) confidence calibration maps and write grounding/_calibration_table.py.
+"""Fit the per-(modality, key) confidence calibration maps and write lv3d/data/calibration.json.
 
-The table in the tree (docs/grounding.md, "Calibration on perceived scenes"): rgbd refitted in session 21, when
-parallel's maps were offered the side the two faces share, on 9800 fresh scenes of dev seeds (session 20's 5600
-and 4200 more; each 1050-scene set ~2-4 min on one core, two at a time), checked on 3570 scenes (seeds 100000+,
-50000+, 150000+ and 160000+)::
+The fit reads candidate facts with their truth from two kinds of data:
 
-    for a in "30000 150 a150" "40000 150 b150" "60000 100 d60000" "70000 100 d70000" "80000 150 e80000" \
-             "90000 150 f90000" "110000 150 g110000" "120000 150 g120000" "130000 150 g130000" \
-             "140000 150 g140000" "100000 150 chk100000" "50000 60 c60" "150000 150 k150000" \
-             "160000 150 k160000"; do set -- $a
-        .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class $2 --modalities rgbd \
-            --out out/calib/$3.pkl; done
-    .venv/bin/python benchmarks/fit_calibration.py out/calib/{a150,b150,d60000,d70000,e80000,f90000}.pkl \
-        out/calib/{g110000,g120000,g130000,g140000}.pkl --check out/calib/chk_all.pkl --modalities rgbd
+- rendered dev scenes (benchmarks/calibration_data.py): every fact type, truth from the renderer;
+- labelled real frames (benchmarks/calibration_real.py, ``--real``): ``perpendicular`` only, truth from the
+  labelled shape (adjacent faces of a box are perpendicular, of a cylinder or bowl not; bench_real.py's
+  definition). Rendered scenes hold no curved solids, and their perception errors are smaller than a real
+  sensor's; the real rows teach the maps both.
 
-(chk_all: the rows and scenes of chk100000, c60, k150000 and k160000 concatenated into one pickle; the fit takes ~30 s). Depth is session 17's, fitted for both
-modalities after the dihedral tolerance became 90 +- 7 deg (docs/facts.md) and side counts moved onto the plane:
-3500 scenes, each 1050-scene set ~3.5 min on one core with rgbd and depth, the 420-scene check set ~1.2 min, the fit
-~20 s:
+The whole fit, on one core (the rendered sets ~6 min each for both modalities, the real folders ~1 min, the fit
+a few minutes)::
 
-    for a in "30000 150 a150" "40000 150 b150" "60000 100 d60000" "70000 100 d70000"; do set -- $a
-        .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class $2 --modalities rgbd,depth \
-            --out out/calib/s17p_$3.pkl; done
-    .venv/bin/python benchmarks/calibration_data.py --fresh --seed 50000 --per-class 60 --modalities rgbd,depth --out out/calib/s17p_c60.pkl
-    .venv/bin/python benchmarks/fit_calibration.py out/calib/s17p_{a150,b150,d60000,d70000}.pkl --check out/calib/s17p_c60.pkl
+    for a in "30000 r30000" "40000 r40000" "60000 r60000" "80000 r80000" "100000 chk100000" "150000 chk150000"; do
+        set -- $a
+        .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class 150 --modalities rgbd,depth \\
+            --out out/calib/$2.pkl
+    done
+    for f in osd-learn ycb-realsense; do
+        .venv/bin/python benchmarks/calibration_real.py ../shared/data/real/$f --out out/calib/real_$f.pkl
+    done
+    .venv/bin/python benchmarks/fit_calibration.py out/calib/r{30000,40000,60000,80000}.pkl \\
+        --real out/calib/real_osd-learn.pkl out/calib/real_ycb-realsense.pkl \\
+        --check out/calib/chk100000.pkl out/calib/chk150000.pkl --holdout
 
-For each (modality, predicate) four maps compete by scene-grouped 5-fold cross-validated log loss on the dev rows:
-the raw probability unchanged, a shift in logit space, Platt scaling (bias + slope on logit p), and Platt
-plus a few face measurements (``FEATURES``) and, for predicates with a tolerance, the measured value in
-tolerances (``tol_frac``); for facts about two faces (``PAIR_PREDS``) also that map plus the length of the side
-the two faces share (``PAIR_FEATURES``), and for parallel (``PLANE_GAP_PREDS``) that map plus how far the two faces
-are from one plane (``PLANE_GAP_FEATURES``), and that map plus the shared side. The winner is refitted on all rows (L2-regularised logistic regression,
-measurements standardised, the standardisation folded into the coefficients). A map whose slope on
-logit p comes out negative is not used (confidence must grow with the measured probability). Then the
-final map (``FINAL``) of out-of-fold confidences: per modality one isotonic map of every type pooled, one of
-the per-face types (``FACE_PREDS``) pooled, and per type the best by scene-grouped 5-fold CV log loss of
-none, its group's pooled map (per-face types: the per-face one, so the pair types' inputs cannot move their
-choice) and the type's own isotonic map (``fit_final``).
-``--modalities rgbd`` refits one modality and keeps the other's maps from the table in the tree (session 14 refitted
-rgbd alone: a depth refit on fresh rows scored worse on held-out dev scenes, docs/grounding.md).
-``--check`` prints per-type ECE on another dev set (rows with confidence >= 0.05, as facts are emitted)
-for the raw probabilities, the table in the tree and the new one, and each modality's ECE and log loss
-over all facts. Rows come from dev seeds only, never the study's data.
+Rows come from dev seeds only, never the study's data. After perception or grounding changed, all of it is rerun
+(:func:`lv3d.calibration.stale_sources` names what changed since the shipped fit).
+
+The maps. For each (modality, key) (``grounding.calibration_key``: the predicate, or a kind filed apart) several
+maps compete by scene-grouped 5-fold cross-validated log loss (a scene's or real frame's facts share its view and
+its perception errors): the raw probability unchanged, a shift in logit space, Platt scaling (bias + slope on
+logit p), and Platt plus face measurements (``FEATURES``; for predicates with a tolerance also ``tol_frac``, the
+measured value in tolerances), each with and without how well the faces fit a polygon and a plane
+(``FIT_FEATURES``); for facts about two faces (``PAIR_PREDS``) also those plus the side the two share
+(``PAIR_FEATURES``), for parallel (``PLANE_GAP_PREDS``) plus how far the faces are from one plane. The winner is
+refitted on all rows (L2-regularised logistic regression, measurements standardised, the standardisation folded
+into the coefficients); a map whose slope on logit p comes out negative is refitted without it (confidence
+must not fall as the measured probability rises). Then the final maps: per modality one isotonic map of every
+key's out-of-fold confidences pooled, one of the per-face keys (``FACE_PREDS``) pooled, and per key the best by
+scene-grouped CV log loss of none, its group's pooled map and its own (:func:`fit_final`).
+
+Weights. Where a key has rows of both kinds, the real rows carry ``REAL_SHARE`` of its total weight (each kind's
+rows equal among themselves, weights averaging 1): a few hundred real candidates against tens of thousands of
+rendered ones would otherwise leave the maps as they were. The real frames also check the fit: ``--holdout``
+fits once without each real pickle and prints bench_real's figures on the one left out, before the fit on all.
+
+``--check`` prints per-type ECE on other rendered dev sets (facts with confidence >= 0.05, as they are emitted)
+for the raw probabilities, the shipped maps and the new ones; real pickles print bench_real's box and
+calibration figures (benchmarks/calibration_real.figures) for the shipped and the new maps. The written file
+holds the maps, those figures (``checks``) and the provenance (lv3d.calibration).
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
+import hashlib
+import json
 import pickle
-import pprint
+import subprocess
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -59,25 +68,31 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.calibration_error import chance_ece, ece, log_loss  # noqa: E402
-from grounding._calibration import SHARED_SIDE_PREDS, TOL_FRAC_PREDS, calibration_key, inputs  # noqa: E402
+from grounding._calibration import SHARED_SIDE_PREDS, TOL_FRAC_PREDS, calibrate_with, calibration_key, inputs  # noqa: E402
 from lv3d.describe import SIDE_NAMES  # noqa: E402
 from lv3d.facts import PREDICATES  # noqa: E402
 
-MODALITIES = ("rgbd", "depth")  # rgb is left raw: see docs/grounding.md (its labels need a look first)
+MODALITIES = ("rgbd", "depth")  # rgb is left raw: its facts' truth needs a look first (docs/grounding.md)
 FEATURES = ["support", "log_area_px", "min_turn_z", "min_side_px"]
+# how well the faces are a polygon and a plane (lv3d.describe._face_features): outlines off straight edges and
+# surfaces off their plane are what a curved solid read as planar faces shows, and rendered scenes have none
+FIT_FEATURES = ["edge_scale2", "plane_rms_mm"]
 MIN_ROWS = 12        # fewer rows (or one class of label only): keep the raw probability
-C_REG = 0.5          # inverse L2 strength of the logistic fits (standardised inputs)
-MIN_CONF = 0.05
+C_REG = 0.5          # inverse L2 strength of the logistic fits (standardised inputs, weights averaging 1)
+MIN_CONF = 0.05      # facts below this confidence are not emitted (lv3d.describe.MIN_CONF): ECE is over the rest
 MIN_OWN_FINAL = 50   # fewer rows of either label: a type's own isotonic map would be steps of a few facts
-FINAL_REPEATS = 5    # fold draws the final maps are chosen over (_choose_final)
-SUPPORT_PREDS = ("face_of", "adjacent", "object")
+FINAL_REPEATS = 5    # fold draws the final maps are chosen over (_choose_final): one draw's choice between
+#                      near-equal maps is a coin toss
+# the share of a key's total fit weight its real rows carry where it has rows of both kinds: the two kinds count
+# alike (the maps must hold on both; neither is the other's special case)
+REAL_SHARE = 0.5
+SUPPORT_PREDS = ("face_of", "adjacent", "object")  # p is edge support, not a geometric probability: may be ignored
 # facts about two faces whose map may also read the side the faces share (0: none, e.g. pyramid laterals
-# touching at the apex); parallel is offered it beside the plane gap (PLANE_GAP_PREDS): with ~60 fit rows (session
-# 14) it made parallel's log loss worse out of sample, with ~900 (session 21) better
+# touching at the apex); parallel is offered it beside the plane gap (PLANE_GAP_PREDS)
 PAIR_PREDS = SHARED_SIDE_PREDS
 PAIR_FEATURES = ["shared_side_px"]
 # facts about two planes whose map may also read how far the two faces are from one plane: parallel facts that
-# hold are mostly two pieces of one face, a few mm apart (docs/grounding.md, session 14)
+# hold are mostly two pieces of one face, a few mm apart
 PLANE_GAP_PREDS = ("parallel",)
 PLANE_GAP_FEATURES = ["plane_gap_mm"]
 # facts about one face: their final maps are chosen on their rows alone (fit_final); with the (n - 1) side counts,
@@ -92,17 +107,45 @@ def row_key(r: dict) -> str:
     return calibration_key(r["pred"], r.get("is_fewer", 0.0) > 0, r.get("shared_side_px"))
 
 
-def _fit(x: np.ndarray, y: np.ndarray):
-    """Logistic regression on standardised x with one pseudo-observation of each label (weight 1/2 each,
+def scene_of(r: dict) -> str:
+    """The scene a row comes from, the unit cross-validation keeps in one fold: a real row's folder/frame, a
+    rendered row's render seed."""
+    return r.get("scene") or f"render/{r['seed']}"
+
+
+def is_real(r: dict) -> bool:
+    return str(r.get("source", "")).startswith("real:")
+
+
+def row_weights(rows: list[dict], real_share: float = REAL_SHARE) -> np.ndarray:
+    """Fit weight of each row of one key: where there are rows of both kinds, the real ones carry
+    ``real_share`` of the total, the rendered ones the rest; weights average 1."""
+    real = np.array([is_real(r) for r in rows])
+    w = np.ones(len(rows))
+    if real.any() and (~real).any():
+        w[real] = real_share / real.sum()
+        w[~real] = (1.0 - real_share) / (~real).sum()
+        w *= len(rows)
+    return w
+
+
+def _wlog_loss(p, y, w) -> float:
+    p = np.clip(np.asarray(p, float), 1e-6, 1 - 1e-6)
+    return float(-np.sum(w * (y * np.log(p) + (1 - y) * np.log(1 - p))) / np.sum(w))
+
+
+def _fit(x: np.ndarray, y: np.ndarray, w: np.ndarray):
+    """Weighted logistic regression on standardised x with one pseudo-observation of each label (weight 1/2 each,
     at the mean inputs: Laplace smoothing, so a type that was always true on dev gets (n + 1/2) / (n + 1),
     not 1); returns (bias, coef) in the original units."""
     from sklearn.linear_model import LogisticRegression
 
-    mu, sd = x.mean(0), x.std(0) + 1e-9
+    mu = np.average(x, axis=0, weights=w)
+    sd = np.sqrt(np.average((x - mu) ** 2, axis=0, weights=w)) + 1e-9
     xs = np.concatenate([(x - mu) / sd, np.zeros((2, x.shape[1]))])
     ys = np.concatenate([y, [0.0, 1.0]])
-    w = np.concatenate([np.ones(len(y)), [0.5, 0.5]])
-    m = LogisticRegression(C=C_REG, max_iter=1000).fit(xs, ys, sample_weight=w)
+    ws = np.concatenate([w, [0.5, 0.5]])
+    m = LogisticRegression(C=C_REG, max_iter=1000).fit(xs, ys, sample_weight=ws)
     coef = m.coef_[0] / sd
     return float(m.intercept_[0] - coef @ mu), coef
 
@@ -111,7 +154,7 @@ def _predict(bias, coef, x):
     return 1.0 / (1.0 + np.exp(-np.clip(bias + x @ coef, -50, 50)))
 
 
-def _fit_shift(rows: list[dict]):
+def _fit_shift(rows: list[dict], w: np.ndarray):
     """(bias, coef, features) of ``sigmoid(logit p + bias)``: the raw probability moved in logit space by
     one smoothed constant (types whose dev candidates were all true or all false keep p's order)."""
     from scipy.optimize import minimize_scalar
@@ -119,53 +162,64 @@ def _fit_shift(rows: list[dict]):
     z = np.array([inputs(r["pred"], r["p"], r, ["logit_p"])[0] for r in rows])
     y = np.array([r["y"] for r in rows], float)
 
-    def loss(b):  # log loss plus the two half pseudo-observations at logit 0
-        return len(y) * log_loss(_predict(b, np.ones(1), z[:, None]), y) + 0.5 * (np.logaddexp(0, -b) + np.logaddexp(0, b))
+    def loss(b):  # weighted log loss plus the two half pseudo-observations at logit 0
+        return np.sum(w) * _wlog_loss(_predict(b, np.ones(1), z[:, None]), y, w) + \
+            0.5 * (np.logaddexp(0, -b) + np.logaddexp(0, b))
 
     return float(minimize_scalar(loss, bounds=(-15, 15), method="bounded").x), np.ones(1), ["logit_p"]
 
 
-def _fit_monotone(rows: list[dict], feats: list[str] | None):
+def _fit_monotone(rows: list[dict], feats: list[str] | None, w: np.ndarray):
+    """(bias, coef, features) of a logistic map (``feats`` None: :func:`_fit_shift`); refitted without logit p
+    when its slope comes out negative (where p carries no information, e.g. always 1, the map must not turn it
+    upside down)."""
     if feats is None:
-        return _fit_shift(rows)
-    """(bias, coef, features) of a logistic map; refitted without logit p when its slope comes out
-    negative (where p carries no information, e.g. always 1, the map must not turn it upside down)."""
+        return _fit_shift(rows, w)
     y = np.array([r["y"] for r in rows], float)
-    if not feats:  # a constant: the smoothed rate
-        return float(np.log((y.sum() + .5) / ((1 - y).sum() + .5))), np.zeros(0), []
+    if not feats:  # a constant: the smoothed weighted rate
+        return float(np.log((np.sum(w * y) + .5) / (np.sum(w * (1 - y)) + .5))), np.zeros(0), []
     x = np.array([inputs(r["pred"], r["p"], r, feats) for r in rows])
-    b, c = _fit(x, y)
-    if feats and feats[0] == "logit_p" and c[0] < 0:
-        return _fit_monotone(rows, feats[1:])
+    b, c = _fit(x, y, w)
+    if feats[0] == "logit_p" and c[0] < 0:
+        return _fit_monotone(rows, feats[1:], w)
     return b, c, feats
 
 
-def _scene_fold_of(seeds, seed: int) -> dict:
-    """{scene (its render seed): one of 5 folds} over the scenes of ``seeds``, seeded: every row of one scene
+def _scene_fold_of(scenes, seed: int) -> dict:
+    """{scene: one of 5 folds} over ``scenes`` (render seeds or real frames), seeded: every row of one scene
     goes to the same fold. A scene's facts share its view and its perception errors; rows of one scene on both
     sides of a split would reward a map for learning the scene rather than the fact type."""
-    scenes = np.unique(np.asarray(seeds))
-    return dict(zip(scenes.tolist(), np.random.default_rng(seed).permutation(len(scenes)) % 5))
+    names = np.unique(np.asarray(scenes))
+    return dict(zip(names.tolist(), np.random.default_rng(seed).permutation(len(names)) % 5))
 
 
-def fit_one(rows: list[dict], seed: int = 0):
-    """The best map for one (modality, predicate) by scene-grouped 5-fold CV log loss (:func:`_scene_fold_of`):
-    (None (raw) or a table entry, {map: CV log loss}, the winner's out-of-fold confidences (n,))."""
-    y = np.array([r["y"] for r in rows], float)
-    p = np.array([r["p"] for r in rows])
-    if len(rows) < MIN_ROWS:
-        return None, {}, np.clip(p, 0, 1)
-    fold = _scene_fold_of([r["seed"] for r in rows], seed)
-    folds = np.array([fold[r["seed"]] for r in rows])
-    tol = ["tol_frac"] if rows[0]["pred"] in TOL_FRAC_PREDS else []  # the measured value in tolerances
-    cands = {"raw": "raw", "shift": None, "platt": ["logit_p"], "platt+measures": ["logit_p"] + FEATURES + tol}
-    if rows[0]["pred"] in PAIR_PREDS:
+def candidate_maps(pred: str) -> dict:
+    """{name: the inputs of the map (``"raw"``: none; None: a shift of logit p)} that compete for ``pred``."""
+    tol = ["tol_frac"] if pred in TOL_FRAC_PREDS else []  # the measured value in tolerances
+    cands = {"raw": "raw", "shift": None, "platt": ["logit_p"], "platt+measures": ["logit_p"] + FEATURES + tol,
+             "platt+measures+fit": ["logit_p"] + FEATURES + FIT_FEATURES + tol}
+    if pred in PAIR_PREDS:
         cands["platt+measures+shared"] = ["logit_p"] + FEATURES + PAIR_FEATURES + tol
-    if rows[0]["pred"] in PLANE_GAP_PREDS:
+        cands["platt+measures+shared+fit"] = ["logit_p"] + FEATURES + PAIR_FEATURES + FIT_FEATURES + tol
+    if pred in PLANE_GAP_PREDS:
         cands["platt+measures+gap"] = ["logit_p"] + FEATURES + PLANE_GAP_FEATURES + tol
         cands["platt+measures+gap+shared"] = ["logit_p"] + FEATURES + PLANE_GAP_FEATURES + PAIR_FEATURES + tol
-    if rows[0]["pred"] in SUPPORT_PREDS:  # p is edge support, not a geometric probability: may be ignored
+    if pred in SUPPORT_PREDS:  # p is edge support, not a geometric probability: may be ignored
         cands["const"] = []
+    return cands
+
+
+def fit_one(rows: list[dict], seed: int = 0, w: np.ndarray | None = None):
+    """The best map for one (modality, key) by scene-grouped 5-fold CV weighted log loss (:func:`_scene_fold_of`):
+    (None (raw) or a map, {map: CV log loss}, the winner's out-of-fold confidences (n,))."""
+    y = np.array([r["y"] for r in rows], float)
+    p = np.array([r["p"] for r in rows])
+    w = np.ones(len(rows)) if w is None else w
+    if len(rows) < MIN_ROWS:
+        return None, {}, np.clip(p, 0, 1)
+    fold = _scene_fold_of([scene_of(r) for r in rows], seed)
+    folds = np.array([fold[scene_of(r)] for r in rows])
+    cands = candidate_maps(rows[0]["pred"])
     losses, oof = {}, {}
     for name, feats in cands.items():
         pred = np.empty(len(rows))
@@ -175,22 +229,22 @@ def fit_one(rows: list[dict], seed: int = 0):
                 pred[te] = np.clip(p[te], 0, 1)
                 continue
             trows = [r for r, t in zip(rows, tr) if t]
-            b, c, f = _fit_monotone(trows, feats)
+            b, c, f = _fit_monotone(trows, feats, w[tr])
             x = np.array([inputs(r["pred"], r["p"], r, f) for r, t in zip(rows, te) if t]).reshape(int(te.sum()), len(f))
             pred[te] = _predict(b, c, x)
-        losses[name], oof[name] = log_loss(pred, y), pred
+        losses[name], oof[name] = _wlog_loss(pred, y, w), pred
     name = min(losses, key=losses.get)
     if cands[name] == "raw":
         return None, losses, oof[name]
-    b, c, f = _fit_monotone(rows, cands[name])
+    b, c, f = _fit_monotone(rows, cands[name], w)
     return {"features": f, "bias": round(b, 5), "coef": [round(float(v), 5) for v in c], "n": len(rows),
             "map": name, "cv_logloss": round(losses[name], 4)}, losses, oof[name]
 
 
-def _isotonic(conf: np.ndarray, y: np.ndarray):
+def _isotonic(conf: np.ndarray, y: np.ndarray, w: np.ndarray | None = None):
     from sklearn.isotonic import IsotonicRegression
 
-    return IsotonicRegression(y_min=1e-3, y_max=1 - 1e-3, out_of_bounds="clip").fit(conf, y)
+    return IsotonicRegression(y_min=1e-3, y_max=1 - 1e-3, out_of_bounds="clip").fit(conf, y, sample_weight=w)
 
 
 def _knots(iso) -> dict:
@@ -198,53 +252,56 @@ def _knots(iso) -> dict:
     return {"x": [round(float(v), 5) for v in iso.X_thresholds_], "y": [round(float(v), 5) for v in iso.y_thresholds_]}
 
 
+def _parts(entry: tuple) -> tuple:
+    """(confidences, truth, scenes, weights) of an out-of-fold entry; weights 1 where it has none."""
+    c, t, s = entry[:3]
+    return c, t, s, (entry[3] if len(entry) > 3 else np.ones(len(c)))
+
+
 def _choose_final(oof: dict, pool: list[str], members: list[str], seed: int) -> tuple[dict, dict, dict]:
-    """Fit the isotonic map of the rows of the types in ``pool`` together and choose, for each type in
-    ``members``, among none, that pooled map and the type's own (with ``MIN_OWN_FINAL`` rows of each label)
-    by scene-grouped 5-fold CV log loss on its own rows, averaged over ``FINAL_REPEATS`` fold draws (one draw's
-    choice between near-equal maps was a coin toss: rgbd pentagon flipped from the pooled map to none when a
-    sixth of the rows was added, and its check-set ECE doubled). Returns (pooled knots, {member: "pooled", None or
-    own knots}, {member: {choice: mean CV log loss}}). Nothing outside ``pool`` enters the choice."""
-    conf, y, seeds = (np.concatenate([oof[p][i] for p in pool]) for i in range(3))
+    """Fit the isotonic map of the rows of the keys in ``pool`` together and choose, for each key in
+    ``members``, among none, that pooled map and the key's own (with ``MIN_OWN_FINAL`` rows of each label)
+    by scene-grouped 5-fold CV weighted log loss on its own rows, averaged over ``FINAL_REPEATS`` fold draws.
+    Returns (pooled knots, {member: "pooled", None or own knots}, {member: {choice: mean CV log loss}}). Nothing
+    outside ``pool`` enters the choice."""
+    conf, y, scenes, w = (np.concatenate([_parts(oof[p])[i] for p in pool]) for i in range(4))
     sums: dict = defaultdict(lambda: defaultdict(float))
     for rep in range(FINAL_REPEATS):
-        fold = _scene_fold_of(seeds, seed + rep)
-        folds = np.array([fold[s] for s in seeds.tolist()])
-        pooled = [_isotonic(conf[folds != k], y[folds != k]) for k in range(5)]
+        fold = _scene_fold_of(scenes, seed + rep)
+        folds = np.array([fold[s] for s in scenes.tolist()])
+        pooled = [_isotonic(conf[folds != k], y[folds != k], w[folds != k]) for k in range(5)]
         for pred in members:
-            c, t = oof[pred][0], oof[pred][1]
-            f = np.array([fold[s] for s in oof[pred][2]])
+            c, t, s, wp = _parts(oof[pred])
+            f = np.array([fold[x] for x in s.tolist()])
             cands = {"none": c, "pooled": np.empty(len(c))}
             if min(t.sum(), len(t) - t.sum()) >= MIN_OWN_FINAL:
                 cands["own"] = np.empty(len(c))
             for k in range(5):
                 te = f == k
-                if not te.any():  # a rare type (depth parallel: 8 rows in session 9) may miss a fold
+                if not te.any():  # a rare key may miss a fold
                     continue
                 cands["pooled"][te] = pooled[k].predict(c[te])
                 if "own" in cands:
-                    cands["own"][te] = _isotonic(c[~te], t[~te]).predict(c[te])
+                    cands["own"][te] = _isotonic(c[~te], t[~te], wp[~te]).predict(c[te])
             for name, v in cands.items():
-                sums[pred][name] += log_loss(v, t) / FINAL_REPEATS
+                sums[pred][name] += _wlog_loss(v, t, wp) / FINAL_REPEATS
     choice, losses = {}, {}
     for pred in members:
         losses[pred] = dict(sums[pred])
         best = min(losses[pred], key=losses[pred].get)
-        c, t = oof[pred][0], oof[pred][1]
-        choice[pred] = best if best == "pooled" else None if best == "none" else _knots(_isotonic(c, t))
-    return _knots(_isotonic(conf, y)), choice, losses
+        c, t, _, wp = _parts(oof[pred])
+        choice[pred] = best if best == "pooled" else None if best == "none" else _knots(_isotonic(c, t, wp))
+    return _knots(_isotonic(conf, y, w)), choice, losses
 
 
 def fit_final(oof: dict, seed: int = 0) -> tuple[dict, dict]:
-    """The final maps of one modality from ``oof`` {pred: (out-of-fold stage-1 confidences (n,), truth (n,),
-    scene seeds (n,))}. Per-face types (``FACE_PREDS``) choose among none, the pooled isotonic map of the
-    per-face types' rows and their own isotonic map; the other types among none, the pooled map of every
-    type's rows and their own (:func:`_choose_final`, scene-grouped 5-fold CV log loss: a scene's facts share
-    its view and perception errors). So a per-face type's final map depends on per-face rows only: a new
-    input of the pair types' maps cannot move it (session 9: it flipped rgbd pentagon to the pooled map).
-    Returns (the ``FINAL`` entry: the every-type pooled knots, "faces" the per-face pooled knots and
-    "by_pred" {pred: own knots, None for no final stage, or "faces"} for each type that does not take the
-    every-type pooled map, {pred: {choice: CV log loss}})."""
+    """The final maps of one modality from ``oof`` {key: (out-of-fold stage-1 confidences (n,), truth (n,),
+    scenes (n,)[, weights (n,)])}. Per-face keys (``FACE_PREDS``) choose among none, the pooled isotonic map of the
+    per-face keys' rows and their own isotonic map; the other keys among none, the pooled map of every key's rows
+    and their own (:func:`_choose_final`). So a per-face key's final map depends on per-face rows only: a new
+    input of the pair keys' maps cannot move it. Returns (the modality's final maps: the every-key pooled knots,
+    "faces" the per-face pooled knots and "by_pred" {key: own knots, None for no final stage, or "faces"} for
+    each key that does not take the every-key pooled map, {key: {choice: CV log loss}})."""
     preds = sorted(oof)
     faces = [p for p in preds if p in FACE_PREDS]
     final, choice, losses = _choose_final(oof, preds, [p for p in preds if p not in FACE_PREDS], seed)
@@ -253,17 +310,64 @@ def fit_final(oof: dict, seed: int = 0) -> tuple[dict, dict]:
         final["faces"], choice, face_losses = _choose_final(oof, faces, faces, seed)
         by_pred.update({p: "faces" if c == "pooled" else c for p, c in choice.items()})
         losses.update(face_losses)
-    return {**final, "by_pred": by_pred, "fewer_maps": True, "touch_maps": True}, losses
+    return {**final, "by_pred": by_pred}, losses
 
 
-def report(rows: list[dict], table: tuple, title: str, shipped: tuple | None = None) -> None:
-    """Per (modality, predicate): ECE of the raw probabilities, of ``shipped`` (the (TABLE, FINAL) in the
-    tree when the fit began) if given, and of ``table`` (TABLE, FINAL), with the chance level of its
-    confidences."""
-    from grounding._calibration import calibrate_with
+def fit(rows: list[dict], modalities, real_share: float = REAL_SHARE, log=print) -> tuple[dict, dict]:
+    """(table, final) fitted on ``rows`` (rendered and real together) for ``modalities``."""
+    by = defaultdict(list)
+    for r in rows:
+        if r["modality"] in modalities and r["p"] > 0:
+            by[(r["modality"], row_key(r))].append(r)
+    table: dict = {}
+    oof = defaultdict(dict)  # per modality, per key: out-of-fold confidences, truth, scenes, weights
+    for key in sorted(by):
+        rs = by[key]
+        w = row_weights(rs, real_share)
+        entry, losses, conf = fit_one(rs, w=w)
+        oof[key[0]][key[1]] = (conf, np.array([r["y"] for r in rs], float), np.array([scene_of(r) for r in rs]), w)
+        n_real = sum(is_real(r) for r in rs)
+        log(f"  {key[0]:5s} {key[1]:20s} n={len(rs):5d} ({n_real} real)  cv log loss "
+            + "  ".join(f"{k} {v:.4f}" for k, v in losses.items())
+            + f"  -> {'raw' if entry is None else entry['map'] + ' ' + ','.join(entry['features'])}")
+        if entry is not None:
+            table.setdefault(key[0], {})[key[1]] = entry
+    final = {}
+    log("final map per key, scene-grouped 5-fold CV log loss:")
+    for mod in sorted(oof):
+        final[mod], losses = fit_final(oof[mod])
+        for pred, ls in losses.items():
+            log(f"  {mod:5s} {pred:20s} " + "  ".join(f"{k} {v:.4f}" for k, v in ls.items()) + f"  -> {min(ls, key=ls.get)}")
+    return table, final
 
-    print(f"== {title}: per-type ECE of emitted facts (conf >= {MIN_CONF}), raw -> "
-          + ("shipped table -> " if shipped is not None else "") + "calibrated")
+
+# ---------------------------------------------------------------------------------------------- checks
+
+
+def rendered_ece(rows: list[dict], maps: tuple) -> dict:
+    """{modality: {predicate: (ECE, facts)}} of the facts emitted under ``maps`` (table, final) (confidence >=
+    MIN_CONF), grouped by predicate as calibration_check.py groups them, and "all" over every fact."""
+    facts = defaultdict(list)
+    for r in rows:
+        if r["modality"] not in MODALITIES or not r["p"] > 0:
+            continue
+        c = calibrate_with(maps[0], r["modality"], row_key(r), r["p"], r, maps[1])
+        if c >= MIN_CONF:
+            facts[(r["modality"], r["pred"])].append((c, float(r["y"])))
+            facts[(r["modality"], "all")].append((c, float(r["y"])))
+    out: dict = defaultdict(dict)
+    for (mod, pred), v in sorted(facts.items()):
+        a = np.array(v)
+        out[mod][pred] = (round(ece(a[:, 0], a[:, 1]), 4), len(a))
+    return dict(out)
+
+
+def report_rendered(rows: list[dict], table: tuple, title: str, shipped: tuple | None = None) -> None:
+    """Per (modality, key): ECE of the raw probabilities, of ``shipped`` (the maps in the tree when the fit began)
+    if given, and of ``table`` (table, final), with the chance level of its confidences; then per modality over
+    every emitted fact."""
+    print(f"== {title}: per-key ECE of emitted facts (conf >= {MIN_CONF}), raw -> "
+          + ("shipped -> " if shipped is not None else "") + "calibrated")
     by = defaultdict(list)
     for r in rows:
         by[(r["modality"], row_key(r))].append(r)
@@ -279,69 +383,157 @@ def report(rows: list[dict], table: tuple, title: str, shipped: tuple | None = N
         raw = np.array([(min(r["p"], 1.0), r["y"]) for r in rs if r["p"] >= MIN_CONF], float).reshape(-1, 2)
         cal = emitted(table)
         old = f"  shipped {ece(*emitted(shipped).T):.3f}" if shipped is not None else ""
-        print(f"  {key[0]:5s} {key[1]:14s} raw {ece(*raw.T):.3f} (n={len(raw):4d}){old}  calibrated {ece(*cal.T):.3f} "
-              f"(n={len(cal):4d}, chance {chance_ece(cal[:, 0]):.3f})  mean conf {cal[:, 0].mean() if len(cal) else float('nan'):.2f} "
-              f"true {cal[:, 1].mean() if len(cal) else float('nan'):.2f}")
+        print(f"  {key[0]:5s} {key[1]:20s} raw {ece(*raw.T):.3f} (n={len(raw):5d}){old}  calibrated {ece(*cal.T):.3f} "
+              f"(n={len(cal):5d}, chance {chance_ece(cal[:, 0]):.3f})  mean conf "
+              f"{cal[:, 0].mean() if len(cal) else float('nan'):.2f} true {cal[:, 1].mean() if len(cal) else float('nan'):.2f}")
     for mod in MODALITIES:  # every emitted fact, and the log loss of every candidate (p > 0): a proper score
         rs = [r for r in rows if r["modality"] == mod and r["p"] > 0]
-        if not rs:  # a set made for the other modality only
+        if not rs:
             continue
         y = np.array([r["y"] for r in rs], float)
-        line = f"  {mod:5s} all facts     "
+        line = f"  {mod:5s} all facts           "
         for name, tab in (("shipped", shipped), ("calibrated", table)):
             if tab is None:
                 continue
             c = np.array([calibrate_with(tab[0], mod, row_key(r), r["p"], r, tab[1]) for r in rs])
-            line += f"  {name} ECE {ece(c[c >= MIN_CONF], y[c >= MIN_CONF]):.3f} (n={int((c >= MIN_CONF).sum())}) log loss {log_loss(c, y):.4f}"
+            line += (f"  {name} ECE {ece(c[c >= MIN_CONF], y[c >= MIN_CONF]):.3f} (n={int((c >= MIN_CONF).sum())}) "
+                     f"log loss {log_loss(c, y):.4f}")
         print(line)
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("data", type=Path, nargs="+", help="pickles from benchmarks/calibration_data.py")
-    ap.add_argument("--check", type=Path, help="another dev set to report ECE on")
-    ap.add_argument("--out", type=Path, default=ROOT / "grounding" / "_calibration_table.py")
-    ap.add_argument("--dry-run", action="store_true")
-    ap.add_argument("--modalities", default=",".join(MODALITIES),
-                    help="refit these; the other modalities' maps are kept from the table in the tree")
-    a = ap.parse_args(argv)
-    refit = a.modalities.split(",")
-    if not set(refit) <= set(MODALITIES):
-        ap.error(f"--modalities: choose from {', '.join(MODALITIES)}")
-    rows = [r for path in a.data for r in pickle.loads(path.read_bytes())["rows"]]
-    by = defaultdict(list)
-    for r in rows:
-        if r["modality"] in refit and r["p"] > 0:
-            by[(r["modality"], row_key(r))].append(r)
-    from grounding._calibration_table import FINAL, TABLE
+def real_figures(frames: list[dict], maps: tuple) -> dict:
+    """bench_real's box and calibration figures (calibration_real.figures) of real frame entries under ``maps``."""
+    from benchmarks.calibration_real import figures
 
-    kept = [m for m in MODALITIES if m not in refit]
-    table: dict = {m: TABLE[m] for m in kept if m in TABLE}
-    oof = defaultdict(dict)  # per modality, per predicate: out-of-fold confidences, truth, scene seeds
-    for key in sorted(by):
-        entry, losses, conf = fit_one(by[key])
-        oof[key[0]][key[1]] = (conf, np.array([r["y"] for r in by[key]], float), np.array([r["seed"] for r in by[key]]))
-        print(f"  {key[0]:5s} {key[1]:14s} n={len(by[key]):5d}  cv log loss "
-              + "  ".join(f"{k} {v:.4f}" for k, v in losses.items()) + f"  -> {'raw' if entry is None else entry['map'] + ' ' + ','.join(entry['features'])}")
-        if entry is not None:
-            table.setdefault(key[0], {})[key[1]] = entry
-    final = {m: FINAL[m] for m in kept if m in FINAL}
-    print("final map per type, scene-grouped 5-fold CV log loss:")
-    for mod in sorted(oof):
-        final[mod], losses = fit_final(oof[mod])
-        for pred, ls in losses.items():
-            print(f"  {mod:5s} {pred:14s} " + "  ".join(f"{k} {v:.4f}" for k, v in ls.items()) + f"  -> {min(ls, key=ls.get)}")
-    report(rows, (table, final), f"fit rows ({', '.join(map(str, a.data))})")
-    if a.check:
-        report(pickle.loads(a.check.read_bytes())["rows"], (table, final), f"check rows ({a.check})", (TABLE, FINAL))
-    if not a.dry_run:
-        keep_note = f"; {', '.join(kept)} kept from the table before" if kept else ""
-        a.out.write_text('"""Calibration maps (see _calibration.py), written by benchmarks/fit_calibration.py: '
-                         f'{", ".join(refit)} from\n{", ".join(p.name for p in a.data)} (perceived realsense dev scenes)'
-                         f'{keep_note}. Do not edit by hand."""\n\n'
-                         f"TABLE: dict = {pprint.pformat(table, width=110, sort_dicts=True)}\n\n"
-                         f"FINAL: dict = {pprint.pformat(final, width=110, compact=True)}\n")
-        print(f"wrote {a.out}")
+    return figures(frames, lambda r: calibrate_with(maps[0], r["modality"], r["key"], r["p"], r, maps[1]))
+
+
+def print_real(title: str, figs: dict, before: dict | None = None) -> None:
+    print(f"== {title}")
+    for m, f in sorted(figs.items()):
+        b = (before or {}).get(m, {})
+        cells = []
+        for k in ("perpendicular_ece", "box_perpendicular_frac", "cylinder_as_prism_frac"):
+            v = f[k]
+            was = f"{b[k]:.3f} -> " if b.get(k) is not None else ""
+            cells.append(f"{k} {was}{'null' if v is None else f'{v:.3f}'}")
+        print(f"  {m:5s} " + "  ".join(cells) + f"  ({f['pairs']} pairs)")
+
+
+# ---------------------------------------------------------------------------------------------- provenance
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _git(*args: str) -> str | None:
+    try:
+        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+
+
+def provenance(argv: list[str], data: list[tuple[Path, dict, str]]) -> dict:
+    """Who made the file: the command, the code version (git commit, the files that differed from it among the
+    fit's sources and this script's), the sources' digests (lv3d.calibration.source_digests) and each data
+    file (name, sha256, rows, scenes, the command that made it, its kind)."""
+    from lv3d.calibration import source_digests
+
+    dirty = _git("status", "--porcelain", "--", "grounding", "lv3d/perception", "lv3d/describe.py", "benchmarks")
+    return {
+        "command": " ".join(["benchmarks/fit_calibration.py", *argv]),
+        "git_commit": _git("rev-parse", "HEAD"),
+        "uncommitted": sorted(line[3:] for line in (dirty or "").splitlines()),
+        "sources_sha256": source_digests(),
+        "fitted_at": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "data": [{"file": p.name, "kind": kind, "sha256": _sha256(p), "rows": len(d["rows"]),
+                  "scenes": len({scene_of(r) for r in d["rows"]}),
+                  "made_by": d.get("made_by") or ("benchmarks/calibration_data.py" if kind == "rendered"
+                                                  else "benchmarks/calibration_real.py")}
+                 for p, d, kind in data],
+    }
+
+
+def _read(path: Path, what: str) -> dict:
+    try:
+        d = pickle.loads(path.read_bytes())
+        if not isinstance(d, dict) or "rows" not in d:
+            raise KeyError("rows")
+        return d
+    except (OSError, pickle.UnpicklingError, KeyError, EOFError) as e:
+        raise SystemExit(f"fit_calibration.py: error: {path}: not a {what} pickle ({e!r})") from None
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    from lv3d.calibration import DATA, FORMAT, read
+
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("data", type=Path, nargs="+", help="pickles from benchmarks/calibration_data.py (rendered)")
+    ap.add_argument("--real", type=Path, nargs="*", default=[], help="pickles from benchmarks/calibration_real.py")
+    ap.add_argument("--check", type=Path, nargs="*", default=[], help="rendered dev sets to report ECE on")
+    ap.add_argument("--holdout", action="store_true",
+                    help="first fit once without each --real pickle and report the figures on the one left out")
+    ap.add_argument("--real-share", type=float, default=REAL_SHARE,
+                    help=f"share of a key's fit weight its real rows carry (default {REAL_SHARE})")
+    ap.add_argument("--out", type=Path, default=DATA)
+    ap.add_argument("--dry-run", action="store_true", help="fit and report, write nothing")
+    ap.add_argument("--modalities", default=",".join(MODALITIES))
+    a = ap.parse_args(argv)
+    mods = a.modalities.split(",")
+    if not set(mods) <= set(MODALITIES):
+        ap.error(f"--modalities: choose from {', '.join(MODALITIES)}")
+    rendered = [(p, _read(p, "calibration_data.py"), "rendered") for p in a.data]
+    real = [(p, _read(p, "calibration_real.py"), "real") for p in a.real]
+    checks = [(p, _read(p, "calibration_data.py"), "rendered check") for p in a.check]
+    shipped_file = read(DATA) if DATA.is_file() else None
+    shipped = None if shipped_file is None else (shipped_file["table"], shipped_file["final"])
+    render_rows = [r for _, d, _ in rendered for r in d["rows"]]
+    check_rows = [r for _, d, _ in checks for r in d["rows"]]
+    out_checks: dict = {"real_held_out": {}}
+
+    def quiet(*_args, **_kw):
+        return None
+
+    if a.holdout:
+        for i, (path, d, _) in enumerate(real):
+            others = [r for j, (_, e, _) in enumerate(real) if j != i for r in e["rows"]]
+            maps = fit(render_rows + others, mods, a.real_share, log=quiet)
+            figs = real_figures(d["frames"], maps)
+            before = real_figures(d["frames"], shipped) if shipped else None
+            print_real(f"held out {path.name}: fitted on the rendered sets and "
+                       f"{', '.join(p.name for j, (p, _, _) in enumerate(real) if j != i) or 'no real set'}"
+                       + ("; shipped -> held-out fit" if shipped else ""), figs, before)
+            out_checks["real_held_out"][path.name] = figs
+            if check_rows:
+                e = rendered_ece(check_rows, maps)
+                print("  rendered check sets, ECE over all emitted facts: "
+                      + "  ".join(f"{m} {e[m]['all'][0]:.3f}" for m in sorted(e)))
+    print("== fit on every set")
+    maps = fit(render_rows + [r for _, d, _ in real for r in d["rows"]], mods, a.real_share)
+    for m in MODALITIES:  # a modality not refitted keeps the shipped maps
+        if m not in mods and shipped is not None:
+            maps[0][m], maps[1][m] = shipped[0].get(m, {}), shipped[1].get(m, {})
+    for path, d, _ in real:
+        figs = real_figures(d["frames"], maps)
+        print_real(f"{path.name} (in the fit)" + ("; shipped -> calibrated" if shipped else ""), figs,
+                   real_figures(d["frames"], shipped) if shipped else None)
+        out_checks.setdefault("real_in_fit", {})[path.name] = figs
+    report_rendered(render_rows, maps, f"fit rows ({', '.join(p.name for p in a.data)})")
+    if check_rows:
+        report_rendered(check_rows, maps, f"check rows ({', '.join(p.name for p in a.check)})", shipped)
+        out_checks["rendered_check"] = {"sets": [p.name for p in a.check], "ece": rendered_ece(check_rows, maps)}
+    if a.dry_run:
+        return 0
+    doc = {"format": FORMAT,
+           "about": "Confidence calibration maps of lv3d (lv3d/calibration.py, grounding.Calibration); written by "
+                    "benchmarks/fit_calibration.py, not to be edited by hand.",
+           "provenance": provenance(argv, rendered + real + checks), "checks": out_checks,
+           "table": maps[0], "final": maps[1]}
+    a.out.parent.mkdir(parents=True, exist_ok=True)
+    a.out.write_text(json.dumps(doc, indent=1, sort_keys=False) + "\n")
+    print(f"wrote {a.out}")
     return 0
 
 

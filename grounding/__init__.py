@@ -2,10 +2,10 @@
 uncertainty into the confidences of facts. Pure functions over arrays; knows nothing of lv3d."""
 
 from ._cache import enable_cache as enable_cache
-from ._calibration import calibrate as calibrate
 from ._calibration import SHARED_SIDE_PREDS as SHARED_SIDE_PREDS
+from ._calibration import Calibration as Calibration
+from ._calibration import calibrate_with as calibrate_with
 from ._calibration import calibration_key as calibration_key
-from ._calibration import measures_used as measures_used
 from ._confidence import ACUTE_BELOW_DEG as ACUTE_BELOW_DEG
 from ._confidence import CORNER_TURN_MIN_DEG as CORNER_TURN_MIN_DEG
 from ._confidence import CORNER_TURN_MIN_PLANE_DEG as CORNER_TURN_MIN_PLANE_DEG

@@ -1,34 +1,29 @@
-"""Calibration of fact probabilities against ground truth, per modality and predicate.
+"""Calibration of fact probabilities: maps handed in as plain data turn a raw probability into a calibrated one.
 
 The Gaussian probability of a predicate (``_confidence``) speaks only of the errors the residuals can
 see. End to end, perception also makes gross errors the Laplace covariance cannot know of: a spurious
 corner on a long side (a pentagon that is a quadrilateral), a face split in two, a plane fitted across
-an edge. A per-(modality, predicate) logistic map turns the raw probability ``p`` and a few measurements
-of the faces behind it into a calibrated one:
+an edge, a curved surface read as a plane. A per-(modality, key) logistic map turns the raw probability ``p``
+and a few measurements of the faces behind it into a calibrated one:
 
-    conf = sigmoid(bias + sum_k coef_k x_k),  x = (logit p, measurements named in the table)
+    conf = sigmoid(bias + sum_k coef_k x_k),  x = (logit p, measurements named in the map)
 
-then a final non-decreasing piecewise-linear map (isotonic regression of out-of-fold confidences,
-``FINAL``) corrects what the logistic form leaves over: per type calibrated on average, the pooled middle
-bins (0.4-0.85) came out over-confident. Per (modality, predicate) the final map is the type's own (fitted
-on its rows alone), a pooled one of the modality, or none, whichever had the best scene-grouped
-cross-validated log loss: one pooled map helped some types far less than their own map (perpendicular) and
-hurt others (triangle, acute, parallel). Facts about one face (shape, orientation) pool only with each
-other, so what the maps of pair facts read cannot move theirs; the other types pool every type.
-The maps are fitted (L2-regularised logistic regression, ``benchmarks/fit_calibration.py``) on perceived
-dev scenes (realsense preset, seeds 30000+; never the study's data) and live in
-``_calibration_table.py``; a (modality, predicate) pair without a map keeps its raw probability (then the
-final map). Both stages are monotone increasing in ``p`` (the ``logit_p`` coefficient is kept positive), so a
-more certain measurement never gets a lower confidence, other things equal.
+then a final non-decreasing piecewise-linear map (knots of an isotonic regression) corrects what the logistic
+form leaves over. Per (modality, key) the final map is the key's own, one pooled over the modality's facts
+about one face (``"faces"``), one pooled over every key, or none (``"by_pred"`` names the choice; a key it does
+not name takes the pooled one). Both stages are monotone increasing in ``p`` (the ``logit_p`` coefficient is
+kept positive), so a more certain measurement never gets a lower confidence, other things equal.
+
+This package holds no maps: :class:`Calibration` is built from them (``{"table": {modality: {key: map}},
+"final": {modality: final maps}}``, the layout the fitting code writes); a (modality, key) without a map keeps
+its raw probability (then the final map, if any).
 """
 
 from __future__ import annotations
 
 import bisect
-import functools
 import math
 
-from ._calibration_table import FINAL, TABLE
 from ._confidence import (ACUTE_BELOW_DEG, EQUAL_SIDES_RATIO, OBTUSE_ABOVE_DEG, PARALLEL_SIDES_DEG, PLANE_ANGLE_DEG,
                           PERPENDICULAR_DEG, RIGHT_ANGLE_DEG)
 
@@ -41,9 +36,13 @@ def logit(p: float) -> float:
 
 
 # measurements on tame scales: a corner's turn in spreads clipped (a 40-spread corner is no surer than a
-# 20-spread one), lengths as logs; absent measurements (e.g. of `object`) read as 0
+# 20-spread one), lengths and variance factors as logs; absent measurements (e.g. of `object`) read as 0.
+# Floors of the logs: 1 px and 1 mm (below them a length is no surer), 0.25 for a variance factor (the least
+# that grounding's Laplace step lets a residual block claim, its MIN_SCALE2), 0.1 mm of plane residual (far
+# below any depth sensor's noise)
 _SCALE = {"min_turn_z": lambda v: min(max(v, -5.0), 20.0), "min_side_px": lambda v: math.log(max(v, 1.0)),
-          "shared_side_px": lambda v: math.log(max(v, 1.0)), "plane_gap_mm": lambda v: math.log(max(v, 1.0))}
+          "shared_side_px": lambda v: math.log(max(v, 1.0)), "plane_gap_mm": lambda v: math.log(max(v, 1.0)),
+          "edge_scale2": lambda v: math.log(max(v, 0.25)), "plane_rms_mm": lambda v: math.log(max(v, 0.1))}
 
 # "tol_frac": the fact's measured value (describe's candidate value) as a fraction of its predicate's
 # tolerance, 1 at the boundary, below 1 inside it. The Gaussian probability reads the same value in units of
@@ -73,10 +72,8 @@ def _tol_fraction(pred: str):
 # facts about two faces that touch at a point have maps of their own (``calibration_key``)
 SHARED_SIDE_PREDS = ("adjacent", "acute", "obtuse", "perpendicular")
 
-# the kinds of candidate filed apart from their predicate: key suffix -> the flag a modality's FINAL entry carries
-# when its maps were fitted with that kind apart (a modality fitted before sees the predicate's maps)
+# the suffixes of the kinds of candidate filed apart from their predicate (calibration_key)
 _FEWER, _TOUCH = "_fewer", "_touch"
-_KIND_FLAG = {_FEWER: "fewer_maps", _TOUCH: "touch_maps"}
 
 
 def calibration_key(pred: str, fewer: bool = False, shared_side_px: float | None = None) -> str:
@@ -89,8 +86,8 @@ def calibration_key(pred: str, fewer: bool = False, shared_side_px: float | None
     - A fact about two faces (``SHARED_SIDE_PREDS``) that share no side (``shared_side_px`` 0,
       ``lv3d.describe.shared_side_px``: they touch at a point, or a gap or a spurious corner parts their outlines):
       ``pred + "_touch"``. Their errors are of another kind (opposite laterals of a pyramid meeting at its apex are
-      no neighbours; a tetrahedron's faces traced apart are), and one map over both kinds read its measurements
-      alike for both (session 19, docs/grounding.md)."""
+      no neighbours; a tetrahedron's faces traced apart are), and one map over both kinds would read its
+      measurements alike for both."""
     if fewer:
         return pred + _FEWER
     if pred in SHARED_SIDE_PREDS and shared_side_px is not None and shared_side_px <= 0.0:
@@ -98,48 +95,51 @@ def calibration_key(pred: str, fewer: bool = False, shared_side_px: float | None
     return pred
 
 
-def _filed_under(key: str, final: dict | None) -> str:
-    """``key`` itself, or for a key of a kind filed apart (``_KIND_FLAG``) in a modality whose maps were fitted
-    before that kind was (its ``FINAL`` entry lacks the kind's flag) the predicate's own key: that modality's maps
-    saw both kinds as one."""
-    pred = _predicate(key)
-    return key if pred == key or (final or {}).get(_KIND_FLAG[key[len(pred):]], False) else pred
-
-
 def inputs(pred: str, p: float, x: dict, names: list[str]) -> list[float]:
     """The inputs of ``pred``'s calibration map: ``logit(p)`` then the named measurements of ``x``."""
     return [logit(p) if k is None else scale(float(x.get(k, 0.0))) for k, scale in _inputs(pred, names)]
 
 
-def measures_used(modality: str, pred: str) -> list[str]:
-    """The face measurements the map of (modality, pred) reads (empty: it needs only p, or there is no map)."""
-    entry = TABLE.get(modality, {}).get(_filed_under(pred, FINAL.get(modality)))
-    return [] if entry is None else [n for n in entry["features"] if n != "logit_p"]
-
-
-def calibrate(modality: str, pred: str, p: float, x: dict | None = None) -> float:
-    """Calibrated probability of one candidate fact with raw probability ``p`` and face measurements ``x``
-    (keys as ``lv3d.describe.calibration_features`` gives them); ``pred``: its calibration key
-    (:func:`calibration_key`: the predicate, or the key of a kind filed apart). ``p`` itself where nothing was fitted;
-    0 stays 0 (a predicate the geometry rules out is not revived). :func:`calibrate_with` on ``TABLE`` and
-    ``FINAL``, with each map's inputs looked up once (a frame has ~150 candidates)."""
-    return _apply(_compiled(modality, pred), p, x)
-
-
 def calibrate_with(table: dict, modality: str, pred: str, p: float, x: dict | None = None,
                    final: dict | None = None) -> float:
-    """:func:`calibrate` with the maps of ``table`` (same layout as ``TABLE``) and the final maps of ``final``
-    (layout of ``FINAL``: per modality pooled knots {"x", "y"}, optionally "faces", the knots pooled over
-    facts about one face, and "by_pred", {pred: knots of the type's own map, None for no final stage, or
-    "faces"}; None: no final stage)."""
+    """The calibrated probability of one candidate fact with raw probability ``p`` and face measurements ``x``
+    under the maps ``table`` ({modality: {key: map}}) and final maps ``final`` ({modality: {"x", "y"} pooled
+    knots, optionally "faces", the knots pooled over facts about one face, and "by_pred", {key: the key's own
+    knots, None for no final stage, or "faces"}}; None: no final stage); ``pred``: the fact's calibration key
+    (:func:`calibration_key`). Uncached: :class:`Calibration` is the same, with each map's inputs looked up once."""
     fin = (final or {}).get(modality)
-    pred = _filed_under(pred, fin)
     return _apply(_compile(pred, table.get(modality, {}).get(pred), fin), p, x)
+
+
+class Calibration:
+    """Calibration maps handed in as plain data (``table`` and ``final`` as :func:`calibrate_with` takes them),
+    each map compiled once on first use (a frame has ~150 candidates)."""
+
+    def __init__(self, table: dict, final: dict | None = None):
+        self.table = table
+        self.final = final or {}
+        self._compiled: dict[tuple[str, str], tuple | None] = {}
+
+    def calibrate(self, modality: str, pred: str, p: float, x: dict | None = None) -> float:
+        """Calibrated probability of one candidate fact with raw probability ``p`` and face measurements ``x``
+        (keys as ``lv3d.describe.calibration_features`` gives them); ``pred``: its calibration key
+        (:func:`calibration_key`). ``p`` itself where nothing was fitted; 0 stays 0 (a predicate the geometry
+        rules out is not revived). Equal to :func:`calibrate_with` on the same maps."""
+        key = (modality, pred)
+        if key not in self._compiled:
+            self._compiled[key] = _compile(pred, self.table.get(modality, {}).get(pred), self.final.get(modality))
+        return _apply(self._compiled[key], p, x)
+
+    def measures_used(self, modality: str, pred: str) -> list[str]:
+        """The face measurements the map of (modality, key ``pred``) reads (empty: it needs only p, or there is
+        no map)."""
+        entry = self.table.get(modality, {}).get(pred)
+        return [] if entry is None else [n for n in entry["features"] if n != "logit_p"]
 
 
 def _predicate(key: str) -> str:
     """The predicate a calibration key is of (the key without the suffix of a kind filed apart)."""
-    for suffix in _KIND_FLAG:
+    for suffix in (_FEWER, _TOUCH):
         if key.endswith(suffix):
             return key[: -len(suffix)]
     return key
@@ -153,7 +153,7 @@ def _inputs(key: str, names: list[str]) -> list:
 
 
 def _final_knots(pred: str, final: dict | None) -> dict | None:
-    """The final map of ``pred`` in one modality's ``final`` (layout of a ``FINAL`` value): the type's own
+    """The final map of ``pred`` in one modality's ``final`` (:func:`calibrate_with`'s layout): the type's own
     (or None, no final stage) where "by_pred" names it, the per-face pooled one ("faces") where it says
     "faces", else the pooled one of every type."""
     if final is None:
@@ -172,13 +172,6 @@ def _compile(pred: str, entry: dict | None, final: dict | None):
         return None
     terms = None if entry is None else [(c, k, s) for c, (k, s) in zip(entry["coef"], _inputs(pred, entry["features"]))]
     return (None if entry is None else entry["bias"]), terms, (None if knots is None else (knots["x"], knots["y"]))
-
-
-@functools.cache
-def _compiled(modality: str, pred: str):
-    """:func:`_compile` of TABLE's and FINAL's maps of (modality, pred)."""
-    pred = _filed_under(pred, FINAL.get(modality))
-    return _compile(pred, TABLE.get(modality, {}).get(pred), FINAL.get(modality))
 
 
 def _apply(compiled, p: float, x: dict | None) -> float:

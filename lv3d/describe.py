@@ -15,6 +15,7 @@ from dataclasses import dataclass, field as dc_field
 import cv2
 import numpy as np
 
+from .calibration import shipped as shipped_calibration
 from .facts import PREDICATES, Fact, SceneFacts
 from .perception.polygons import area
 from .rgbd import RGBD
@@ -182,8 +183,8 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     refined unless ``refine_all``: the others keep perception's geometry, and their facts still get
     confidences from its Laplace covariance (the solver is three quarters of an object's cost).
 
-    With ``calibrate``, each probability goes through the per-(modality, predicate) calibration map fitted on
-    dev scenes (:func:`grounding.calibrate`, docs/grounding.md); without it, the raw Gaussian probabilities.
+    With ``calibrate``, each probability goes through the per-(modality, predicate) calibration map lv3d ships
+    (:mod:`lv3d.calibration`, docs/grounding.md); without it, the raw Gaussian probabilities.
     With ``dense_points``, a refined face's plane is fitted to every depth reading inside its outline
     (:func:`dense_face_points`) rather than perception's strided points."""
     import grounding
@@ -243,7 +244,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
             support_l = np.clip(g["conf"]["edge_support"] / grounding.SUPPORT_FULL, 0.0, 1.0).tolist()
             vstd_all = _largest_std(g["vertex_cov"])
             ns = [len(p) for p in polys]
-            feats = _face_features(g, index, ns)
+            feats = _face_features(g, index, ns, [f.points if hp else None for f, hp in zip(chunk, has_plane)])
             for i, f in enumerate(chunk):
                 n = ns[i]
                 ids_i = index[i, :n]
@@ -297,7 +298,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         feats = calibration_features([c for c, pick in zip(cands, picked) if pick], results,
                                      fewer=[f for f, pick in zip(fewer, picked) if pick], shared=shared)
         it = iter(feats)
-        calibrate_one, modality = grounding.calibrate, scene.modality
+        calibrate_one, modality = shipped_calibration().calibrate, scene.modality
         cands = [(pred, args, calibrate_one(modality, key, p, next(it) if pick else None), value)
                  for (pred, args, p, value), key, pick in zip(cands, keys, picked)]
     return cands, results
@@ -310,7 +311,7 @@ def _needs(modality: str) -> dict[str, bool]:
 
     keys = {grounding.calibration_key(pred, fewer, side) for pred in PREDICATES
             for fewer, side in ((False, None), (True, None), (False, 0.0))}
-    return {key: bool(grounding.measures_used(modality, key)) for key in keys}
+    return {key: bool(shipped_calibration().measures_used(modality, key)) for key in keys}
 
 
 def _largest_std(cov: np.ndarray) -> np.ndarray:
@@ -320,23 +321,34 @@ def _largest_std(cov: np.ndarray) -> np.ndarray:
     return np.sqrt(np.clip(0.5 * (a + c) + np.hypot(0.5 * (a - c), b), 0.0, None))
 
 
-def _face_features(g: dict, index: np.ndarray, ns: list[int]) -> list[dict]:
+def _face_features(g: dict, index: np.ndarray, ns: list[int], points: list[np.ndarray | None] | None = None) -> list[dict]:
     """Measurements of each face of a grounding result that the calibration may read: the weakest corner's
     turn in units of its spread (grounding's ``corner_z``, on the face's plane where it has one: how sure the side
-    count is), edge support, image area and shortest side. ``index``: (faces, S) union vertex id of each polygon
-    slot; ``ns``: each face's side count."""
+    count is), edge support, image area and shortest side; how well the problem's outlines sit on straight image
+    edges (``edge_scale2``, grounding's variance factor of the edge block: mean squared edge residual over its a
+    priori spread, 1 for a polygon whose sides lie on edges as sharp as the noise model says; a curved outline
+    traced as a polygon reads several times that); and for a face with a plane and ``points`` (its camera-frame
+    depth points, metres) how flat the surface is (``plane_rms_mm``: root mean square distance of the points from
+    the refined plane, millimetres; a curved surface read as a plane departs from it by its sagitta, a flat one by
+    the sensor's noise). ``index``: (faces, S) union vertex id of each polygon slot; ``ns``: each face's side
+    count."""
     nf = len(ns)
     real = np.arange(index.shape[1])[None, :] < np.asarray(ns)[:, None]
     # the minimum over each face's real corners (padding reads +inf); grounding's corner test, as p_sides reads it
     z = np.where(real, g["conf"]["corner_z"][:nf, :index.shape[1]], np.inf)
     weakest = np.argmin(z, axis=1)
     support = g["conf"]["edge_support"][:nf].tolist()
+    edge_scale2 = float(g["scale2"][0])
     out = []
     for i, n in enumerate(ns):
         poly = g["vertices"][index[i, :n]]
         f = {"sides": n, "min_turn_z": float(z[i].min()),
              "support": support[i], "log_area_px": float(np.log(max(area(poly), 1.0))),
-             "min_side_px": _min_side(poly), "faces": nf}
+             "min_side_px": _min_side(poly), "faces": nf, "edge_scale2": edge_scale2}
+        pts = None if points is None else points[i]
+        if pts is not None and len(pts):
+            plane = g["planes"][i]
+            f["plane_rms_mm"] = 1e3 * float(np.sqrt(np.mean((pts @ plane[:3] + plane[3]) ** 2)))
         if n > 3:
             # the same measurements of the polygon without its weakest corner: what a (sides - 1) fact reads
             k = weakest[i]
@@ -415,10 +427,19 @@ def calibration_keys(cands: list, results: list[ObjectResult], *, fewer: list[bo
             for (pred, args, _, _), few in zip(cands, fewer)]
 
 
+# face measurements of which the larger value is the weaker face (for the others, the smaller)
+_LARGER_IS_WEAKER = frozenset({"plane_rms_mm", "edge_scale2"})
+
+
+def _weaker(name: str, values: list[float]) -> float:
+    """The weaker of two faces' values of the measurement ``name``."""
+    return max(values) if name in _LARGER_IS_WEAKER else min(values)
+
+
 def calibration_features(cands: list, results: list[ObjectResult], *, fewer: list[bool] | None = None,
                          shared: dict | None = None) -> list[dict]:
     """Per candidate the face measurements its calibration may read (:func:`_face_features`); for a fact
-    about two faces, the weaker of each (smaller value), the length of the side they share
+    about two faces, the weaker of each (the smaller value; the larger of ``plane_rms_mm`` and ``edge_scale2``), the length of the side they share
     (``shared_side_px``, :func:`shared_side_px`) and, where both have planes, how far they are from one plane
     (``plane_gap_mm``, :func:`plane_gap_mm`); for ``object`` the object's best face; and, for a candidate with a
     measured value, that value as ``value``. An (n - 1) side count reads the face's measurements without its weakest
@@ -435,7 +456,7 @@ def calibration_features(cands: list, results: list[ObjectResult], *, fewer: lis
         key = args if len(args) < 2 or args[0] <= args[1] else args[::-1]  # (a, b) and (b, a) share one
         if key not in weaker:
             fs = [by_face[a] for a in key if a in by_face]
-            weaker[key] = {k: min(f[k] for f in fs) for k in fs[0] if k != "fewer"} if fs else {}
+            weaker[key] = {k: _weaker(k, [f[k] for f in fs if k in f]) for k in fs[0] if k != "fewer"} if fs else {}
             side = _shared_side(shared, by_result, key)
             if side is not None:
                 weaker[key]["shared_side_px"] = side

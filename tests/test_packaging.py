@@ -1,4 +1,5 @@
-"""A non-editable install must still find the Prolog sources (shipped inside the package)."""
+"""A non-editable install must still find the Prolog sources and the calibration maps (shipped inside the
+packages)."""
 
 import subprocess
 import sys
@@ -17,11 +18,13 @@ def test_wheel_ships_prolog_sources_and_they_are_found_outside_the_checkout(tmp_
     shipped = sorted(n for n in names if n.startswith("prolog/") and n.endswith(".pl"))
     checkout = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "prolog").rglob("*.pl"))
     assert shipped == checkout, f"wheel ships {shipped}, checkout has {checkout}"
+    assert "lv3d/data/calibration.json" in names
     site = tmp_path / "site"
     subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(site), str(wheel)],
                    check=True, capture_output=True)
     probe = ("import prolog, lv3d, pathlib; "
              "assert pathlib.Path(prolog.__file__).is_relative_to(pathlib.Path(r'%s')), prolog.__file__; "
+             "import lv3d.calibration; assert lv3d.calibration.read()['table']; "
              "print(len([p for p in pathlib.Path(prolog.__file__).parent.rglob('*.pl')]))" % site)
     out = subprocess.run([sys.executable, "-c", probe], cwd=tmp_path, env={"PYTHONPATH": str(site)},
                          check=True, capture_output=True, text=True)

@@ -1,7 +1,7 @@
-"""grounding.calibrate: the shipped per-(modality, predicate) maps are monotone in the raw probability,
+"""grounding.Calibration and the maps lv3d ships (lv3d/data/calibration.json): monotone in the raw probability,
 stay in (0, 1), leave unmapped predicates and impossible facts alone, read a fact's value in tolerances,
 take a type's own final map (or none) over the pooled one, per-face types the per-face pooled one, chosen
-without the pair types' rows;
+without the pair types' rows; the file names its provenance and a malformed one is refused in one line;
 pack_object picks the small padded shape for small objects."""
 
 import math
@@ -9,11 +9,18 @@ from types import SimpleNamespace
 
 import numpy as np
 
+import pytest
+
 import grounding
-from grounding._calibration import FINAL, TABLE, calibrate_with
+from grounding import calibrate_with
 from grounding._confidence import ACUTE_BELOW_DEG, EQUAL_SIDES_RATIO, PERPENDICULAR_DEG
 from grounding._problem import SIZES
+from lv3d import calibration
 from lv3d.describe import calibration_features, shared_side_px
+from lv3d.errors import InputError
+
+SHIPPED = calibration.read()
+TABLE, FINAL = SHIPPED["table"], SHIPPED["final"]
 
 MEASURES = {"support": 0.9, "log_area_px": 8.0, "min_turn_z": 6.0, "min_side_px": 40.0, "sides": 4, "faces": 3,
             "value": 1.05}
@@ -24,15 +31,15 @@ def test_every_shipped_map_grows_with_the_raw_probability():
     ps = np.linspace(0.01, 1.0, 25)
     for modality, maps in TABLE.items():
         for pred in maps:
-            c = np.array([grounding.calibrate(modality, pred, p, MEASURES) for p in ps])
+            c = np.array([calibration.calibrate(modality, pred, p, MEASURES) for p in ps])
             assert np.all((c > 0) & (c < 1)), (modality, pred)
             assert np.all(np.diff(c) >= -1e-12), (modality, pred)
 
 
 def test_unmapped_predicates_and_impossible_facts_keep_their_probability():
-    assert grounding.calibrate("no-such-modality", "square", 0.7, MEASURES) == 0.7
+    assert calibration.calibrate("no-such-modality", "square", 0.7, MEASURES) == 0.7
     modality, maps = next(iter(TABLE.items()))
-    assert grounding.calibrate(modality, next(iter(maps)), 0.0, MEASURES) == 0.0
+    assert calibration.calibrate(modality, next(iter(maps)), 0.0, MEASURES) == 0.0
 
 
 def test_a_map_reads_the_named_measurements():
@@ -108,12 +115,29 @@ def test_plane_gap_tells_two_pieces_of_one_face_from_two_faces():
 
 
 def test_calibrate_is_calibrate_with_the_shipped_table():
-    # calibrate keeps each map's inputs looked up; the numbers must be those of the general function
+    # Calibration keeps each map's inputs looked up; the numbers must be those of the general function
     for modality, maps in TABLE.items():
         for pred in maps:
             for p in (1e-6, 0.3, 0.97, 1.0):
-                assert grounding.calibrate(modality, pred, p, MEASURES) == calibrate_with(TABLE, modality, pred, p, MEASURES, FINAL)
-                assert grounding.calibrate(modality, pred, p) == calibrate_with(TABLE, modality, pred, p, None, FINAL)
+                assert calibration.calibrate(modality, pred, p, MEASURES) == calibrate_with(TABLE, modality, pred, p, MEASURES, FINAL)
+                assert calibration.calibrate(modality, pred, p) == calibrate_with(TABLE, modality, pred, p, None, FINAL)
+
+
+def test_the_shipped_file_names_how_it_was_made_and_a_foreign_one_is_refused(tmp_path):
+    prov = SHIPPED["provenance"]
+    assert "benchmarks/fit_calibration.py" in prov["command"]
+    assert set(calibration.source_digests()) == set(calibration.SOURCES)
+    assert set(calibration.stale_sources()) <= set(calibration.SOURCES)
+    assert "perpendicular" in TABLE["rgbd"] and "perpendicular" in TABLE["depth"]
+    bad = tmp_path / "calibration.json"
+    bad.write_text('{"format": 0, "table": {}, "final": {}, "provenance": {}}')
+    with pytest.raises(InputError, match="format 0, this code reads format"):
+        calibration.read(bad)
+    bad.write_text('{"format": %d, "table": {}}' % calibration.FORMAT)
+    with pytest.raises(InputError, match="without its 'final' part"):
+        calibration.read(bad)
+    with pytest.raises(InputError, match="calibration file not found"):
+        calibration.read(tmp_path / "absent.json")
 
 
 def test_final_map_interpolates_its_knots_and_keeps_zero():
@@ -169,24 +193,21 @@ def test_pack_object_uses_the_small_shape_when_the_object_fits():
     assert big.face_index.shape == SIZES[-1][:2] and index.shape == (len(five), SIZES[-1][1])
 
 
-def test_one_side_fewer_has_maps_of_its_own_where_they_were_fitted():
+def test_one_side_fewer_has_maps_of_its_own():
     assert grounding.calibration_key("pentagon") == "pentagon"
     assert grounding.calibration_key("pentagon", fewer=True) == "pentagon_fewer"
     own = {"features": ["logit_p"], "bias": 0.0, "coef": [1.0]}
     fewer = {"features": ["logit_p"], "bias": -2.0, "coef": [1.0]}
     table = {"rgbd": {"pentagon": own, "pentagon_fewer": fewer}}
-    old = {"rgbd": {"x": [0.0, 1.0], "y": [0.0, 1.0]}}              # fitted before (n - 1) keys existed
-    new = {"rgbd": {"x": [0.0, 1.0], "y": [0.0, 1.0], "fewer_maps": True}}
+    final = {"rgbd": {"x": [0.0, 1.0], "y": [0.0, 1.0]}}
     p = 0.6
-    same = calibrate_with(table, "rgbd", "pentagon", p, {}, old)
-    assert calibrate_with(table, "rgbd", "pentagon_fewer", p, {}, old) == same
+    assert math.isclose(calibrate_with(table, "rgbd", "pentagon", p, {}, final), p)
     # logit 0.6 = log 1.5, moved by the fewer map's bias -2
-    assert math.isclose(calibrate_with(table, "rgbd", "pentagon_fewer", p, {}, new),
+    assert math.isclose(calibrate_with(table, "rgbd", "pentagon_fewer", p, {}, final),
                         1 / (1 + math.exp(2 - math.log(1.5))))
-    assert FINAL["rgbd"].get("fewer_maps") and not FINAL["depth"].get("fewer_maps")  # depth: session 17's maps
 
 
-def test_facts_about_faces_that_touch_at_a_point_have_maps_of_their_own_where_they_were_fitted():
+def test_facts_about_faces_that_touch_at_a_point_have_maps_of_their_own():
     from lv3d.describe import FaceResult, ObjectResult, calibration_keys
 
     assert grounding.calibration_key("acute", shared_side_px=40.0) == "acute"
@@ -203,13 +224,8 @@ def test_facts_about_faces_that_touch_at_a_point_have_maps_of_their_own_where_th
     cands = [("acute", ("f1", "f2"), 0.9, 60.0), ("acute", ("f3", "f1"), 0.9, 60.0),
              ("adjacent", ("f1", "f3"), 0.9, None), ("parallel", ("f1", "f3"), 0.9, 2.0)]
     assert calibration_keys(cands, [res]) == ["acute", "acute_touch", "adjacent_touch", "parallel"]
-    # in a modality whose maps were fitted before touch keys existed, a touch key reads its predicate's maps
     table = {"rgbd": {"acute": {"features": ["logit_p"], "bias": 0.0, "coef": [1.0]},
                       "acute_touch": {"features": ["logit_p"], "bias": -2.0, "coef": [1.0]}}}
-    old = {"rgbd": {"x": [0.0, 1.0], "y": [0.0, 1.0], "fewer_maps": True}}
-    new = {"rgbd": {**old["rgbd"], "touch_maps": True}}
-    assert calibrate_with(table, "rgbd", "acute_touch", 0.6, {}, old) == \
-        calibrate_with(table, "rgbd", "acute", 0.6, {}, old)
-    assert math.isclose(calibrate_with(table, "rgbd", "acute_touch", 0.6, {}, new),
-                        1 / (1 + math.exp(2 - math.log(1.5))))
-    assert FINAL["rgbd"].get("touch_maps") and "acute_touch" in TABLE["rgbd"] and not FINAL["depth"].get("touch_maps")
+    assert math.isclose(calibrate_with(table, "rgbd", "acute", 0.6, {}), 0.6)
+    assert math.isclose(calibrate_with(table, "rgbd", "acute_touch", 0.6, {}), 1 / (1 + math.exp(2 - math.log(1.5))))
+    assert "acute_touch" in TABLE["rgbd"] and "perpendicular_touch" in TABLE["depth"]

@@ -88,22 +88,29 @@ def test_face_features_equal_the_per_face_computation():
     f, s, u = 4, 6, 16
     g = {"conf": {"edge_support": rng.uniform(0, 1, f).astype(np.float32),
                   "corner_z": rng.uniform(-3, 30, (f, s)).astype(np.float32)},
-         "vertices": rng.uniform(0, 400, (u, 2)).astype(np.float32)}
+         "vertices": rng.uniform(0, 400, (u, 2)).astype(np.float32),
+         "scale2": np.array([2.5, 30.0, 1.0], np.float32),
+         "planes": np.array([[0.0, 0.0, -1.0, 0.8]] * f, np.float32)}       # z = 0.8 m
     ns = [3, 6, 4]
     index = rng.integers(0, u, (len(ns), s))
-    got = _face_features(g, index, ns)
+    bumps = np.array([-0.002, 0.002, 0.001, -0.001])                      # 2, 2, 1, 1 mm off the plane
+    points = [None, np.c_[np.zeros((4, 2)), 0.8 + bumps], np.zeros((0, 3))]
+    got = _face_features(g, index, ns, points)
     for i, n in enumerate(ns):
         z = g["conf"]["corner_z"][i, :n]  # each corner's turn in spreads, as grounding's corner test gives it
         poly = g["vertices"][index[i, :n]]
         want = {"sides": n, "min_turn_z": float(z.min()),
                 "support": float(g["conf"]["edge_support"][i]), "log_area_px": float(np.log(max(area(poly), 1.0))),
                 "min_side_px": float(np.linalg.norm(np.diff(poly, axis=0, append=poly[:1]), axis=1).min()),
-                "faces": len(ns)}
+                "faces": len(ns), "edge_scale2": 2.5}
+        if i == 1:  # the only face with points: their rms distance from its plane, mm
+            assert abs(got[i].pop("plane_rms_mm") - np.sqrt(2.5)) < 1e-6
         if n > 3:  # the polygon without its weakest corner (smallest turn in spreads)
             k = int(np.argmin(z))
             rest = np.delete(poly, k, 0)
             want["fewer"] = {**want, "sides": n - 1, "min_turn_z": float(np.delete(z, k).min()),
                              "min_side_px": float(np.linalg.norm(np.diff(rest, axis=0, append=rest[:1]), axis=1).min())}
+            got[i]["fewer"].pop("plane_rms_mm", None)
         assert got[i] == want
 
 
