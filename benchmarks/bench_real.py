@@ -19,9 +19,10 @@ figure a folder or modality cannot measure is null (recall and split without mas
 
 Definitions
 -----------
-*A perceived object's pixels* are the union of its faces' image polygons, each rasterised with cv2.fillPoly
-(perception's object segment is not kept in the Scene; the faces are what grounding and the learner see).
-A perceived object *holds* a pixel when the pixel is among its pixels.
+*A perceived object's pixels* are its segment (``SceneObject.mask``: the image region perception segmented as
+the object, depth and rgbd) where perception gives one, else (colour alone) the union of its faces' image
+polygons, each rasterised with cv2.fillPoly. Face polygons of a partly hidden face are completed over what
+hides it, so their union overlaps the occluder; the segment does not.
 
 *A labelled object's perceived object* is the perceived object that holds the labelled pixel (u, v); where
 several do, the one with the most faces covering (u, v), ties to the one perception lists first (the larger).
@@ -243,8 +244,10 @@ def read_label_image(path: Path, shape: tuple[int, int]) -> np.ndarray | None:
 
 
 def face_cover(obj, shape: tuple[int, int]) -> np.ndarray:
-    """(H, W) uint8: how many of ``obj``'s faces cover each pixel (their polygons rasterised with cv2.fillPoly).
-    The object's pixels are where it is > 0."""
+    """(H, W) uint8: 1 on ``obj``'s segment where it has one; else how many of its faces cover each pixel (their
+    polygons rasterised with cv2.fillPoly). The object's pixels are where it is > 0."""
+    if getattr(obj, "mask", None) is not None and obj.mask.shape == shape:
+        return obj.mask.astype(np.uint8)
     cover = np.zeros(shape, np.uint8)
     one = np.zeros(shape, np.uint8)
     for f in obj.faces:
@@ -593,7 +596,7 @@ def main(argv=None) -> int:
     mods = args.modalities
     pooled_rows: dict[str, list[dict]] = {m: [] for m in mods}
     result: dict = {"pooled": {}, "folders": {}}
-    pixels = "a perceived object's pixels: the union of its faces' polygons, rasterised"
+    pixels = "a perceived object's pixels: its segment (depth, rgbd), else the union of its faces' polygons (rgb)"
     t0 = time.perf_counter()
     for folder, name in zip(folders, names):
         try:
