@@ -519,9 +519,31 @@ def _one_core() -> None:
     torch.set_num_threads(1)
 
 
-def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dict[str, list[dict]]) -> dict:
+def write_overlay(path: Path, frame, scene, labels: list, label_img: np.ndarray | None) -> None:
+    """What perception found (lv3d's overlay: each object's faces) with the truth over it: ground-truth mask
+    outlines in white where the frame has masks, and each labelled pixel as a white ring."""
+    from lv3d.perception.overlay import draw_overlay
+
+    img = draw_overlay(frame.color, scene)
+    if label_img is not None:
+        for gid in np.unique(label_img):
+            if gid == 0:
+                continue
+            cnts, _ = cv2.findContours((label_img == gid).astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+            cv2.drawContours(img, cnts, -1, (0, 0, 0), 3)
+            cv2.drawContours(img, cnts, -1, (255, 255, 255), 1)
+    for lab in labels:
+        cv2.circle(img, (lab.u, lab.v), 5, (0, 0, 0), 3)
+        cv2.circle(img, (lab.u, lab.v), 5, (255, 255, 255), 1)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(path), cv2.cvtColor(img, cv2.COLOR_RGB2BGR))
+
+
+def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dict[str, list[dict]],
+               overlays: Path | None = None) -> dict:
     """Perceive, ground and evaluate every frame (the first ``limit``) of ``folder`` in each modality; the frames'
-    rows are appended to ``rows[modality]``. Returns {modality: [rows of this folder]}."""
+    rows are appended to ``rows[modality]``. With ``overlays``, each frame's overlay (:func:`write_overlay`) goes
+    to ``overlays/<folder>/<frame>_<modality>.png``. Returns {modality: [rows of this folder]}."""
     from lv3d.describe import describe
     from lv3d.perception import perceive
     from lv3d.rgbd import load_real
@@ -546,6 +568,9 @@ def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dic
                        frame=name)
             mine[m].append(row)
             rows[m].append(row)
+            if overlays is not None:
+                write_overlay(overlays / folder.name / f"{name}_{m}.png", frame, scene, labels.get(name, []),
+                              label_img)
     return mine
 
 
@@ -571,6 +596,9 @@ def main(argv=None) -> int:
     ap.add_argument("--modalities", type=_modalities, default=list(MODALITIES), metavar="M1,M2",
                     help="among rgb, depth, rgbd (default: all three)")
     ap.add_argument("--json", type=Path, metavar="FILE", help="also write the figures to FILE")
+    ap.add_argument("--overlays", type=Path, metavar="DIR",
+                    help="also write each frame's overlay (perceived faces, true masks and labelled pixels in white) "
+                         "to DIR/<folder>/<frame>_<modality>.png")
     args = ap.parse_args(argv)
     if args.limit is not None and args.limit < 1:
         ap.error("--limit must be at least 1")
@@ -582,6 +610,9 @@ def main(argv=None) -> int:
             check_folder(folder)
     except InputError as e:
         print(f"bench_real.py: error: {e}", file=sys.stderr)
+        return 2
+    if args.overlays is not None and args.overlays.exists() and not args.overlays.is_dir():
+        print(f"bench_real.py: error: {args.overlays}: is a file; --overlays names a folder", file=sys.stderr)
         return 2
     if args.json is not None and args.json.is_dir():
         print(f"bench_real.py: error: {args.json}: is a folder; --json names a file", file=sys.stderr)
@@ -600,7 +631,7 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     for folder, name in zip(folders, names):
         try:
-            mine = run_folder(Path(folder), mods, args.limit, pooled_rows)
+            mine = run_folder(Path(folder), mods, args.limit, pooled_rows, args.overlays)
         except InputError as e:
             print(f"bench_real.py: error: {e}", file=sys.stderr)
             return 2
