@@ -1,4 +1,4 @@
-"""The real Kinect frames in ../shared/data/real/pcl-kinect (README there says what must be found)."""
+"""Real frames in ../shared/data/real: pcl-kinect (its README says what must be found) and osd-learn (masks)."""
 
 import numpy as np
 import pytest
@@ -6,6 +6,7 @@ import pytest
 from lv3d.perception import perceive
 from lv3d.plane import dihedral_deg
 from lv3d.rgbd import load_real
+from tests.conftest import REAL_DIR
 
 pytestmark = pytest.mark.real
 
@@ -59,3 +60,38 @@ def test_rgbd_on_real_frames_fuses_some_faces(real_dir, name):
     scene = perceive(load_real(real_dir, name), "rgbd")
     provenances = {f.provenance for o in scene.objects for f in o.faces}
     assert "rgbd" in provenances
+
+
+OSD = REAL_DIR.parent / "osd-learn"
+
+
+def _osd_objects(frame_names):
+    """(ground-truth objects, those matched at IoU >= 0.5 by a perceived object's segment, labelled objects whose
+    segment also holds a fifth of another's mask) over the named osd-learn frames, depth alone."""
+    import cv2
+
+    from lv3d.rgbd import load_real
+
+    if not OSD.is_dir():
+        pytest.skip(f"osd-learn frames not found at {OSD}")
+    n = matched = merged = 0
+    for name in frame_names:
+        frame = load_real(OSD, name)
+        lab = cv2.imread(str(OSD / f"{name}_label.png"), cv2.IMREAD_UNCHANGED)
+        masks = [o.mask for o in perceive(frame, "depth").objects]
+        gts = [lab == g for g in np.unique(lab) if g]
+        for gt in gts:
+            n += 1
+            ious = [np.count_nonzero(gt & m) / np.count_nonzero(gt | m) for m in masks]
+            matched += bool(ious) and max(ious) >= 0.5
+            holder = [m for m in masks if np.count_nonzero(gt & m) >= 0.5 * np.count_nonzero(gt)]
+            merged += any(np.count_nonzero(o & holder[0]) >= 0.2 * np.count_nonzero(o) for o in gts if o is not gt) \
+                if holder else 0
+    return n, matched, merged
+
+
+def test_stacked_and_touching_boxes_on_real_kinect_frames_come_apart():
+    # osd-learn's stacked boxes (frames 17-24) and occluded boxes (25-32): a box on a box and boxes side by side
+    n, matched, merged = _osd_objects([f"learn{i}" for i in range(17, 33)])
+    assert matched >= 0.85 * n
+    assert merged <= 0.15 * n
