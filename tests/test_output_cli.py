@@ -64,7 +64,7 @@ def test_learn_fit_refuses_the_data_folder_and_a_folder_of_the_users(tmp_path, c
 
 
 def test_learn_fit_replaces_its_own_output(tmp_path, capsys, monkeypatch):
-    import lv3d.learn.cli as learn_cli
+    import lv3d.cli.learn as learn_cli
     from lv3d.learn.model import Model
 
     class Fitted:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -22,6 +23,11 @@ class Item:
     id: str
     cls: str
     dir: str
+
+
+def fold_path(out: Path, condition: str, system: str, fold: int) -> Path:
+    """Where a study in ``out`` keeps the result of one (condition, system, held-out fold)."""
+    return Path(out) / "folds" / condition / system / f"fold{fold}.json"
 
 
 def stratified_folds(items: list[Item], k: int, seed: int) -> list[list[Item]]:

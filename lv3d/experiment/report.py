@@ -12,12 +12,11 @@ import math
 from pathlib import Path
 
 from .config import LOGIC_SYSTEMS
+from .folds import fold_path
 from .stats import mean_std, paired
 
 
 def _load(out: Path, cond: str, system: str, folds: int) -> list[dict]:
-    from .runner import fold_path
-
     recs = []
     for k in range(folds):
         p = fold_path(out, cond, system, k)

@@ -8,7 +8,8 @@ from ..camera import Intrinsics
 from ..errors import InputError
 from ..rgbd import RGBD
 from .noise import NoiseConfig, as_config, noisy_color, noisy_depth
-from .raycast import Body, ray_lengths, raycast
+from .body import Body
+from .raycast import ray_lengths, raycast
 from .sampler import FLOOR_Z_M, TABLE_THICKNESS_M, Layout, sample_layout
 from .appearance import design_prints, multi_hue_albedo
 from .shading import environment_colour, object_albedo, shade

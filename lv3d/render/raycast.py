@@ -7,42 +7,15 @@ Rays leave the camera centre with direction ((u - cx)/fx, (v - cy)/fy, 1), so th
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property, lru_cache
+from functools import lru_cache
 
 import cv2
 import numpy as np
 import open3d as o3d
 
 from ..camera import Intrinsics
-from .solids import Solid
-
-
-@dataclass(frozen=True)
-class Body:
-    """A solid in the camera frame: ``to_camera`` (4, 4) maps its object frame into the camera frame."""
-
-    solid: Solid
-    to_camera: np.ndarray
-
-    def vertices(self) -> np.ndarray:
-        """Camera-frame vertices (n, 3), metres (read-only, computed once)."""
-        return self._vertices
-
-    def normals(self) -> np.ndarray:
-        """Camera-frame outward face normals (f, 3) (read-only, computed once)."""
-        return self._normals
-
-    @cached_property
-    def _vertices(self) -> np.ndarray:
-        v = self.solid.vertices @ self.to_camera[:3, :3].T + self.to_camera[:3, 3]
-        v.setflags(write=False)
-        return v
-
-    @cached_property
-    def _normals(self) -> np.ndarray:
-        n = self.solid.normals() @ self.to_camera[:3, :3].T
-        n.setflags(write=False)
-        return n
+from .body import Body, clip_near
+from .shadows import soft_shadow
 
 
 @dataclass(frozen=True)
@@ -160,8 +133,6 @@ def raycast(bodies: list[Body], k: Intrinsics, light_cam: np.ndarray | None = No
     body = np.take(face_body, gface)
     face = np.take(face_id, gface)
     if light_cam is not None:
-        from .shadows import soft_shadow  # builds on this module's Body
-
         shadow = soft_shadow(bodies, gface, normals, offsets_f, face_body[:-1], k, np.asarray(light_cam, float))
     else:
         shadow = np.zeros(depth.shape, np.float32)
@@ -185,20 +156,6 @@ def _silhouette_pixels(bodies: list[Body], k: Intrinsics) -> np.ndarray:
         cv2.fillConvexPoly(mask, hull, 1, cv2.LINE_8, shift=4)
         cv2.polylines(mask, [hull], True, 1, 3, cv2.LINE_8, shift=4)  # pixel centres right on the outline
     return np.flatnonzero(mask)
-
-
-def clip_near(poly: np.ndarray, z_near: float) -> np.ndarray:
-    """The part of the planar polygon (n, 3) with z >= ``z_near`` (Sutherland-Hodgman against one plane)."""
-    if poly[:, 2].min() >= z_near:  # the usual case: all in front
-        return poly
-    out = []
-    for a, b in zip(poly, np.roll(poly, -1, axis=0)):
-        ina, inb = a[2] >= z_near, b[2] >= z_near
-        if ina:
-            out.append(a)
-        if ina != inb:
-            out.append(a + (b - a) * (z_near - a[2]) / (b[2] - a[2]))
-    return np.asarray(out).reshape(-1, 3)
 
 
 def _fill_background(bodies: list[Body], normals: np.ndarray, offsets_f: np.ndarray,

@@ -16,7 +16,7 @@ import cv2
 import numpy as np
 
 from ..camera import Intrinsics
-from .raycast import Body, clip_near
+from .body import Body, clip_near
 
 _EPS = 1e-9
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..camera import Intrinsics
 from ..plane import Plane, dihedral_deg
-from .raycast import Body
+from .body import Body
 from .sampler import Layout
 
 MIN_FACE_PIXELS = 50

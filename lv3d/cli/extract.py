@@ -31,8 +31,8 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
             scene_id: str, out_dir: Path, facts: bool, max_objects: int | None) -> None:
     """Find objects, faces and planes in one frame COLOR; write OUT/scene.json and OUT/overlay.png."""
     from ..rgbd import load_frame, read_intrinsics
-    from .overlay import draw_overlay
-    from .perceive import perceive
+    from ..perception.overlay import draw_overlay
+    from ..perception.perceive import perceive
 
     if modality in ("depth", "rgbd") and depth is None:
         raise InputError("--depth", f"modality {modality!r} needs a depth image")
@@ -53,7 +53,7 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
         raise InputError(color, "no object found in this frame")
     facts_obj = None
     if facts:
-        from ..describe import describe  # written beside grounding; imported only when asked for
+        from ..describe import describe  # grounding (JAX) is imported only when asked for
 
         facts_obj = describe(scene, frame)
     _write(Path(out_dir), inputs, scene, draw_overlay(frame.color, scene), facts_obj)

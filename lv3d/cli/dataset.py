@@ -24,7 +24,7 @@ def dataset():
 @click.option("--height", type=int, default=480, show_default=True)
 def make(classes, per_class, noise, seed, out, workers, width, height):
     """Render PER_CLASS images of each class into OUT (resumes: an identical finished set is kept)."""
-    from .dataset import make_dataset
+    from ..render.dataset import make_dataset
 
     path = make_dataset(out, classes, per_class, noise, seed, workers=workers, width=width, height=height)
     click.echo(str(path))
@@ -36,6 +36,6 @@ def make(classes, per_class, noise, seed, out, workers, width, height):
 @click.option("--max-items", type=int, default=48, show_default=True)
 def show(folder, out, max_items):
     """Write a contact sheet (colour + depth thumbnails, labelled) of the data set in FOLDER."""
-    from .contact import dataset_sheet
+    from ..render.contact import dataset_sheet
 
     click.echo(str(dataset_sheet(folder, out or Path(folder) / "sheet.png", max_items=max_items)))

@@ -20,7 +20,7 @@ def experiment():
 @click.option("--quiet", is_flag=True, help="no progress bars")
 def run(config: Path, out: Path, overrides: tuple[str, ...], quiet: bool):
     """Run the study CONFIG into OUT; finished (fold, system) results are kept and skipped."""
-    from .runner import run_study
+    from ..experiment.runner import run_study
 
     res = run_study(config, out, list(overrides), progress=not quiet)
     click.echo(f"{res['ran']} fold results computed, {res['skipped']} reused; report: {out / 'results.md'}")

@@ -1,23 +1,22 @@
-"""The ``lv3d`` command. Subcommands live beside the code they drive and are imported lazily, so
-that ``lv3d dataset`` does not pay for importing JAX or torch."""
+"""The ``lv3d`` command: a group whose subcommands (the other modules of this package) are imported
+lazily, so that ``lv3d dataset`` does not pay for importing JAX or torch."""
 
 from __future__ import annotations
 
 import importlib
-import sys
 
 import click
 
-from .errors import InputError
+from ..errors import InputError
 
 # command name -> "module:attribute" of a click command or group
 COMMANDS = {
-    "dataset": "lv3d.render.cli:dataset",
-    "extract": "lv3d.perception.cli:extract",
-    "mil": "lv3d.learn.cli:mil",
-    "learn": "lv3d.learn.cli:learn",
-    "experiment": "lv3d.experiment.cli:experiment",
-    "demo": "lv3d.experiment.demo:demo",
+    "dataset": "lv3d.cli.dataset:dataset",
+    "extract": "lv3d.cli.extract:extract",
+    "mil": "lv3d.cli.learn:mil",
+    "learn": "lv3d.cli.learn:learn",
+    "experiment": "lv3d.cli.experiment:experiment",
+    "demo": "lv3d.cli.demo:demo",
 }
 
 
@@ -56,7 +55,3 @@ def main(argv=None) -> int:
     except click.exceptions.Exit as e:
         return e.exit_code
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

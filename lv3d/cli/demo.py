@@ -17,8 +17,8 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .config import DEFAULTS, LOGIC_SYSTEMS, SYSTEMS
-from .folds import Item
+from ..experiment.config import DEFAULTS, LOGIC_SYSTEMS, SYSTEMS
+from ..experiment.folds import Item
 
 CLASSES = ["cube", "square_pyramid", "triangular_prism", "pentagonal_prism"]
 
@@ -94,8 +94,8 @@ def plot_accuracy(acc: dict[str, float], path: Path) -> None:
 def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int, systems: str, threads: int):
     """Learn four shape classes from a few RGB-D images and explain an answer."""
     from ..errors import InputError
-    from . import data as data_mod
-    from .systems import make_system
+    from ..experiment import data as data_mod
+    from ..experiment.systems import make_system
 
     names = [s.strip() for s in systems.split(",") if s.strip()]
     for s in names:

@@ -17,8 +17,8 @@ from ..facts import MODALITIES
 @click.option("--time-limit", type=float, default=None, help="seconds for the search (default: the task's, else 10)")
 def mil(task: Path, time_limit: float | None):
     """Learn the Metagol-style TASK file and print the program."""
-    from .engine import LearnError
-    from .task import learn_task
+    from ..learn.engine import LearnError
+    from ..learn.task import learn_task
 
     try:
         clauses = learn_task(task, time_limit=time_limit)
@@ -78,7 +78,7 @@ _facts = click.option("--facts", type=click.Choice(["truth", "pipeline"]), defau
 def fit(data: Path, modality: str, facts: str, classes: str | None, out: Path, seed: int, time_limit: float | None):
     """Learn one program per class and save them as .pl files in OUT."""
     from ..output import check_out, replacing
-    from .model import Model
+    from ..learn.model import Model
 
     check_out(out, (data,))  # before any work: a file, a folder lv3d did not write or one holding the data
     wanted = [c.strip() for c in classes.split(",")] if classes else None
@@ -102,7 +102,7 @@ def fit(data: Path, modality: str, facts: str, classes: str | None, out: Path, s
 @click.option("--explain/--no-explain", default=False, help="print each answer's proof")
 def predict(data: Path, modality: str, facts: str, model_dir: Path, explain: bool):
     """Classify every item of a data set with saved programs; print accuracy."""
-    from .model import Model
+    from ..learn.model import Model
 
     model = Model.load(model_dir)
     scenes, labels = _dataset_scenes(data, modality, facts)
