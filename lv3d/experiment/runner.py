@@ -22,17 +22,14 @@ from ..output import claim
 from . import data as data_mod
 from .code_version import learner_version
 from .config import LOGIC_SYSTEMS, conditions, digest, load_config
-from .folds import Item, class_task, multiclass_task, split, stratified_folds
+from .folds import Item, class_task, fold_path, multiclass_task, split, stratified_folds
+from .report import write_report
 from .systems import make_system, modality_of, negative_label
 
 
 def task_seed(seed: int, fold: int, task: int, draw: int = 0) -> int:
     """A seed for one draw of one (fold, task) cell, independent of the system."""
     return int(np.random.SeedSequence([seed, fold, task] + ([draw] if draw else [])).generate_state(1)[0])
-
-
-def fold_path(out: Path, condition: str, system: str, fold: int) -> Path:
-    return Path(out) / "folds" / condition / system / f"fold{fold}.json"
 
 
 def result_key(cfg: dict, system: str, fold: int) -> str:
@@ -159,8 +156,6 @@ def _write_json(path: Path, obj) -> None:
 def run_study(config: Path, out: Path, overrides: list[str] = (), progress: bool = True) -> dict:
     """Run (or resume) the study of ``config`` into ``out``; writes the fold files and the report.
     Returns ``{"ran": n, "skipped": n, "report": summary}``."""
-    from .report import write_report
-
     config, out = Path(config), Path(out)
     cfg = load_config(config, list(overrides))
     conds = conditions(cfg, config)
