@@ -11,8 +11,9 @@ demo: setup
 test: setup
 	.venv/bin/python -m pytest -q tests
 
+# every benchmark at a small size; `python -m benchmarks.run_all` without --quick runs the full sizes
 bench: setup
-	.venv/bin/python benchmarks/run_all.py
+	.venv/bin/python -m benchmarks.run_all --quick
 
 clean:
 	rm -rf out build dist *.egg-info

@@ -1,6 +1,6 @@
 """Speed and accuracy of the statistical baselines on a *dev* data set (never the seed protocol's).
 
-    .venv/bin/python benchmarks/bench_baselines.py [--data /tmp/cnndev/data] [--seed 1234]
+    .venv/bin/python -m benchmarks.bench_baselines [--data /tmp/cnndev/data] [--seed 1234]
         [--systems cnn-rgb,cnn-depth,cnn-rgbd,cnn-rgbd-2s,tree-rgbd] [--folds 1] [--threads 2]
 
 Renders 4 classes x 50 images (realsense noise) with the dev seed unless ``--data`` already holds

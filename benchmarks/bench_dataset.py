@@ -1,6 +1,7 @@
 """Throughput of the synthetic data set writer: `make_dataset` with the `realsense` preset at 640x480.
 
-Run: .venv/bin/python benchmarks/bench_dataset.py [--images 42] [--workers 2]
+    .venv/bin/python -m benchmarks.bench_dataset [--images 42] [--workers 2]
+
 Prints, for one process, the CPU ms per image of each render stage and of writing the files (CPU time
 via time.process_time, so a machine shared with other work inflates it less than wall time), then the
 images/s of make_dataset with the target beside it (issue 2: >= 20 images/s on 2 cores, i.e. about

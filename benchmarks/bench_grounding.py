@@ -1,9 +1,9 @@
 """Grounding accuracy, calibration and speed on rendered scenes with exact ground truth.
 
-    .venv/bin/python benchmarks/bench_grounding.py            # 6 scenes per class, realsense and hard
-    .venv/bin/python benchmarks/bench_grounding.py --quick    # 2 per class
-    .venv/bin/python benchmarks/bench_grounding.py --no-speed --out out/bench_grounding
-    .venv/bin/python benchmarks/bench_grounding.py --presets realsense --sources perceived --no-speed --bins acute,parallel
+    .venv/bin/python -m benchmarks.bench_grounding            # 6 scenes per class, realsense and hard
+    .venv/bin/python -m benchmarks.bench_grounding --quick    # 2 per class
+    .venv/bin/python -m benchmarks.bench_grounding --no-speed --out out/bench_grounding
+    .venv/bin/python -m benchmarks.bench_grounding --presets realsense --sources perceived --no-speed --bins acute,parallel
 
 Per preset (rgbd perception of the target object): median vertex error (px) of faces whose side count is
 right and median interior-dihedral error (deg) of truly adjacent faces, without and with refinement;
@@ -31,14 +31,13 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+from benchmarks.calibration_error import chance_ece, ece, ece_verdict, log_loss, reliability_bins, scene_interval
+from benchmarks.grounding_truth import match_faces, truth_labels, truth_quantities, truth_scene
+from lv3d.describe import MIN_CONF, ground
+from lv3d.perception import perceive
+from lv3d.render import render_scene
 
-from benchmarks.calibration_error import chance_ece, ece, ece_verdict, log_loss, reliability_bins, scene_interval  # noqa: E402
-from benchmarks.grounding_truth import match_faces, truth_labels, truth_quantities, truth_scene  # noqa: E402
-from lv3d.describe import MIN_CONF, ground  # noqa: E402
-from lv3d.perception import perceive  # noqa: E402
-from lv3d.render import render_scene  # noqa: E402
+ROOT = Path(__file__).resolve().parent.parent
 
 CLASSES = ["cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
            "tetrahedron"]
@@ -170,7 +169,6 @@ def speed(frames: int, runs: int) -> tuple[float, float, list[float]]:
     code = r"""
 import os, sys, time, json
 os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
-sys.path.insert(0, %r)
 from lv3d.describe import describe
 from lv3d.render import render_scene
 from lv3d.perception import perceive
@@ -187,7 +185,7 @@ for fr, sc in items[1:] + items[1:]:
     ts.append(time.perf_counter() - t); cs.append(time.process_time() - c)
 import numpy as np
 print(json.dumps({"first": first, "ts": ts, "cs": cs}))
-""" % (str(ROOT), frames)
+""" % frames
     env = dict(os.environ, XLA_FLAGS="--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1")
     out = []
     for _ in range(1 + runs):  # the first run warms the cache if it is cold; the others are measured

@@ -1,11 +1,11 @@
 """The learner's accuracy under noise and its speed; prints each figure beside its target (issue 5).
 
-    .venv/bin/python benchmarks/bench_learner.py [--seed 778] [--per-class 30] [--root /tmp/lv3d_bench]
+    .venv/bin/python -m benchmarks.bench_learner [--seed 778] [--per-class 30] [--root /tmp/lv3d_bench]
         [--quick | --noise | --few-shot [--draws 16]] [--modality depth|rgb] [--settings '{"extra_literals": 0}']
 
 Data: two DEV data sets (never the study's seed 0), 640x480 like the study, rendered from the same
 seed with the clean and the realsense preset, their pipeline and ground-truth rgbd facts cached by
-benchmarks/dev_facts.py under <root>/<preset><seed> (made on the first run, ~10 min; reruns take
+benchmarks.dev_facts under <root>/<preset><seed> (made on the first run, ~10 min; reruns take
 a few minutes). Protocol as the study's (lv3d.experiment.folds): 5 stratified folds; a class task
 trains on 20 positives + 30 negatives (10 of each other class) and is scored on the held-out fold
 (binary: positive iff the model names the class); the multi-class model learns one program per
@@ -32,20 +32,17 @@ import argparse
 import json
 import pickle
 import statistics
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-
-from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stratified_folds  # noqa: E402
-from lv3d.learn import Model, fit  # noqa: E402
-from lv3d.learn.engine import LearnError  # noqa: E402
-from lv3d.truth_facts import truth_facts  # noqa: E402
+from benchmarks.dev_facts import make_dev_facts
+from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stratified_folds
+from lv3d.learn import Model, fit
+from lv3d.learn.engine import LearnError
+from lv3d.truth_facts import truth_facts
 
 CLASSES = ("cube", "square_pyramid", "triangular_prism", "pentagonal_prism")
 
@@ -55,9 +52,7 @@ def dev_set(root: Path, preset: str, seed: int, per_class: int, modality: str = 
     out = root / f"{preset}{seed}"
     if not (out / f"facts_{modality}.pkl").is_file():
         print(f"making {out} {modality} facts (render + pipeline facts, minutes) ...", flush=True)
-        subprocess.run([sys.executable, str(ROOT / "benchmarks" / "dev_facts.py"), "--preset", preset,
-                        "--seed", str(seed), "--per-class", str(per_class), "--out", str(out),
-                        "--modalities", modality], check=True)
+        make_dev_facts(out, preset, seed, per_class, [modality])
     return out
 
 

@@ -1,9 +1,9 @@
 """Perception accuracy and speed on rendered scenes with exact ground truth.
 
-    .venv/bin/python benchmarks/bench_perception.py            # 10 scenes per class, every noise preset
-    .venv/bin/python benchmarks/bench_perception.py --quick    # 2 per class, clean and realsense
-    .venv/bin/python benchmarks/bench_perception.py --presets clean --set depth_sigma_k=0.008   # one knob changed
-    .venv/bin/python benchmarks/bench_perception.py --seeds 1000,2000,3000 --rows runs/perception.jsonl  # pooled
+    .venv/bin/python -m benchmarks.bench_perception            # 10 scenes per class, every noise preset
+    .venv/bin/python -m benchmarks.bench_perception --quick    # 2 per class, clean and realsense
+    .venv/bin/python -m benchmarks.bench_perception --presets clean --set depth_sigma_k=0.008   # one knob changed
+    .venv/bin/python -m benchmarks.bench_perception --seeds 1000,2000,3000 --rows runs/perception.jsonl  # pooled
 
 Per preset and modality: face recall and precision (a face is found when its polygon, rasterised, has
 IoU >= 0.5 with the ground-truth mask of a visible target face of at least --min-face-px pixels), side-count
@@ -33,17 +33,15 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
-from lv3d.errors import InputError  # noqa: E402
-from lv3d.perception import perceive  # noqa: E402
-from lv3d.perception.cloud import slope_noise  # noqa: E402
-from lv3d.perception.polygons import rasterize  # noqa: E402
-from lv3d.plane import dihedral_deg  # noqa: E402
-from lv3d.render import render_scene  # noqa: E402
-from lv3d.experiment.code_version import FACT_SOURCES, source_digest  # noqa: E402
-from lv3d.experiment.config import parse_override  # noqa: E402
-from lv3d.render.noise import noise_config  # noqa: E402
+from lv3d.errors import InputError
+from lv3d.perception import perceive
+from lv3d.perception.cloud import slope_noise
+from lv3d.perception.polygons import rasterize
+from lv3d.plane import dihedral_deg
+from lv3d.render import render_scene
+from lv3d.experiment.code_version import FACT_SOURCES, source_digest
+from lv3d.experiment.config import parse_override
+from lv3d.render.noise import noise_config
 
 CLASSES = ["cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
            "tetrahedron"]

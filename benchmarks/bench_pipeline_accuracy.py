@@ -1,8 +1,8 @@
 """Per-class binary and multi-class accuracy of lv3d on a DEV set, per modality, beside the targets (issue 6).
 
-    .venv/bin/python benchmarks/dev_facts.py --preset clean --seed 777 --out /work/runs/dev_clean
-    .venv/bin/python benchmarks/dev_facts.py --preset realsense --seed 778 --out /work/runs/dev_realsense
-    .venv/bin/python benchmarks/bench_pipeline_accuracy.py /work/runs/dev_clean /work/runs/dev_realsense
+    .venv/bin/python -m benchmarks.dev_facts --preset clean --seed 777 --out runs/dev_clean
+    .venv/bin/python -m benchmarks.dev_facts --preset realsense --seed 778 --out runs/dev_realsense
+    .venv/bin/python -m benchmarks.bench_pipeline_accuracy runs/dev_clean runs/dev_realsense
 
 The study's protocol on a smaller DEV set (never the study's data): stratified folds, per class task
 positives + 1.5 negatives per positive spread over the other classes, a multi-class task, tested on
@@ -15,16 +15,13 @@ from __future__ import annotations
 import argparse
 import json
 import pickle
-import sys
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
-from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stratified_folds  # noqa: E402
-from lv3d.experiment.runner import score_binary  # noqa: E402
-from lv3d.experiment.systems import LogicSystem, negative_label  # noqa: E402
+from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stratified_folds
+from lv3d.experiment.runner import score_binary
+from lv3d.experiment.systems import LogicSystem, negative_label
 
 TARGETS = {"clean": 0.95, "realsense": 0.85}
 

@@ -1,17 +1,23 @@
-"""The benchmarks `make bench` runs, one after the other, each printing its figures beside its targets:
+"""Every benchmark, one after the other, each printing its figures beside its targets.
 
-1. benchmarks/bench_real.py: perception + grounding on every real frame of every folder under
-   ../shared/data/real that has objects.csv (the arbiter), rgb, depth and rgbd;
-2. benchmarks/bench_perception.py --per-class 5: perception on rendered scenes, every noise preset
-   (a regression check).
+    .venv/bin/python -m benchmarks.run_all --quick     # what `make bench` runs: every benchmark, small
+    .venv/bin/python -m benchmarks.run_all             # the full sizes (an hour or more on two cores)
+    .venv/bin/python -m benchmarks.run_all --only bench_real,bench_perception --json out/bench
 
-    .venv/bin/python benchmarks/run_all.py            # about 5-10 minutes on two cores
-    .venv/bin/python benchmarks/run_all.py --quick    # bench_real --limit 3, bench_perception --quick
-    .venv/bin/python benchmarks/run_all.py --json out/bench   # bench_real's figures to out/bench/bench_real.json
+| benchmark | measures | quick | full |
+|---|---|---|---|
+| bench_real | perception + grounding on the real frames of ../shared/data/real (the arbiter) | 3 frames a folder | every frame |
+| bench_perception | perception on rendered scenes, every noise preset | 2 scenes a class, 2 presets | 5 a class |
+| bench_grounding | refinement error, fact calibration, ms per frame | 2 scenes a class, 1 speed run | 6 a class |
+| bench_dataset | renderer throughput (images/s) | 8 images | 42 |
+| bench_learner | learner accuracy, clean against realsense, and speed | 8 scenes a class | 30 a class |
+| bench_pipeline_accuracy | per-class accuracy of each modality on bench_learner's DEV sets | rgbd, 2 folds | 3 modalities |
+| bench_baselines | CNN and decision tree: accuracy and seconds per training | one fold, cnn-rgbd and tree-rgbd | 5 systems |
 
-Each runs in a process of its own (bench_real holds itself to one core). Exit status: 0 when every benchmark
-ran, else that of the first that failed. Without ../shared/data/real the real benchmark is skipped with a
-message, and the rendered one still runs.
+Each runs as ``python -m benchmarks.NAME`` in a process of its own, from the repository root; rendered data
+and DEV sets go under ``--work`` (default out/bench) and are reused by the next run. Exit status: 0 when
+every benchmark ran, else that of the first that failed. Without real frames under ../shared/data/real,
+bench_real is skipped with a message.
 """
 
 from __future__ import annotations
@@ -22,37 +28,58 @@ import sys
 import time
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent
+ROOT = Path(__file__).resolve().parent.parent
 REAL = ROOT.parent / "shared" / "data" / "real"
+LEARNER_SEED = 778  # bench_learner's default DEV seed: bench_pipeline_accuracy reads the sets it made
 
 
-def commands(quick: bool, json_dir: Path | None) -> list[tuple[str, list[str]]]:
-    """(title, argv) of each benchmark to run."""
-    real = [sys.executable, str(HERE / "bench_real.py")] + (["--limit", "3"] if quick else [])
-    if json_dir is not None:
-        real += ["--json", str(json_dir / "bench_real.json")]
-    rendered = [sys.executable, str(HERE / "bench_perception.py")] + (["--quick"] if quick else ["--per-class", "5"])
-    out = []
-    if REAL.is_dir() and any((p / "objects.csv").is_file() for p in REAL.iterdir()):
-        out.append(("real frames (benchmarks/bench_real.py)", real))
-    else:
-        print(f"run_all: no real frames with objects.csv under {REAL}: bench_real skipped", flush=True)
-    out.append(("rendered scenes (benchmarks/bench_perception.py)", rendered))
-    return out
+def commands(quick: bool, work: Path, json_dir: Path | None) -> list[tuple[str, list[str]]]:
+    """(name, arguments) of each benchmark, in the order they run."""
+    dev = work / "dev"
+    per_class = 8 if quick else 30
+    real = (["--limit", "3"] if quick else []) + (["--json", str(json_dir / "bench_real.json")] if json_dir else [])
+    return [
+        ("bench_real", real),
+        ("bench_perception", ["--quick"] if quick else ["--per-class", "5"]),
+        ("bench_grounding", ["--quick", "--speed-runs", "1", "--speed-frames", "4"] if quick else []),
+        ("bench_dataset", ["--images", "8", "--single", "4"] if quick else []),
+        ("bench_learner", ["--root", str(dev), "--per-class", str(per_class), "--seed", str(LEARNER_SEED)]
+         + (["--quick", "--positives", "4"] if quick else [])),
+        ("bench_pipeline_accuracy", [str(dev / f"clean{LEARNER_SEED}"), str(dev / f"realsense{LEARNER_SEED}")]
+         + (["--modalities", "rgbd", "--folds", "2", "--positives", "4"] if quick else ["--modalities", "rgbd"])),
+        ("bench_baselines", ["--data", str(work / "baselines_data")]
+         + (["--systems", "cnn-rgbd,tree-rgbd", "--folds", "1"] if quick else [])),
+    ]
+
+
+def has_real_frames() -> bool:
+    return REAL.is_dir() and any((p / "objects.csv").is_file() for p in REAL.iterdir())
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--quick", action="store_true", help="a few frames and scenes only (a smoke test)")
+    ap.add_argument("--quick", action="store_true", help="every benchmark at a small size (a smoke test)")
+    ap.add_argument("--only", default="", metavar="B1,B2", help="run only these benchmarks")
+    ap.add_argument("--work", type=Path, default=ROOT / "out" / "bench", help="rendered data and DEV sets")
     ap.add_argument("--json", type=Path, metavar="DIR", help="write bench_real's figures to DIR/bench_real.json")
     args = ap.parse_args(argv)
+    todo = commands(args.quick, args.work, args.json)
+    if args.only:
+        wanted = [w.strip() for w in args.only.split(",") if w.strip()]
+        unknown = sorted(set(wanted) - {name for name, _ in todo})
+        if unknown:
+            ap.error(f"--only: unknown benchmark(s) {', '.join(unknown)}; known: {', '.join(n for n, _ in todo)}")
+        todo = [(name, argv_) for name, argv_ in todo if name in wanted]
     status = 0
-    for title, cmd in commands(args.quick, args.json):
-        print(f"\n######## {title}: {' '.join(Path(c).name if i < 2 else c for i, c in enumerate(cmd))}", flush=True)
+    for name, extra in todo:
+        if name == "bench_real" and not has_real_frames():
+            print(f"run_all: no real frames with objects.csv under {REAL}: bench_real skipped", flush=True)
+            continue
+        cmd = [sys.executable, "-m", f"benchmarks.{name}", *extra]
+        print(f"\n######## {name}: python -m benchmarks.{name} {' '.join(extra)}", flush=True)
         t = time.perf_counter()
         rc = subprocess.run(cmd, cwd=ROOT).returncode
-        print(f"######## {title}: exit {rc}, {time.perf_counter() - t:.0f} s", flush=True)
+        print(f"######## {name}: exit {rc}, {time.perf_counter() - t:.0f} s", flush=True)
         status = status or rc
     return status
 

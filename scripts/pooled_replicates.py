@@ -12,14 +12,10 @@ from __future__ import annotations
 
 import argparse
 import csv
-import sys
 from collections import defaultdict
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-
-from lv3d.experiment.stats import paired  # noqa: E402
+from lv3d.experiment.stats import paired
 
 
 def cells(run: Path, system: str) -> dict:

@@ -27,9 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
-from lv3d.experiment.stats import mean_std  # noqa: E402
+from lv3d.experiment.stats import mean_std
 
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "experiments" / "README.md"

@@ -21,12 +21,10 @@ import sys
 from collections import defaultdict
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
-from lv3d.errors import InputError  # noqa: E402
-from lv3d.experiment.config import LOGIC_SYSTEMS, conditions, load_config  # noqa: E402
-from lv3d.experiment.runner import _write_json, fold_path, result_key  # noqa: E402
-from lv3d.output import claim  # noqa: E402
+from lv3d.errors import InputError
+from lv3d.experiment.config import LOGIC_SYSTEMS, conditions, load_config
+from lv3d.experiment.runner import _write_json, fold_path, result_key
+from lv3d.output import claim
 
 
 def read_rows(path: Path) -> dict[tuple[str, str, int], dict[str, dict]]:
