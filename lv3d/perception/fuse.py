@@ -1,53 +1,84 @@
-"""Fusion: each colour polygon tied to the depth plane it lies on (the polygon's pixels mostly inside the
-plane's mask). The fused face keeps the colour polygon (sharper corners) and the depth plane."""
+"""Fusion (rgbd): each depth object with its faces as depth has them, colour confirming them and adding only the
+faces depth could not read.
+
+Depth gives the object and its faces: one per plane (depth.py). Colour never cuts a plane's face and never adds a
+face on a plane: on real frames printed packaging draws edges across every face, and colour faces there are print,
+not faces. Colour's part is
+
+- to confirm: a plane's outline that lies on colour edges is a face both sensors see (provenance 'rgbd'), one that
+  does not keeps provenance 'depth' (grounding then fits it to depth's edges where colour has none near,
+  lv3d.describe.edge_field); a face depth infers beside the object from a hole in its readings
+  (holes.unread_faces) is kept only where colour edges run along its outline (a sensor's occlusion shadow has none
+  where it crosses the table);
+- to add the faces depth has no reading of: holes along the object whose outline lies on colour edges
+  (holes.add_hole_faces), or that extend a face the sensor read only part of, at a grazing angle;
+- to refine: grounding fits every outline to the colour image's edges (lv3d.describe), which places corners more
+  sharply than the planes' cells do.
+
+Colour faces traced inside each object's box (rgb.rgb_faces) and matched to the planes gave no better figure on the
+real dev frames than depth's outlines refined by grounding, lost side counts on rendered scenes, and cost more than
+the depth stage; they are not traced here.
+"""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
-from .boundary import grid_to_pixels
-from .polygons import rasterize
+from ..rgbd import RGBD
+from ..scene import Face
+from .edges import channel_edges, channels, edge_distance, edge_support
+from .holes import UnreadFace, add_hole_faces
+from .polygons import area, rasterize
+
+# a depth outline lying on colour edges (within edges.edge_support's 2 px) for at least this fraction of its
+# length is confirmed by colour: it is where the colour image has an edge too (fraction of the perimeter,
+# scale-free; the same fraction admits an unread face, holes.add_hole_faces)
+CONFIRMED_SUPPORT = 0.5
 
 
-def match_faces(polygons: list[np.ndarray], plane_masks_grid: list[np.ndarray], stride: int,
-                box: tuple[int, int, int, int], min_inside: float = 0.5,
-                min_iou: float = 0.2) -> dict[int, int]:
-    """One-to-one matches colour face index -> plane index. Polygons are (n, 2) pixels; plane masks are grid
-    masks of step ``stride``; everything is compared inside ``box`` (u0, v0, u1, v1). A pair qualifies when at
-    least ``min_inside`` of the polygon lies on the plane and their IoU is at least ``min_iou``; pairs are taken
-    greedily by IoU, best first (ties broken by index, so the result is deterministic)."""
+def colour_edge_distance(color: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
+    """Distance (px, (v1 - v0, u1 - u0) float32) from each pixel of ``box`` = (u0, v0, u1, v1) to the nearest
+    colour edge (edges.channel_edges of each channel of ``color`` (H, W, 3) uint8, combined)."""
     u0, v0, u1, v1 = box
-    shape = (v1 - v0, u1 - u0)
-    off = np.array([u0, v0], float)
-    plane_px = [grid_to_pixels(m, stride, box) for m in plane_masks_grid]
-    cands = []
-    for i, poly in enumerate(polygons):
-        pm = rasterize(poly - off, shape)
-        pa = np.count_nonzero(pm)
-        if pa == 0:
-            continue
-        for j, qm in enumerate(plane_px):
-            inter = np.count_nonzero(pm & qm)
-            if inter == 0:
-                continue
-            iou = inter / (pa + np.count_nonzero(qm) - inter)
-            if inter / pa >= min_inside and iou >= min_iou:
-                cands.append((-iou, i, j))
-    cands.sort()
-    used_i, used_j, out = set(), set(), {}
-    for _, i, j in cands:
-        if i in used_i or j in used_j:
-            continue
-        out[i] = j
-        used_i.add(i)
-        used_j.add(j)
-    return out
+    chans = channels(np.ascontiguousarray(color[v0:v1, u0:u1]))
+    return edge_distance(np.maximum.reduce([channel_edges(c).edges for c in chans]))
 
 
-def inside_fraction(poly: np.ndarray, grid_mask: np.ndarray, stride: int, box: tuple[int, int, int, int]) -> float:
-    """Fraction of the polygon's pixels that lie on the grid mask (object membership of a colour face)."""
-    u0, v0, u1, v1 = box
-    pm = rasterize(poly - np.array([u0, v0], float), (v1 - v0, u1 - u0))
-    qm = grid_to_pixels(grid_mask, stride, box)
-    pa = np.count_nonzero(pm)
-    return float(np.count_nonzero(pm & qm) / pa) if pa else 0.0
+def fused_faces(frame: RGBD, planes: list, polygons: list[np.ndarray | None], adjacency: list[tuple[int, int]],
+                object_px: np.ndarray, box: tuple[int, int, int, int], unread: list[UnreadFace],
+                timings: dict[str, float]) -> tuple[list[Face], list[tuple[int, int]]]:
+    """The faces of one depth object under rgbd, and the pairs of them (indices) that share an edge.
+
+    ``planes``: the object's depth.DepthPlane list, ``polygons``: their outlines (full-frame pixels, None where the
+    plane's cells gave none), ``adjacency``: pairs of plane indices; ``object_px``: the object's pixels in ``box``
+    = (u0, v0, u1, v1), the crop the colour edges are searched in; ``unread``: the faces depth infers from holes
+    beside the object (holes.unread_faces). The colour edges' time is added to ``timings['edges']``."""
+    t0 = time.perf_counter()
+    dist = colour_edge_distance(frame.color, box)
+    timings["edges"] = timings.get("edges", 0.0) + (time.perf_counter() - t0) * 1e3
+    off = np.array([box[0], box[1]], float)
+    shape = dist.shape
+    faces: list[Face] = []
+    index: dict[int, int] = {}
+    for j, (p, poly) in enumerate(zip(planes, polygons)):
+        if poly is None:
+            continue
+        sup = edge_support(poly - off, dist)
+        index[j] = len(faces)
+        faces.append(Face("", poly, "rgbd" if sup >= CONFIRMED_SUPPORT else "depth", plane=p.plane, points=p.points,
+                          edge_support=sup, plane_rms_m=p.rms_m))
+    pairs = {(index[a], index[b]) for a, b in adjacency if a in index and b in index}
+    keep = list(range(len(faces)))
+    masks = {i: rasterize(f.polygon - off, shape) for i, f in enumerate(faces)}
+    keep += add_hole_faces(faces, pairs, keep, frame, box, object_px, dist, masks=masks, unread=unread,
+                           min_unread_support=CONFIRMED_SUPPORT)
+    return [faces[i] for i in keep], sorted((keep.index(a), keep.index(b)) for a, b in pairs
+                                            if a in keep and b in keep)
+
+
+def largest_first(faces: list[Face]) -> list[int]:
+    """Indices of ``faces`` ordered by polygon area, largest first (ties by the first vertex's u): stable ids."""
+    return sorted(range(len(faces)), key=lambda i: (-area(faces[i].polygon), float(faces[i].polygon[0, 0])))
+

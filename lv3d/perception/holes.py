@@ -207,20 +207,20 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
                    max_taken: float = 0.3, max_share: float = 0.5,
                    masks: dict[int, np.ndarray] | None = None, unread: list[UnreadFace] = (),
                    min_unread_support: float = 0.5) -> list[int]:
-    """Faces seen so edge-on that depth has no reading there (:func:`hole_faces`), appended to ``faces`` with
-    provenance 'rgb' (the outline is checked on colour edges; no plane), then the ``unread`` faces
-    (:func:`unread_faces`, full-frame polygons) that colour did not confirm but that lie on colour edges for at
-    least ``min_unread_support`` of their outline, with provenance 'depth' and the plane through their rim, each
-    made a neighbour (in ``pairs``) of the kept faces it touches. Returns their indices.
+    """The faces depth has no reading of, appended to ``faces``: first the ``unread`` faces (:func:`unread_faces`,
+    full-frame polygons, each with the plane through its rim) whose outline lies on colour edges for at least
+    ``min_unread_support`` of its length, with provenance 'rgbd'; then the holes whose outline colour edges confirm
+    (:func:`hole_faces`) where no face lies yet, with provenance 'rgb' (no plane), unless such a hole is the unread
+    rest of a face the sensor read at a grazing angle (:func:`_extend`: that face then covers it). Each added face
+    is made a neighbour (in ``pairs``) of the kept faces it touches. Returns their indices.
     ``box``: the crop (u0, v0, u1, v1) pixels that ``object_px`` (the object's pixels) and ``edge_dist`` cover;
     ``masks``: the ``keep`` faces' masks in that crop when the caller has them already (index -> (H, W) bool;
     updated in place), else they are drawn here.
 
     A hole that the kept faces cover for at most ``max_taken`` of its pixels is a face beside them. One that a
-    single kept face covers, as a part of at most ``max_share`` of that face, is a face the colour outline
-    swallowed (the edge between them is faint where the grazing face is dark): that face gives the hole's
-    pixels up when what is left is one convex region with fewer corners. Otherwise a face there was found
-    already."""
+    single kept face covers, as a part of at most ``max_share`` of that face, is a face that face's outline
+    swallowed: that face gives the hole's pixels up when what is left is one convex region with fewer corners.
+    Otherwise a face there was found already."""
     u0, v0, u1, v1 = box
     depth = frame.depth[v0:v1, u0:u1]
     no_reading = ~(np.isfinite(depth) & (depth > 0))
@@ -231,13 +231,12 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
     if masks is None:
         masks = {i: rasterize(faces[i].polygon - off, shape) for i in keep}
     added = []
-    # an unread face that colour confirmed too is covered by the colour face added first
-    found = [(poly, Face("", poly + off, "rgb")) for poly in hole_faces(no_reading, object_px, edge_dist)]
     # an unread face needs colour edges along more of its outline than the object's side alone: a sensor's
-    # occlusion shadow beside an object (a band without readings that depth alone takes for a face: the Kinect's
-    # beside the bottle in milk_cartoon_all_small_clorox, on 0.40 of its outline) has none where it crosses the table
-    found += [(u.polygon - off, Face("", u.polygon, "depth", plane=u.plane, points=u.points, plane_rms_m=u.rms_m))
-              for u in unread if edge_support(u.polygon - off, edge_dist) >= min_unread_support]
+    # occlusion shadow beside an object (a band without readings that depth alone takes for a face) has none where
+    # it crosses the table. One that colour confirms comes first: it has a plane, a colour hole there has none
+    found = [(u.polygon - off, Face("", u.polygon, "rgbd", plane=u.plane, points=u.points, plane_rms_m=u.rms_m))
+             for u in unread if edge_support(u.polygon - off, edge_dist) >= min_unread_support]
+    found += [(poly, Face("", poly + off, "rgb")) for poly in hole_faces(no_reading, object_px, edge_dist)]
     for poly, face in found:
         hole = rasterize(poly, shape)
         a = max(1, np.count_nonzero(hole))
@@ -247,12 +246,44 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
             if len(over) != 1 or not _give_up(faces, masks, over[0], hole, off, max_share):
                 continue
         grown = cv2.dilate(hole.astype(np.uint8), np.ones((5, 5), np.uint8)).astype(bool)
+        if face.plane is None and _extend(faces, masks, hole, grown, off):
+            continue
         new = len(faces)
         faces.append(face)
         pairs |= {(i, new) for i, m in masks.items() if np.count_nonzero(grown & m) >= 4}
         masks[new] = hole
         added.append(new)
     return added
+
+
+def _extend(faces: list[Face], masks: dict[int, np.ndarray], hole: np.ndarray, grown: np.ndarray, off: np.ndarray,
+            min_graze_deg: float = _UNREAD_DEG, fill: tuple[float, float] = _FILL) -> bool:
+    """Extends over ``hole`` (a region without readings, crop pixels; ``grown``: it dilated) the one face it
+    touches whose plane is seen at ``min_graze_deg`` or more from face-on, when the two make one convex region
+    (their union over its hull's area within ``fill``): the sensor read that face on part of it only, and the
+    hole is the rest of it, not a face of its own. Updates the face's polygon and ``masks`` in place; True when it
+    did."""
+    touching = [i for i, m in masks.items() if np.count_nonzero(grown & m) >= 4]
+    grazing = [i for i in touching if faces[i].plane is not None and faces[i].points is not None
+               and len(faces[i].points) and _graze_deg(faces[i]) >= min_graze_deg]
+    if len(grazing) != 1:
+        return False
+    i = grazing[0]
+    union = masks[i] | hole
+    # the closing fills the rim of a pixel or two the two outlines may leave between them
+    union = cv2.morphologyEx(union.astype(np.uint8), cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8)).astype(bool)
+    poly = _outline(union)
+    if poly is None or not fill[0] <= np.count_nonzero(union) / max(area(poly), 1e-9) <= fill[1]:
+        return False
+    faces[i].polygon = poly + off
+    masks[i] = rasterize(poly, hole.shape)
+    return True
+
+
+def _graze_deg(face: Face) -> float:
+    """The angle (degrees) from face-on at which the camera sees ``face``'s plane, at its points' centroid."""
+    ray = np.asarray(face.points, np.float64).mean(axis=0)
+    return float(np.degrees(np.arccos(min(1.0, abs(float(face.plane.n @ ray)) / float(np.linalg.norm(ray))))))
 
 
 def _give_up(faces: list[Face], masks: dict[int, np.ndarray], i: int, hole: np.ndarray, off: np.ndarray,

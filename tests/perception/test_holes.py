@@ -92,7 +92,7 @@ def test_a_face_that_swallowed_the_hole_gives_it_up_and_one_that_is_the_hole_kee
     assert np.array_equal(faces[1].polygon, STRIP)
 
 
-def test_unread_face_in_rgbd_needs_colour_edges_beyond_the_object_side_and_defers_to_colour():
+def test_unread_face_in_rgbd_needs_colour_edges_beyond_the_object_side_and_comes_before_colour():
     from lv3d.perception.holes import UnreadFace, add_hole_faces
     from lv3d.plane import Plane
     from lv3d.scene import Face
@@ -103,13 +103,34 @@ def test_unread_face_in_rgbd_needs_colour_edges_beyond_the_object_side_and_defer
     # a band of the table's colour (an occlusion shadow): an edge along the object's side only
     faces = [Face("", OBJECT, "depth")]
     assert add_hole_faces(faces, set(), [0], frame, box, obj, _dist((200, 190, 170)), unread=unread) == []
-    assert add_hole_faces(faces, set(), [0], frame, box, obj, _dist((200, 190, 170)), unread=unread,
-                          min_unread_support=0.0) == [1]
-    assert faces[1].provenance == "depth" and faces[1].plane == unread[0].plane
-    # a strip of a colour of its own: colour's hole face comes first and the unread face adds nothing
+    # a strip of a colour of its own: the unread face, with its plane, comes first, and colour's hole face there
+    # adds nothing
     faces = [Face("", OBJECT, "depth")]
     assert add_hole_faces(faces, set(), [0], frame, box, obj, _dist(), unread=unread) == [1]
-    assert faces[1].provenance == "rgb"
+    assert faces[1].provenance == "rgbd" and faces[1].plane == unread[0].plane
+
+
+def test_a_hole_that_is_the_unread_rest_of_a_grazing_face_extends_it():
+    from lv3d.perception.holes import add_hole_faces
+    from lv3d.plane import Plane
+    from lv3d.scene import Face
+
+    frame, obj = _frame_and_object()
+    box = (0, 0, SHAPE[1], SHAPE[0])
+    # the face beside the strip, read on its right part only: seen at 80 degrees from face-on, the strip is the
+    # rest of it; seen face-on, the strip is a face of its own
+    read_part = np.array([(40, 50), (62, 45), (70, 148), (48, 150)], float)
+    pts = np.array([[0.0, 0.0, 0.8], [0.01, 0.0, 0.8], [0.0, 0.01, 0.8]])
+    for normal, extended in (((np.cos(np.radians(10)), 0.0, np.sin(np.radians(10))), True), ((0.0, 0.0, 1.0), False)):
+        n = np.asarray(normal)
+        faces = [Face("", OBJECT, "depth"), Face("", read_part, "depth", plane=Plane.from_arrays(n, -0.8 * n[2]),
+                                                 points=pts)]
+        added = add_hole_faces(faces, set(), [0, 1], frame, box, obj, _dist())
+        if extended:
+            assert added == [] and _iou(rasterize(faces[1].polygon, SHAPE),
+                                        rasterize(read_part, SHAPE) | rasterize(STRIP, SHAPE)) >= 0.9
+        else:
+            assert added == [2] and np.array_equal(faces[1].polygon, read_part)
 
 
 def _grazing_cuboid(grazing_deg: float = 78.0):

@@ -68,3 +68,21 @@ def test_a_line_painted_across_a_face_does_not_make_it_two_faces(box_frame):
     painted = perceive(RGBD(color, frame.depth, frame.intrinsics), "rgbd").target()
     assert sorted(f.sides for f in painted.faces) == [4, 4, 4]
     assert all(f.plane is not None for f in painted.faces)
+
+
+def test_rgbd_has_the_faces_depth_has_and_print_adds_none(box_frame):
+    import cv2
+
+    frame, _ = box_frame
+    depth = perceive(frame, "depth").target()
+    color = frame.color.copy()
+    biggest = max(depth.faces, key=lambda f: len(f.points))
+    # a printed label of another colour inside the largest face: colour edges of its own, no face
+    c = biggest.polygon.mean(axis=0)
+    label = (c + 0.4 * (biggest.polygon - c)).astype(np.int32)
+    cv2.fillPoly(color, [label], (30, 200, 240))
+    for f in (frame, RGBD(color, frame.depth, frame.intrinsics)):
+        fused = perceive(f, "rgbd").target()
+        assert sorted(map(tuple, (np.round(g.polygon, 3).ravel() for g in fused.faces))) == \
+            sorted(map(tuple, (np.round(g.polygon, 3).ravel() for g in depth.faces)))
+        assert len(fused.adjacency) == len(depth.adjacency) == 3

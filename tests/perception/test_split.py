@@ -65,19 +65,6 @@ def test_a_corner_traced_as_two_goes_back_to_one():
     assert len(drop_short_sides(pentagon)) == 5  # real sides stay
 
 
-def test_fused_face_keeps_the_colour_outline_only_where_the_depth_one_just_lost_a_corner():
-    from lv3d.perception.perceive import _pick_polygon
-    from lv3d.perception.polygons import rasterize
-
-    off = np.zeros(2)
-    triangle = np.array([[50.0, 10.0], [90.0, 90.0], [10.0, 90.0]])
-    cut_apex = np.array([[46.0, 18.0], [54.0, 18.0], [90.0, 90.0], [10.0, 90.0]])  # depth: tip cut off
-    assert _pick_polygon(triangle, cut_apex, rasterize(triangle, (100, 100)), off) is triangle
-    merged = np.array([[10.0, 10.0], [90.0, 10.0], [90.0, 90.0]])  # colour reaching over the neighbour
-    own = np.array([[10.0, 10.0], [90.0, 10.0], [90.0, 30.0], [30.0, 30.0]])
-    assert _pick_polygon(merged, own, rasterize(merged, (100, 100)), off) is own
-
-
 def test_a_diagonal_running_close_along_the_outline_is_not_taken_for_an_edge():
     # a flat hexagon whose top corner lies 7 px off the diagonal below it (from hexagonal prism, dev seed 2001):
     # near its ends that diagonal runs within a pixel of the outline's own edge, which must not count for a cut
@@ -102,28 +89,3 @@ def test_a_diagonal_within_a_blurred_edge_of_the_outline_has_no_strength_measure
     shallow, across = _mean_clear_of_outline(2, *samples, clear_px=2.5)
     assert shallow == 0.0 and across < 5.0
     assert _mean_clear_of_outline(2, *samples, clear_px=1.0)[0] > 50.0
-
-
-def test_a_colour_face_that_traced_part_of_its_plane_takes_the_depth_outline():
-    # dev scene (seed 4242, realsense): a pentagonal prism's end face cut in two by a shading line; the colour face
-    # matched to the plane holds half of it, the other half is a colour face on the same plane
-    from types import SimpleNamespace
-
-    from lv3d.perception.perceive import _matched_polygon, _off_plane_px
-    from lv3d.perception.polygons import rasterize
-
-    off, shape = np.zeros(2), (100, 100)
-    square = np.array([[10.0, 10.0], [90.0, 10.0], [90.0, 90.0], [10.0, 90.0]])  # the plane's depth outline
-    upper = np.array([[10.0, 10.0], [90.0, 10.0], [90.0, 50.0], [10.0, 50.0]])
-    lower = np.array([[10.0, 50.0], [90.0, 50.0], [90.0, 90.0], [10.0, 90.0]])
-    o = SimpleNamespace(polygons=[square])
-    px = [rasterize(upper, shape), rasterize(lower, shape)]
-    plane = rasterize(square, shape)
-    others = _off_plane_px([0, 1], px, {}, plane, shape)
-    assert not others.any()  # both halves lie on the plane: pieces of one face, not neighbours
-    assert _matched_polygon(upper, 0, o, px[0], off, None, others, seed=0) is square
-    # the other half on another plane (a neighbour face the depth outline reached over): colour's outline stays
-    assert _matched_polygon(upper, 0, o, px[0], off, None, px[1], seed=0) is upper
-    # the colour face holds nearly all of the outline: colour's sharper corners stay
-    most = np.array([[10.0, 10.0], [90.0, 10.0], [90.0, 85.0], [10.0, 85.0]])
-    assert _matched_polygon(most, 0, o, rasterize(most, shape), off, None, others, seed=0) is most
