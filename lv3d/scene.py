@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .camera import Intrinsics
+from .cylinder import Cylinder
 from .plane import Plane
 
 PROVENANCE = ("rgb", "depth", "rgbd")
@@ -20,7 +21,8 @@ PROVENANCE = ("rgb", "depth", "rgbd")
 class Face:
     """One face. ``polygon``: (n, 2) float pixels, in order around the face. ``plane``: where depth
     found one. ``points``: the camera-frame depth points (m, 3) the plane was fitted to (not serialised).
-    ``provenance``: which modality found it ('rgbd' = matched in both)."""
+    ``provenance``: which modality found it ('rgbd' = matched in both). A curved face of depth (``surface``
+    'cylinder': a can's side) has its ``cylinder`` and no plane."""
 
     id: str
     polygon: np.ndarray
@@ -28,7 +30,9 @@ class Face:
     plane: Plane | None = None
     points: np.ndarray | None = None
     edge_support: float | None = None  # fraction of the polygon's perimeter on image edges, in [0, 1]
-    plane_rms_m: float | None = None   # RMS point-to-plane residual of the fit, metres
+    plane_rms_m: float | None = None   # RMS point-to-surface residual of the fit, metres
+    surface: str = "plane"             # 'plane' (or a polygon without depth), or 'cylinder'
+    cylinder: Cylinder | None = None  # the fitted cylinder of a cylindrical face (then ``plane`` is None)
 
     @property
     def sides(self) -> int:
@@ -39,7 +43,8 @@ class Face:
                 "polygon": np.round(np.asarray(self.polygon, float), 2).tolist(),
                 "plane": self.plane.to_dict() if self.plane else None,
                 "n_points": 0 if self.points is None else int(len(self.points)),
-                "edge_support": self.edge_support, "plane_rms_m": self.plane_rms_m}
+                "edge_support": self.edge_support, "plane_rms_m": self.plane_rms_m, "surface": self.surface,
+                "cylinder": self.cylinder.to_dict() if self.cylinder is not None else None}
 
 
 @dataclass

@@ -12,13 +12,15 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field, replace
 
+import cv2
 import numpy as np
 
 from ..plane import Plane
 from ..rgbd import RGBD
 from .boundary import mask_polygon
-from .cloud import PointGrid, point_grid, slope_noise
+from .cloud import PointGrid, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
+from .curved import CurvedFace, CurvedSettings, fan_cylinder, largest_piece
 from .objects import DepthObject, heavy_noise, segment_objects, support_band
 from .planes import DepthPlane, object_planes, plane_adjacency
 from .plane_outline import simplify_on_plane
@@ -51,6 +53,7 @@ class DepthSettings:
     as objects standing on it (their lower parts), and ``support_inner`` (fraction of its extent, about its
     centre) over what part of it (support.support_plane).
     ``convexity``: the cut at concave creases (convexity.ConvexitySettings).
+    ``curved``: a fan of planes read as one cylindrical face (curved.CurvedSettings).
     """
 
     max_objects: int = 24
@@ -65,6 +68,7 @@ class DepthSettings:
     support_stand_rel: float = 0.1
     support_inner: float = 0.85
     convexity: ConvexitySettings = field(default_factory=ConvexitySettings)
+    curved: CurvedSettings = field(default_factory=CurvedSettings)
 
     def __post_init__(self) -> None:
         if not isinstance(self.max_objects, int) or self.max_objects < 1:
@@ -91,6 +95,9 @@ class DepthObjectResult:
     adjacency: list[tuple[int, int]]
     centroid_m: np.ndarray
     box_px: tuple[int, int, int, int]  # (u0, v0, u1, v1), end exclusive
+    curved: list[CurvedFace] = field(default_factory=list)  # cylindrical faces (a can's side), not in ``planes``
+    curved_polygons: list[np.ndarray | None] = field(default_factory=list)
+    curved_adjacency: list[tuple[int, int]] = field(default_factory=list)  # (plane i, curved face j) touching
 
 
 @dataclass
@@ -136,6 +143,10 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
     for k, (o, planes) in enumerate(solids):
         ta = time.perf_counter()
         adj = plane_adjacency(planes)
+        planes, adj, curved = _curved(grid, o, planes, adj, settings.curved)
+        curved_adj = [(i, j) for j, c in enumerate(curved) for i, p in enumerate(planes)
+                      if np.count_nonzero(cv2.dilate(c.mask.view(np.uint8), np.ones((5, 5), np.uint8)).view(bool)
+                                          & p.mask) >= 4]
         tb = time.perf_counter()
         polys = [mask_polygon(p.mask, stride, (h, w)) for p in planes]
         if planes:
@@ -154,7 +165,9 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
         ij = np.argwhere(o.mask)
         (i0, j0), (i1, j1) = ij.min(axis=0), ij.max(axis=0)
         box = (int(j0 * stride), int(i0 * stride), min(w, int((j1 + 1) * stride)), min(h, int((i1 + 1) * stride)))
-        results.append(DepthObjectResult(o, planes, polys, adj, grid.xyz[o.mask].mean(axis=0).astype(np.float64), box))
+        curved_polys = [mask_polygon(c.mask, stride, (h, w), convex=False) for c in curved]
+        results.append(DepthObjectResult(o, planes, polys, adj, grid.xyz[o.mask].mean(axis=0).astype(np.float64), box,
+                                         curved, curved_polys, curved_adj))
     timings = {"cloud": (t1 - t0) * 1e3, "support": (t2 - t1) * 1e3, "objects": (t3 - t2) * 1e3,
                "planes": t_planes * 1e3, "boundary": t_boundary * 1e3}
     return DepthResult(grid, support, results, timings, dropped)
@@ -175,6 +188,40 @@ def _solids(grid: PointGrid, support: Plane | None, objs: list[DepthObject], see
         else:
             todo += [DepthObject(m, _height(grid, support, m)) for m in pieces]
     return out
+
+
+def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list[tuple[int, int]],
+            settings: CurvedSettings) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
+    """The object's planes and their adjacency with a fan of planes replaced by the cylindrical face it is
+    (curved.fan_cylinder), and that face; the inputs unchanged when there is none."""
+    if len(planes) < 2 or not adj:
+        return planes, adj, []
+    m = o.mask
+    rows, cols = np.flatnonzero(m.any(axis=1)), np.flatnonzero(m.any(axis=0))
+    i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    nrm = crop_normals(grid, i0, j0, i1, j1, within=m)[m[i0:i1, j0:j1]].astype(np.float64)
+    pts = grid.xyz[m].astype(np.float64)
+    plane_of = np.full(len(pts), -1)
+    for k, p in enumerate(planes):
+        plane_of[p.mask[m]] = k
+    extent = float(np.linalg.norm(np.percentile(pts, 95, axis=0) - np.percentile(pts, 5, axis=0)))
+    dist = noise_threshold(float(np.median(pts[:, 2])))
+    found = fan_cylinder([p.plane.n for p in planes], [len(p.points) for p in planes], adj, pts, nrm, plane_of,
+                         dist, extent, settings)
+    if found is None:
+        return planes, adj, []
+    cyl, on, fan = found
+    keep = [k for k in range(len(planes)) if k not in fan]
+    kept = [planes[k] for k in keep]
+    face = np.zeros_like(m)
+    face[m] = on
+    for p in kept:
+        face &= ~p.mask
+    face = largest_piece(face)
+    r, _ = cyl.radial(grid.xyz[face].astype(np.float64))
+    curved = CurvedFace(cyl, face, grid.xyz[face].astype(np.float32), float(np.sqrt(np.mean((r - cyl.radius) ** 2))))
+    index = {k: i for i, k in enumerate(keep)}
+    return kept, [(index[a], index[b]) for a, b in adj if a in index and b in index], [curved]
 
 
 def _height(grid: PointGrid, support: Plane | None, mask: np.ndarray) -> float:

@@ -1,0 +1,79 @@
+"""A fan of planes on a curved side read as one cylindrical face; a box's faces never."""
+
+import csv
+
+import numpy as np
+import pytest
+
+from lv3d.perception import perceive
+from lv3d.perception.curved import fan_cylinder
+from tests.conftest import REAL_DIR
+
+
+def _fan(th_deg: np.ndarray, radius: float, step_deg: float, rng):
+    """Points and outward normals of a vertical cylinder's front (camera y is the axis), and the index of the
+    plane of a fan of ``step_deg`` wide facets each point falls in."""
+    th = np.radians(th_deg)
+    y = rng.uniform(-0.05, 0.05, len(th))
+    pts = np.stack([radius * np.sin(th), y, 0.8 - radius * np.cos(th)], axis=1) + rng.normal(0, 0.0005, (len(th), 3))
+    nrm = np.stack([np.sin(th), 0 * th, -np.cos(th)], axis=1)
+    plane_of = ((th_deg - th_deg.min()) // step_deg).astype(int)
+    k = int(plane_of.max()) + 1
+    normals = []
+    for i in range(k):
+        mid = np.radians(th_deg.min() + (i + 0.5) * step_deg)
+        normals.append(np.array([np.sin(mid), 0.0, -np.cos(mid)]))
+    return pts, nrm, plane_of, normals, [(i, i + 1) for i in range(k - 1)]
+
+
+def test_a_fan_of_planes_on_a_can_is_one_cylinder():
+    rng = np.random.default_rng(0)
+    pts, nrm, plane_of, normals, adj = _fan(rng.uniform(-75, 75, 4000), 0.04, 30.0, rng)
+    found = fan_cylinder(normals, [int(np.sum(plane_of == i)) for i in range(len(normals))], adj, pts, nrm,
+                         plane_of, 0.005, 0.12)
+    assert found is not None
+    cyl, on, fan = found
+    assert abs(cyl.radius - 0.04) < 0.002 and abs(abs(cyl.axis[1]) - 1) < 1e-3
+    assert on.mean() > 0.9 and sorted(fan) == list(range(len(normals)))
+
+
+def test_two_faces_of_a_box_are_no_cylinder():
+    rng = np.random.default_rng(1)
+    # two faces of a box meeting at a vertical edge, turned 45 deg either way from the camera
+    s = rng.uniform(0, 0.08, 2000)
+    y = rng.uniform(-0.05, 0.05, 2000)
+    left = s < 0.04
+    a = np.radians(45)
+    pts = np.where(left[:, None], np.stack([-s * np.cos(a), y, 0.8 + s * np.sin(a) - 0.0], 1),
+                   np.stack([(s - 0.04) * np.cos(a), y, 0.8 + (s - 0.04) * np.sin(a)], 1))
+    n_left, n_right = np.array([-np.sin(a), 0, -np.cos(a)]), np.array([np.sin(a), 0, -np.cos(a)])
+    nrm = np.where(left[:, None], n_left, n_right)
+    plane_of = np.where(left, 0, 1)
+    assert fan_cylinder([n_left, n_right], [int(left.sum()), int((~left).sum())], [(0, 1)], pts, nrm, plane_of,
+                        0.005, 0.12) is None
+
+
+@pytest.mark.real
+def test_real_cans_have_a_cylindrical_face_and_boxes_none():
+    osd = REAL_DIR.parent / "osd-learn"
+    if not osd.is_dir():
+        pytest.skip(f"osd-learn frames not found at {osd}")
+    from lv3d.rgbd import load_real
+
+    rows = [r for r in csv.DictReader(open(osd / "objects.csv")) if r["partial"] == "no"]
+    frames = sorted({r["frame"] for r in rows if r["shape"] == "cylinder"})
+    frames += sorted({r["frame"] for r in rows if r["shape"] == "box"})[:8]
+    cans = can_read = boxes = box_curved = 0
+    for name in frames:
+        scene = perceive(load_real(osd, name), "depth")
+        for r in (r for r in rows if r["frame"] == name and r["shape"] in ("box", "cylinder")):
+            held = [o for o in scene.objects if o.mask[int(r["v"]), int(r["u"])]]
+            curved = bool(held) and any(f.surface == "cylinder" for f in held[0].faces)
+            if r["shape"] == "cylinder":
+                cans += 1
+                can_read += curved
+            else:
+                boxes += 1
+                box_curved += curved
+    assert can_read >= 0.7 * cans
+    assert box_curved == 0
