@@ -14,7 +14,6 @@ chance is 0.5; multi-class chance is 0.25). The machine may be shared: compare C
 from __future__ import annotations
 
 import argparse
-import copy
 import time
 from pathlib import Path
 
@@ -32,23 +31,20 @@ def main() -> None:
 
     from lv3d.baselines import cnn as cnn_mod
     from lv3d.experiment import data as data_mod
-    from lv3d.experiment.config import DEFAULTS
+    from lv3d.experiment.config import from_dict
     from lv3d.experiment.folds import split, stratified_folds
     from lv3d.experiment.runner import run_fold
     from lv3d.experiment.systems import make_system
 
-    cfg = copy.deepcopy(DEFAULTS)
-    cfg["seed"] = args.seed
-    cfg["baselines"]["threads"] = args.threads
+    cfg = from_dict({"seed": args.seed, "baselines": {"threads": args.threads}}, "bench_baselines options")
     if not (args.data / "manifest.json").is_file():
         from lv3d.render import make_dataset
         from lv3d.render.noise import noise_config
 
-        make_dataset(args.data, cfg["data"]["classes"], cfg["data"]["per_class"], noise_config("realsense"),
-                     args.seed)
+        make_dataset(args.data, list(cfg.data.classes), cfg.data.per_class, noise_config("realsense"), args.seed)
     items = data_mod.read_items(args.data)
-    pixels = data_mod.ensure_pixels(args.data, items, cfg["baselines"]["image_size"])
-    folds = stratified_folds(items, cfg["folds"], args.seed)
+    pixels = data_mod.ensure_pixels(args.data, items, cfg.baselines.image_size)
+    folds = stratified_folds(items, cfg.folds, args.seed)
 
     # record the wall/CPU time and epochs of every CNN training
     fits: list[tuple[float, float, int]] = []

@@ -12,12 +12,21 @@ Two ways to write:
   carries the marker (or is empty). An error at any point leaves ``--out`` as it was and no temporary
   folder behind.
 - :func:`claim` (``lv3d experiment run``, ``lv3d demo``): the folder is checked, made and marked, then
-  filled in place, one complete file at a time, so that a rerun resumes from what is there.
+  filled in place, one complete file at a time (:func:`write_atomic`), so that a rerun resumes from what is
+  there.
+
+One run at a time: :func:`locked` holds a lock on a folder (``flock`` on its :data:`LOCK` file, released
+by the kernel when the process ends, however it ends) while a run writes into it; a second run into the
+same folder stops with a one-line error naming the first run's process. What a killed run left half-made
+(temporary folders ``.NAME.partial-PID...``, ``.NAME.old-PID-...`` and files ``.NAME.tmp-PID``) is removed
+by :func:`clean_stale` on the next run, once no process PID is alive.
 """
 
 from __future__ import annotations
 
+import errno
 import os
+import re
 import secrets
 import shutil
 import tempfile
@@ -28,6 +37,7 @@ from pathlib import Path
 from .errors import InputError
 
 MARKER = ".lv3d-output"
+LOCK = ".lv3d-lock"
 _MARKER_TEXT = "This folder was written by lv3d; lv3d may replace or add to it when run with this --out again.\n"
 
 
@@ -136,7 +146,8 @@ def replacing(out: Path, inputs: Iterable[Path | None] = (), option: str = "--ou
             raise InputError(where, f"cannot replace it: {blocked} is read-only")
     _make_parent(target, where)
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.partial-", dir=target.parent))
+        clean_stale(target.parent, target.name)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.partial-{os.getpid()}-", dir=target.parent))
     except OSError as e:
         raise InputError(where, f"cannot write beside it: {e.strerror}") from None
     try:
@@ -174,3 +185,117 @@ def _swap_in(new: Path, target: Path, where: str) -> None:
     except OSError as e:
         raise InputError(where, f"written, but the earlier output moved to {old} could not be removed: "
                                 f"{e.strerror}; remove it by hand") from None
+
+
+# ---- one run at a time, complete files, and what killed runs left behind --------------------------------
+
+class _Lock:
+    def __init__(self, fd: int, path: Path):
+        self.fd, self.path = fd, path
+
+    def release(self) -> None:
+        if self.fd >= 0:
+            os.close(self.fd)  # closing the descriptor drops the flock
+            self.fd = -1
+
+
+def lock_folder(folder: Path, where: str, wait: bool = False) -> _Lock:
+    """Take the lock of ``folder`` (an existing folder lv3d writes into). Held: an InputError naming the
+    process holding it, or with ``wait`` block until it is free."""
+    import fcntl
+
+    path = Path(folder) / LOCK
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o644)
+    except OSError as e:
+        raise InputError(where, f"cannot create the lock file {path.name}: {e.strerror}") from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as e:
+        if e.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+            os.close(fd)
+            raise InputError(where, f"cannot lock the folder: {e.strerror}") from None
+        holder = _read_pid(fd)
+        if not wait:
+            os.close(fd)
+            raise InputError(where, f"another lv3d run{f' (process {holder})' if holder else ''} is writing into "
+                                    "this folder; wait for it to end or choose another --out")
+        fcntl.flock(fd, fcntl.LOCK_EX)
+    os.ftruncate(fd, 0)
+    os.write(fd, f"{os.getpid()}\n".encode())
+    return _Lock(fd, path)
+
+
+def _read_pid(fd: int) -> int | None:
+    try:
+        text = os.pread(fd, 32, 0).decode().strip()
+        return int(text) if text else None
+    except (OSError, ValueError):
+        return None
+
+
+@contextmanager
+def locked(folder: Path, where: str | None = None, wait: bool = False) -> Iterator[Path]:
+    """Hold the lock of ``folder`` for the block (see :func:`lock_folder`)."""
+    lock = lock_folder(folder, where or f"--out {folder}", wait)
+    try:
+        yield Path(folder)
+    finally:
+        lock.release()
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+_STALE = re.compile(r"^\.(?P<name>.+)\.(?:partial-|old-|tmp-)(?P<pid>\d+)(?:-.*)?$")
+
+
+def clean_stale(folder: Path, name: str | None = None) -> list[Path]:
+    """Remove the temporary folders and files a killed lv3d process left in ``folder`` (of the output
+    ``name`` only, when given): those whose process is no longer alive. Returns what it removed."""
+    removed = []
+    try:
+        entries = list(Path(folder).iterdir())
+    except OSError:
+        return removed
+    for p in entries:
+        m = _STALE.match(p.name)
+        if not m or (name is not None and m["name"] != name) or _alive(int(m["pid"])):
+            continue
+        try:
+            if p.is_dir() and not p.is_symlink():
+                shutil.rmtree(p)
+            else:
+                p.unlink()
+            removed.append(p)
+        except OSError:
+            continue
+    return removed
+
+
+def write_atomic(path: Path, data: str | bytes) -> None:
+    """Write ``path`` whole or not at all: into ``.NAME.tmp-PID`` beside it, then renamed over it."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    try:
+        if isinstance(data, str):
+            tmp.write_text(data)
+        else:
+            tmp.write_bytes(data)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            tmp.unlink()
+        except OSError:
+            pass
+        raise

@@ -22,7 +22,7 @@ from collections import defaultdict
 from pathlib import Path
 
 from lv3d.errors import InputError
-from lv3d.experiment.config import LOGIC_SYSTEMS, conditions, load_config
+from lv3d.experiment.config import LOGIC_SYSTEMS, load_study
 from lv3d.experiment.runner import _write_json, fold_path, result_key
 from lv3d.output import claim
 
@@ -45,15 +45,15 @@ def read_rows(path: Path) -> dict[tuple[str, str, int], dict[str, dict]]:
 
 def restore(config: Path, results: Path, out: Path, overrides: list[str] = ()) -> int:
     """Write the baseline fold files of ``config``'s run into ``out`` from ``results``; returns how many."""
-    cfg = load_config(config, list(overrides))
+    study = load_study(config, list(overrides))
     cells = read_rows(results)
     written = 0
     claim(out, (config, results))  # the study's --out: refused unless new, empty or lv3d's own
-    for cname, ccfg in conditions(cfg, config).items():
-        for s in ccfg["systems"]:
+    for cname, ccfg in study.conditions.items():
+        for s in ccfg.systems:
             if s in LOGIC_SYSTEMS:
                 continue
-            for k in range(ccfg["folds"]):
+            for k in range(ccfg.folds):
                 tasks = cells.get((cname, s, k))
                 if not tasks:
                     raise InputError(results, f"no rows for condition {cname!r}, system {s!r}, fold {k} of {config}")

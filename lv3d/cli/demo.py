@@ -9,7 +9,6 @@ explanation of one test answer; writes perception overlays, the programs, a plot
 
 from __future__ import annotations
 
-import copy
 import json
 import time
 from pathlib import Path
@@ -17,19 +16,18 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..experiment.config import DEFAULTS, LOGIC_SYSTEMS, SYSTEMS
+from ..experiment.config import LOGIC_SYSTEMS, SYSTEMS, StudyConfig, from_dict
 from ..experiment.folds import Item
 
 CLASSES = ["cube", "square_pyramid", "triangular_prism", "pentagonal_prism"]
 
 
-def demo_config(per_class: int, noise: str, seed: int, systems: list[str], threads: int) -> dict:
-    cfg = copy.deepcopy(DEFAULTS)
-    cfg.update(name="demo", seed=seed, systems=systems)
-    cfg["data"].update(classes=list(CLASSES), per_class=per_class, noise=noise, workers=2)
-    cfg["lv3d"]["workers"] = 2
-    cfg["baselines"].update(epochs=40, batch_size=8, threads=threads)
-    return cfg
+def demo_config(per_class: int, noise: str, seed: int, systems: list[str], threads: int) -> StudyConfig:
+    """The demo's study config (one split, not folds), checked like a study's."""
+    return from_dict({"name": "demo", "seed": seed, "folds": 2, "systems": systems,
+                      "data": {"classes": list(CLASSES), "per_class": per_class, "noise": noise, "workers": 2},
+                      "lv3d": {"workers": 2}, "baselines": {"epochs": 40, "batch_size": 8, "threads": threads}},
+                     "demo options")
 
 
 def demo_split(items: list[Item], train_per_class: int, seed: int) -> tuple[list[Item], list[Item]]:
@@ -84,13 +82,15 @@ def plot_accuracy(acc: dict[str, float], path: Path) -> None:
 
 @click.command()
 @click.option("--out", "out", required=True, type=click.Path(path_type=Path), help="output folder")
-@click.option("--per-class", default=8, show_default=True, help="images rendered per class")
-@click.option("--train", "train_per_class", default=4, show_default=True, help="training images per class")
+@click.option("--per-class", default=8, show_default=True, type=click.IntRange(2, 1000),
+              help="images rendered per class")
+@click.option("--train", "train_per_class", default=4, show_default=True, type=click.IntRange(1, 999),
+              help="training images per class")
 @click.option("--noise", default="mild", show_default=True, help="noise preset of the renderer")
-@click.option("--seed", default=0, show_default=True)
+@click.option("--seed", default=0, show_default=True, type=click.IntRange(0, 2 ** 32 - 1))
 @click.option("--systems", default="lv3d-rgb,lv3d-depth,lv3d-rgbd,cnn-rgbd,tree-rgbd", show_default=True,
               help="comma-separated systems to compare")
-@click.option("--threads", default=1, show_default=True, help="CPU threads for the CNN")
+@click.option("--threads", default=1, show_default=True, type=click.IntRange(1, 256), help="CPU threads for the CNN")
 def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int, systems: str, threads: int):
     """Learn four shape classes from a few RGB-D images and explain an answer."""
     from ..errors import InputError
@@ -105,12 +105,10 @@ def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int,
         raise InputError("--train", f"need 1 <= train < per-class ({per_class}), got {train_per_class}")
     t_start = time.perf_counter()
     cfg = demo_config(per_class, noise, seed, names, threads)
-    from ..render.noise import noise_config
+    from ..output import claim, lock_folder
 
-    noise_config(noise)  # an unknown preset is an InputError before anything is written
-    from ..output import claim
-
-    claim(out)  # a new, empty or lv3d-written folder, filled in place (a rerun reuses its data and facts)
+    target = claim(out)  # a new, empty or lv3d-written folder, filled in place (a rerun reuses its data and facts)
+    lock = lock_folder(target, f"--out {out}")  # one run at a time in this folder, until this one ends
     click.echo(f"1. rendering {per_class} images of each of {', '.join(CLASSES)} ({noise} noise)")
     data = data_mod.ensure_dataset(cfg, out)
     items = data_mod.read_items(data)
@@ -128,7 +126,7 @@ def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int,
                 click.echo(f"   {len(errors)} image(s) gave no object: {', '.join(sorted(errors))}")
         else:
             click.echo(f"3. {name}: training on the same {len(train)} images")
-            inputs = data_mod.ensure_pixels(data, items, cfg["baselines"]["image_size"])
+            inputs = data_mod.ensure_pixels(data, items, cfg.baselines.image_size)
         system = make_system(name, cfg, inputs)
         fit = system.fit([it.id for it in train], [it.cls for it in train], seed)
         preds = fit.predict([it.id for it in test])
@@ -168,3 +166,4 @@ def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int,
          "seconds": round(time.perf_counter() - t_start, 1)}, indent=1))
     click.echo(f"\nWrote {out / 'results.json'}, {out / 'accuracy.png'}, {out / 'overlays'}/, {out / 'programs'}/ "
                f"in {time.perf_counter() - t_start:.0f} s")
+    lock.release()

@@ -1,10 +1,15 @@
-"""Study configs: one YAML file per study (experiments/*.yaml), validated against a fixed schema.
+"""Study configs: one YAML file per study (experiments/*.yaml), read once into frozen dataclasses.
 
-A config is a nested mapping; ``DEFAULTS`` lists every key a study may set, with its default.
-Anything else is an error that names the file and the key. Overrides use dotted keys
-(``--set train.positives=8``) whose values are parsed as YAML. A study is one or more
-*conditions*: a single one (``base``), a ``sweep`` of one key over values, or named
-``conditions`` each overriding some keys (the ablations).
+:func:`load_study` reads the file, fills in the defaults, applies ``--set key=value`` overrides (dotted
+keys, values parsed as YAML), expands the study's *conditions* (a single one, ``base``; a ``sweep`` of
+one key over values; or named ``conditions`` each overriding some keys) and checks every value of every
+condition: its type, its range and, for names (classes, noise presets and knobs, systems, learner
+settings), that it exists. Any problem is one :class:`~lv3d.errors.InputError` naming the file and the
+key, raised before any work. What the runner, the data cache and the systems then read is a
+:class:`StudyConfig`, typed and known to be valid.
+
+Each field of a section carries its check (kind, range, known names) in its metadata; the ranges are
+what lv3d can run in bounded time and memory (:mod:`lv3d.limits`), not what a study should use.
 """
 
 from __future__ import annotations
@@ -12,69 +17,326 @@ from __future__ import annotations
 import copy
 import hashlib
 import json
+import math
 import re
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
+from typing import Any, Callable
 
 import yaml
 
 from ..errors import InputError
+from ..limits import MAX_DATASET_IMAGES
 
 LOGIC_SYSTEMS = ("lv3d-rgb", "lv3d-depth", "lv3d-rgbd")
 BASELINE_SYSTEMS = ("cnn-rgb", "cnn-depth", "cnn-rgbd", "cnn-rgbd-2s", "tree-rgb", "tree-depth", "tree-rgbd")
 SYSTEMS = LOGIC_SYSTEMS + BASELINE_SYSTEMS
+MAX_FOLDS = 100
+MAX_WORKERS = 256
+# a condition names a folder of the run (folds/<condition>/...): no separators, no "." or ".."
+_CONDITION_NAME = re.compile(r"^[A-Za-z0-9_+=.,-]+$")
 
-DEFAULTS: dict = {
-    "name": "study",
-    "seed": 0,
-    "folds": 5,
-    "data": {
-        "classes": ["cube", "square_pyramid", "triangular_prism", "pentagonal_prism"],
-        "per_class": 50,
-        "noise": "realsense",       # a preset of lv3d.render.noise
-        "noise_overrides": {},      # knob -> value, on top of the preset
-        "cache": None,              # a folder shared between studies; default: <out>/data
-        "workers": None,            # rendering processes (None: the renderer's default)
-    },
-    "train": {
-        "positives": 40,                # per class task; capped by what the training folds hold
-        "negatives_per_positive": 1.5,  # spread evenly over the other classes (40 -> 20 of each of 3)
-        "multiclass": True,             # also train on all classes at once and report multi-class accuracy
-        "draws": 1,                     # training samples drawn per task and fold; scores are their means
-    },
-    "systems": list(SYSTEMS),
-    "lv3d": {
-        "refine": True,            # JAX refinement before facts (False: the no-refinement ablation)
-        "confidences": True,       # facts keep their confidences (False: every confidence is 1)
-        "settings": {},            # lv3d.learn Settings fields, e.g. {label_noise: false}
-        "workers": 1,              # processes computing facts
-    },
-    "baselines": {
-        # CNN settings: see lv3d.baselines.cnn.CNNSettings (why 1 thread, 20 epochs, no augmentation)
-        "image_size": 64, "epochs": 20, "batch_size": 16, "lr": 0.003, "weight_decay": 0.0001,
-        "augment": False, "width": 16, "threads": 1, "tree_cells": 16, "tree_min_samples_leaf": 2,
-        "patience": 0, "val_fraction": 0.15,  # early stopping (off: patience 0)
-    },
-    "stats": {
-        "pairs": None,             # [[a, b], ...]; default: every lv3d pair, and lv3d-rgbd against each baseline
-    },
-    "sweep": None,                 # {param: dotted key, values: [...]}
-    "conditions": None,            # {name: {dotted key: value}}
+
+def _classes() -> tuple[str, ...]:
+    from ..render.solids import CLASSES
+
+    return tuple(CLASSES)
+
+
+def _presets() -> tuple[str, ...]:
+    from ..render.noise import PRESETS
+
+    return tuple(PRESETS)
+
+
+# ---- field specs: what a value must be ------------------------------------------------------------------
+
+def _spec(default, kind: str, *, lo=None, hi=None, lo_open=False, names: Callable[[], tuple] | tuple | None = None,
+          optional=False, min_len=0, doc=""):
+    meta = {"kind": kind, "lo": lo, "hi": hi, "lo_open": lo_open, "names": names, "optional": optional,
+            "min_len": min_len, "doc": doc}
+    if isinstance(default, (list, dict, tuple)):
+        return field(default_factory=lambda: copy.deepcopy(default), metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+def _int(default, lo=None, hi=None, optional=False, doc=""):
+    return _spec(default, "int", lo=lo, hi=hi, optional=optional, doc=doc)
+
+
+def _num(default, lo=None, hi=None, lo_open=False, doc=""):
+    return _spec(default, "number", lo=lo, hi=hi, lo_open=lo_open, doc=doc)
+
+
+def _bool(default, doc=""):
+    return _spec(default, "bool", doc=doc)
+
+
+def _is_int(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _is_num(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _range_text(lo, hi, lo_open=False) -> str:
+    if lo is not None and hi is not None:
+        return f"{'above' if lo_open else 'from'} {lo} {'and at most' if lo_open else 'to'} {hi}"
+    if lo is not None:
+        return f"{'above' if lo_open else 'at least'} {lo}"
+    return f"at most {hi}"
+
+
+def check_value(value, meta: dict, key: str, where: str):
+    """``value`` checked against a field spec; returns it (lists as tuples). InputError naming ``key``."""
+    kind = meta["kind"]
+
+    def bad(problem: str):
+        raise InputError(where, f"{key}: {problem}, got {value!r}")
+
+    if value is None and meta["optional"]:
+        return None
+    lo, hi, lo_open = meta["lo"], meta["hi"], meta["lo_open"]
+    if kind in ("int", "number"):
+        ok = _is_int(value) if kind == "int" else _is_num(value)
+        if not ok:
+            bad("must be a whole number" if kind == "int" else "must be a number")
+        if (lo is not None and (value <= lo if lo_open else value < lo)) or (hi is not None and value > hi):
+            bad(f"must be {_range_text(lo, hi, lo_open)}")
+        return value
+    if kind == "bool":
+        if not isinstance(value, bool):
+            bad("must be true or false")
+        return value
+    if kind == "str":
+        if not isinstance(value, str) or not value.strip():
+            bad("must be a non-empty text")
+        return value
+    if kind == "path":
+        if not isinstance(value, str) or not value.strip() or "\0" in value:
+            bad("must be a folder (a path)")
+        return value
+    names = meta["names"]() if callable(meta["names"]) else meta["names"]
+    if kind == "name":
+        if not isinstance(value, str) or value not in names:
+            bad(f"must be one of {', '.join(names)}")
+        return value
+    if kind == "names":
+        if not isinstance(value, (list, tuple)):
+            bad("must be a list")
+        for v in value:
+            if not isinstance(v, str) or v not in names:
+                raise InputError(where, f"{key}: unknown name {v!r}; known: {', '.join(names)}")
+        if len(set(value)) != len(value):
+            bad("lists a name twice")
+        if len(value) < meta["min_len"]:
+            bad(f"needs a list of at least {meta['min_len']}")
+        return tuple(value)
+    if kind == "mapping":
+        if not isinstance(value, dict):
+            bad("must be a mapping")
+        return dict(value)
+    raise AssertionError(kind)
+
+
+# ---- the sections ---------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class DataConfig:
+    """The images of the study: rendered once, cached by (classes, per_class, noise, seed)."""
+
+    classes: tuple = _spec(("cube", "square_pyramid", "triangular_prism", "pentagonal_prism"), "names",
+                           names=_classes, min_len=2)
+    per_class: int = _int(50, 1, MAX_DATASET_IMAGES // 2, doc="images per class")
+    noise: str = _spec("realsense", "name", names=_presets, doc="a preset of lv3d.render.noise")
+    noise_overrides: dict = _spec({}, "mapping", doc="knob -> value, on top of the preset")
+    cache: str | None = _spec(None, "path", optional=True, doc="a folder shared between studies; None: <out>/data")
+    workers: int | None = _int(None, 1, MAX_WORKERS, optional=True, doc="rendering processes (None: all cores)")
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    positives: int = _int(40, 1, MAX_DATASET_IMAGES, doc="per class task; capped by the training folds")
+    negatives_per_positive: float = _num(1.5, 0, 1000, lo_open=True, doc="spread evenly over the other classes")
+    multiclass: bool = _bool(True, doc="also train on all classes at once and report multi-class accuracy")
+    draws: int = _int(1, 1, 1000, doc="training samples drawn per task and fold; scores are their means")
+
+
+@dataclass(frozen=True)
+class Lv3dConfig:
+    refine: bool = _bool(True, doc="JAX refinement before facts (false: the no-refinement ablation)")
+    confidences: bool = _bool(True, doc="facts keep their confidences (false: every confidence is 1)")
+    settings: dict = _spec({}, "mapping", doc="learner settings (lv3d.learn.settings), e.g. {time_limit: 20}")
+    workers: int = _int(1, 1, MAX_WORKERS, doc="processes computing facts")
+
+
+@dataclass(frozen=True)
+class BaselineConfig:
+    """CNN and tree settings: see lv3d.baselines.cnn.CNNSettings (why 1 thread, 20 epochs, no augmentation)."""
+
+    image_size: int = _int(64, 8, 512, doc="pixels a side of the baselines' input")
+    epochs: int = _int(20, 1, 10000)
+    batch_size: int = _int(16, 2, 4096, doc="batch norm needs two samples")
+    lr: float = _num(0.003, 0, 10, lo_open=True)
+    weight_decay: float = _num(0.0001, 0, 1)
+    augment: bool = _bool(False)
+    width: int = _int(16, 1, 1024, doc="channels of the first layer")
+    threads: int = _int(1, 1, MAX_WORKERS)
+    tree_cells: int = _int(16, 1, 512, doc="cells a side the tree sees; divides image_size")
+    tree_min_samples_leaf: int = _int(2, 1, 100000)
+    patience: int = _int(0, 0, 10000, doc="early stopping (0: off)")
+    val_fraction: float = _num(0.15, 0, 0.9)
+
+
+@dataclass(frozen=True)
+class StatsConfig:
+    pairs: tuple | None = _spec(None, "pairs", optional=True,
+                                doc="[[a, b], ...]; default: every lv3d pair, and lv3d-rgbd against each baseline")
+
+
+SECTIONS = {"data": DataConfig, "train": TrainConfig, "lv3d": Lv3dConfig, "baselines": BaselineConfig,
+            "stats": StatsConfig}
+# mappings whose keys are names checked elsewhere (noise knobs, learner settings), not schema keys
+FREE = {("data", "noise_overrides"), ("lv3d", "settings")}
+
+
+@dataclass(frozen=True)
+class StudyConfig:
+    """One condition of a study, every value checked. ``to_dict()`` is the YAML form."""
+
+    name: str = _spec("study", "str")
+    seed: int = _int(0, 0, 2 ** 32 - 1)
+    folds: int = _int(5, 2, MAX_FOLDS)
+    data: DataConfig = field(default_factory=DataConfig)
+    train: TrainConfig = field(default_factory=TrainConfig)
+    systems: tuple = _spec(SYSTEMS, "names", names=SYSTEMS, min_len=1)
+    lv3d: Lv3dConfig = field(default_factory=Lv3dConfig)
+    baselines: BaselineConfig = field(default_factory=BaselineConfig)
+    stats: StatsConfig = field(default_factory=StatsConfig)
+
+    def to_dict(self) -> dict:
+        """Plain nested mappings and lists (what the YAML holds, and what cache keys digest)."""
+        return _plain(self)
+
+    def with_systems(self, systems) -> "StudyConfig":
+        return replace(self, systems=tuple(systems))
+
+
+def _plain(obj):
+    if hasattr(obj, "__dataclass_fields__"):
+        return {f.name: _plain(getattr(obj, f.name)) for f in fields(obj)}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    return obj
+
+
+def defaults() -> dict:
+    """Every key a study may set, with its default (plus ``sweep`` and ``conditions``), as mappings."""
+    return {**StudyConfig().to_dict(), "sweep": None, "conditions": None}
+
+
+DEFAULTS: dict = defaults()
+
+
+# ---- knobs of the renderer's noise and settings of the learner -----------------------------------------
+
+# The range of each noise knob a study may set (lv3d.render.noise.NoiseConfig says what each means).
+PROB = (0.0, 1.0)
+KNOB_RANGES: dict[str, tuple[float, float]] = {
+    "depth_sigma_base_m": (0.0, 0.1), "depth_sigma_k": (0.0, 1.0), "hole_blobs": (0, 1000),
+    "hole_radius_px": (0.0, 500.0), "grazing_deg": (1.0, 90.0), "flying_pixels": PROB, "color_sigma": (0.0, 255.0),
+    "blur_px": (0.0, 100.0), "jpeg_quality": (0, 100), "exposure": (0.0, 5.0), "occluder": PROB, "clutter": (0, 16),
+    "distractor_lines": (0, 100), "texture": PROB, "table_grain": PROB, "printed_faces": PROB, "face_hues": PROB,
+    "touching": PROB, "stacked": PROB, "small_table": PROB, "edge_dropout_px": (0.0, 100.0),
 }
 
-# keys whose value is a free-form mapping (checked elsewhere), not a schema section
-_FREE = {("data", "noise_overrides"), ("lv3d", "settings")}
+
+def check_noise(data: DataConfig, where: str) -> None:
+    """The preset and knobs exist, each knob has its type (lv3d.render.noise) and lies in KNOB_RANGES."""
+    from ..render.noise import noise_config
+
+    try:
+        noise_config(data.noise, **data.noise_overrides)
+    except InputError as e:
+        key = "data.noise" if e.problem.startswith("unknown noise preset") else "data.noise_overrides"
+        raise InputError(where, f"{key}: {e.problem}") from None
+    except TypeError as e:
+        raise InputError(where, f"data.noise_overrides: {e}") from None
+    for knob, value in data.noise_overrides.items():
+        if knob in KNOB_RANGES and _is_num(value):
+            lo, hi = KNOB_RANGES[knob]
+            if not lo <= value <= hi:
+                raise InputError(where, f"data.noise_overrides.{knob}: must be from {lo:g} to {hi:g}, got {value!r}")
+        elif knob in KNOB_RANGES:
+            raise InputError(where, f"data.noise_overrides.{knob}: must be a finite number, got {value!r}")
 
 
-def _check(cfg: dict, schema: dict, where: Path, prefix: str = "") -> None:
+def check_learner_settings(settings: dict, where: str) -> dict:
+    from ..learn.settings import check_settings
+
+    return check_settings(settings, where, prefix="lv3d.settings.")
+
+
+# ---- building a StudyConfig from mappings ---------------------------------------------------------------
+
+def _section(cls, raw: dict, key: str, where: str):
+    values = {}
+    for f in fields(cls):
+        if f.name in raw:
+            if f.metadata.get("kind") == "pairs":
+                values[f.name] = raw[f.name]  # checked against the study's systems below
+            else:
+                values[f.name] = check_value(raw[f.name], f.metadata, f"{key}.{f.name}", where)
+    return cls(**values)
+
+
+def from_dict(cfg: dict, where: str) -> StudyConfig:
+    """A merged config mapping (every key known) -> StudyConfig; InputError at the first bad value."""
+    top = {}
+    for f in fields(StudyConfig):
+        if f.name in SECTIONS:
+            top[f.name] = _section(SECTIONS[f.name], cfg.get(f.name) or {}, f.name, where)
+        elif f.name in cfg:
+            top[f.name] = check_value(cfg[f.name], f.metadata, f.name, where)
+    study = StudyConfig(**top)
+    d, b = study.data, study.baselines
+    if d.per_class < study.folds:
+        raise InputError(where, f"data.per_class: must be at least folds ({study.folds}), got {d.per_class}")
+    if d.per_class * len(d.classes) > MAX_DATASET_IMAGES:
+        raise InputError(where, f"data.per_class: {d.per_class} images of {len(d.classes)} classes exceed the "
+                                f"{MAX_DATASET_IMAGES} images a data set may hold (lv3d.limits)")
+    check_noise(d, where)
+    lv = replace(study.lv3d, settings=check_learner_settings(study.lv3d.settings, where))
+    if b.tree_cells > b.image_size or b.image_size % b.tree_cells:
+        raise InputError(where, f"baselines.tree_cells: must divide baselines.image_size ({b.image_size}), "
+                                f"got {b.tree_cells}")
+    pairs = study.stats.pairs
+    if pairs is not None:
+        if not isinstance(pairs, (list, tuple)):
+            raise InputError(where, f"stats.pairs: must be a list of [system, system] pairs, got {pairs!r}")
+        for p in pairs:
+            if not (isinstance(p, (list, tuple)) and len(p) == 2 and p[0] != p[1]
+                    and all(isinstance(s, str) and s in study.systems for s in p)):
+                raise InputError(where, f"stats.pairs: {p!r} is not a pair of two systems of this study "
+                                        f"({', '.join(study.systems)})")
+        pairs = tuple(tuple(p) for p in pairs)
+    return replace(study, lv3d=lv, stats=StatsConfig(pairs))
+
+
+# ---- reading the YAML: unknown keys, defaults, overrides, conditions -----------------------------------
+
+def _check_keys(cfg: dict, schema: dict, where: str, prefix: str = "") -> None:
     for key, value in cfg.items():
         path = f"{prefix}{key}"
-        if key not in schema:
-            known = ", ".join(sorted(schema))
-            raise InputError(where, f"unknown key {path!r}; known here: {known}")
-        if isinstance(schema[key], dict) and tuple(path.split(".")) not in _FREE:
+        if not isinstance(key, str) or key not in schema:
+            raise InputError(where, f"unknown key {path!r}; known here: {', '.join(sorted(schema))}")
+        if isinstance(schema[key], dict) and tuple(path.split(".")) not in FREE:
             if not isinstance(value, dict):
-                raise InputError(where, f"{path!r} must be a mapping")
-            _check(value, schema[key], where, path + ".")
+                raise InputError(where, f"{path}: must be a mapping, got {value!r}")
+            _check_keys(value, schema[key], where, path + ".")
 
 
 def _merge(base: dict, over: dict) -> dict:
@@ -87,18 +349,19 @@ def _merge(base: dict, over: dict) -> dict:
     return out
 
 
-def set_dotted(cfg: dict, key: str, value, where: str | Path) -> None:
+def set_dotted(cfg: dict, key: str, value, where: str) -> None:
     """Set ``a.b.c`` in a nested mapping; the key must exist in the schema (free mappings excepted)."""
+    if not isinstance(key, str) or not key or any(not p for p in key.split(".")):
+        raise InputError(where, f"not a dotted key: {key!r}")
     parts = key.split(".")
     node, schema = cfg, DEFAULTS
     for i, p in enumerate(parts[:-1]):
-        if tuple(parts[:i + 1]) in _FREE:  # a knob or learner setting: any name, checked later
-            node = node.setdefault(p, {})
-            schema = None
-            continue
-        if schema is None or p not in schema or not isinstance(schema[p], dict):
+        free = tuple(parts[:i + 1]) in FREE  # a knob or learner setting: any name, checked later
+        if schema is None or p not in schema or not isinstance(schema[p], dict) or (free and i != len(parts) - 2):
             raise InputError(where, f"unknown key {key!r}")
-        node, schema = node.setdefault(p, {}), schema[p]
+        if not isinstance(node.get(p), dict):
+            node[p] = {}
+        node, schema = node[p], (None if free else schema[p])
     if schema is not None and parts[-1] not in schema:
         raise InputError(where, f"unknown key {key!r}")
     node[parts[-1]] = value
@@ -107,113 +370,113 @@ def set_dotted(cfg: dict, key: str, value, where: str | Path) -> None:
 _EXPONENT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
 
 
+def _yaml_value(raw: str):
+    if _EXPONENT.fullmatch(raw.strip()):  # YAML 1.1 reads 1e-3 (no dot) as a string
+        return float(raw)
+    return yaml.safe_load(raw)
+
+
 def parse_override(text: str) -> tuple[str, object]:
     """``key=value`` with the value parsed as YAML (``8``, ``false``, ``[1, 2]``)."""
     if "=" not in text:
         raise InputError("--set", f"expected key=value, got {text!r}")
     key, raw = text.split("=", 1)
-    if _EXPONENT.fullmatch(raw.strip()):  # YAML 1.1 reads 1e-3 (no dot) as a string
-        return key.strip(), float(raw)
     try:
-        return key.strip(), yaml.safe_load(raw)
+        return key.strip(), _yaml_value(raw)
     except yaml.YAMLError as e:
-        raise InputError("--set", f"cannot parse the value of {key!r}: {e}") from None
+        raise InputError("--set", f"cannot parse the value of {key!r}: {str(e).splitlines()[0]}") from None
 
 
-def validate(cfg: dict, where: Path) -> None:
-    """Types and names: classes, presets, knobs and systems must exist (InputError naming the key)."""
-    from ..render.noise import noise_config
-    from ..render.solids import CLASSES
-
-    def need(ok: bool, key: str, problem: str):
-        if not ok:
-            raise InputError(where, f"{key}: {problem}")
-
-    for key in ("seed", "folds"):
-        need(isinstance(cfg[key], int) and not isinstance(cfg[key], bool), key, "must be an integer")
-    need(cfg["folds"] >= 2, "folds", "needs at least 2 folds")
-    d = cfg["data"]
-    need(isinstance(d["classes"], list) and len(d["classes"]) >= 2, "data.classes", "needs a list of at least 2 classes")
-    for c in d["classes"]:
-        need(c in CLASSES, "data.classes", f"unknown class {c!r}; known: {', '.join(CLASSES)}")
-    need(len(set(d["classes"])) == len(d["classes"]), "data.classes", "lists a class twice")
-    need(isinstance(d["per_class"], int) and d["per_class"] >= cfg["folds"], "data.per_class",
-         f"must be an integer of at least folds ({cfg['folds']})")
-    try:
-        noise_config(d["noise"], **(d["noise_overrides"] or {}))
-    except InputError as e:
-        key = "data.noise" if e.problem.startswith("unknown noise preset") else "data.noise_overrides"
-        raise InputError(where, f"{key}: {e.problem}") from None
-    except TypeError as e:
-        raise InputError(where, f"data.noise_overrides: {e}") from None
-    t = cfg["train"]
-    need(isinstance(t["positives"], int) and t["positives"] >= 1, "train.positives", "must be a positive integer")
-    need(isinstance(t["negatives_per_positive"], (int, float)) and t["negatives_per_positive"] > 0,
-         "train.negatives_per_positive", "must be a positive number")
-    need(isinstance(t["draws"], int) and not isinstance(t["draws"], bool) and t["draws"] >= 1, "train.draws",
-         "must be a positive integer")
-    need(isinstance(cfg["systems"], list) and cfg["systems"], "systems", "needs a non-empty list")
-    for s in cfg["systems"]:
-        need(s in SYSTEMS, "systems", f"unknown system {s!r}; known: {', '.join(SYSTEMS)}")
-    need(isinstance(cfg["lv3d"]["settings"], dict), "lv3d.settings", "must be a mapping")
-    pairs = cfg["stats"]["pairs"]
-    if pairs is not None:
-        for p in pairs:
-            need(isinstance(p, list) and len(p) == 2 and all(s in cfg["systems"] for s in p), "stats.pairs",
-                 f"{p!r} is not a pair of systems of this study")
-    b = cfg["baselines"]
-    need(b["image_size"] % b["tree_cells"] == 0, "baselines.tree_cells", "must divide baselines.image_size")
+class _Loader(yaml.SafeLoader):
+    """YAML 1.1 with 1e-3 (no dot) read as a number, as in ``--set``."""
 
 
-def conditions(cfg: dict, where: Path) -> dict[str, dict]:
-    """The study's conditions: name -> fully merged and validated config."""
+_Loader.add_implicit_resolver("tag:yaml.org,2002:float", _EXPONENT, list("-+0123456789."))
+
+
+@dataclass(frozen=True)
+class Study:
+    """A study as read from its file: ``conditions`` maps each condition's name to its checked config;
+    ``base`` is the first condition (name, classes and systems of the report); ``merged`` the YAML form
+    written to config.yaml."""
+
+    path: Path
+    base: StudyConfig
+    conditions: dict
+    merged: dict
+
+    @property
+    def name(self) -> str:
+        return self.base.name
+
+
+def _expand(cfg: dict, where: str) -> dict[str, dict]:
     sweep, named = cfg.get("sweep"), cfg.get("conditions")
     if sweep is not None and named is not None:
         raise InputError(where, "sweep and conditions: give one or the other")
     out: dict[str, dict] = {}
     if sweep is not None:
-        if not isinstance(sweep, dict) or set(sweep) != {"param", "values"} or not isinstance(sweep["values"], list):
-            raise InputError(where, "sweep: must be {param: dotted key, values: [...]}")
+        if not isinstance(sweep, dict) or set(sweep) != {"param", "values"} or not isinstance(sweep["values"], list) \
+                or not sweep["values"] or not isinstance(sweep["param"], str):
+            raise InputError(where, "sweep: must be {param: dotted key, values: [one or more values]}")
         for v in sweep["values"]:
+            if isinstance(v, (dict, list)) or v is None:
+                raise InputError(where, f"sweep.values: each value must be a number, text or true/false, got {v!r}")
             c = copy.deepcopy(cfg)
+            name = f"{sweep['param'].split('.')[-1]}={v}"
             set_dotted(c, sweep["param"], v, f"{where}: sweep.param")
-            out[f"{sweep['param'].split('.')[-1]}={v}"] = c
+            out[name] = c
     elif named is not None:
         if not isinstance(named, dict) or not named:
             raise InputError(where, "conditions: must map names to {dotted key: value}")
         for name, overrides in named.items():
+            if overrides is not None and not isinstance(overrides, dict):
+                raise InputError(where, f"conditions.{name}: must be a mapping of dotted keys to values")
             c = copy.deepcopy(cfg)
             for k, v in (overrides or {}).items():
                 set_dotted(c, k, v, f"{where}: conditions.{name}")
             out[str(name)] = c
     else:
         out["base"] = copy.deepcopy(cfg)
-    for c in out.values():
-        c["sweep"] = c["conditions"] = None
-        validate(c, where)
+    for name in out:
+        if not _CONDITION_NAME.match(name) or name in (".", ".."):
+            raise InputError(where, f"condition name {name!r}: use letters, digits and _ + = . , - only")
     return out
 
 
-def load_config(path: Path, overrides: list[str] = ()) -> dict:
-    """Read, merge with defaults, apply ``key=value`` overrides, validate; returns the full config."""
+def read_yaml(path: Path) -> dict:
     path = Path(path)
     if not path.is_file():
         raise InputError(path, "config file not found")
     try:
-        raw = yaml.safe_load(path.read_text()) or {}
-    except yaml.YAMLError as e:
-        raise InputError(path, f"not valid YAML: {e}") from None
+        raw = yaml.load(path.read_text(), Loader=_Loader) or {}
+    except (yaml.YAMLError, UnicodeDecodeError) as e:
+        raise InputError(path, f"not valid YAML: {str(e).splitlines()[0]}") from None
     if not isinstance(raw, dict):
         raise InputError(path, "a config must be a mapping at the top level")
-    _check(raw, DEFAULTS, path)
-    cfg = _merge(DEFAULTS, raw)
+    return raw
+
+
+def load_study(path: Path, overrides=()) -> Study:
+    """Read, merge with defaults, apply ``key=value`` overrides, expand and check every condition."""
+    path = Path(path)
+    raw = read_yaml(path)
+    where = str(path)
+    _check_keys(raw, DEFAULTS, where)
+    merged = _merge(DEFAULTS, raw)
     for text in overrides:
         key, value = parse_override(text)
-        set_dotted(cfg, key, value, f"{path}: --set")
-    conditions(cfg, path)  # validates every condition now, before any work
-    return cfg
+        set_dotted(merged, key, value, f"{where}: --set")
+    _check_keys({k: v for k, v in merged.items() if k not in ("sweep", "conditions")}, DEFAULTS, where)
+    conds = {}
+    for name, c in _expand(merged, where).items():
+        here = where if name == "base" else f"{where}: {'sweep' if merged.get('sweep') else 'conditions'} {name}"
+        conds[name] = from_dict(c, here)
+    return Study(path, next(iter(conds.values())), conds, merged)
 
 
 def digest(obj) -> str:
     """A short stable hash of JSON-able data (cache keys, resume checks)."""
+    if hasattr(obj, "__dataclass_fields__"):
+        obj = _plain(obj)
     return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:12]

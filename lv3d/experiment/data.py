@@ -6,14 +6,17 @@
   per image, so the expensive pipeline runs once per (image, modality, refine, version of the
   perception and grounding code) and an interrupted run resumes;
 - pixels: ``<cache>/<digest>/pixels-<size>.npz``, the (N, 4, S, S) rgbd tensors of the baselines.
+
+A cache file that cannot be read (cut short, corrupt) is computed again. Rendering into a cache folder
+holds its lock (lv3d.output), so that two studies sharing a cache render a data set once; what a killed
+run left half-made there is removed first.
 """
 
 from __future__ import annotations
 
+import io
 import json
-import os
-from concurrent.futures import ProcessPoolExecutor
-from multiprocessing import get_context
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -21,23 +24,28 @@ from tqdm import tqdm
 
 from ..errors import InputError
 from ..facts import SceneFacts
+from ..output import clean_stale, locked, write_atomic
 from .code_version import facts_version
-from .config import digest
+from .config import StudyConfig, digest
+from .executor import LocalExecutor
 from .folds import Item
 
 
-def data_key(cfg: dict) -> dict:
-    d = cfg["data"]
-    return {"classes": d["classes"], "per_class": d["per_class"], "noise": d["noise"],
-            "noise_overrides": d["noise_overrides"] or {}, "seed": cfg["seed"]}
+def data_key(cfg: StudyConfig) -> dict:
+    d = cfg.data
+    return {"classes": list(d.classes), "per_class": d.per_class, "noise": d.noise,
+            "noise_overrides": dict(d.noise_overrides or {}), "seed": cfg.seed}
 
 
-def dataset_dir(cfg: dict, out: Path) -> Path:
-    root = Path(cfg["data"]["cache"]) if cfg["data"]["cache"] else Path(out) / "data"
-    return root / digest(data_key(cfg))
+def cache_root(cfg: StudyConfig, out: Path) -> Path:
+    return Path(cfg.data.cache).expanduser() if cfg.data.cache else Path(out) / "data"
 
 
-def ensure_dataset(cfg: dict, out: Path) -> Path:
+def dataset_dir(cfg: StudyConfig, out: Path) -> Path:
+    return cache_root(cfg, out) / digest(data_key(cfg))
+
+
+def ensure_dataset(cfg: StudyConfig, out: Path) -> Path:
     """Render the study's data set unless it is already there; returns its folder."""
     from ..render import make_dataset
     from ..render.noise import noise_config
@@ -45,10 +53,19 @@ def ensure_dataset(cfg: dict, out: Path) -> Path:
     target = dataset_dir(cfg, out)
     if (target / "manifest.json").is_file():
         return target
-    d = cfg["data"]
-    noise = noise_config(d["noise"], **(d["noise_overrides"] or {}))
-    # make_dataset renders into a hidden folder and renames it when complete: no half data set is reused
-    make_dataset(target, list(d["classes"]), d["per_class"], noise, cfg["seed"], workers=d["workers"])
+    root = target.parent
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(f"data.cache {root}", f"cannot create the folder: {e.strerror}") from None
+    with locked(root, f"data cache {root}", wait=True):  # another study rendering into the same cache: wait
+        if (target / "manifest.json").is_file():
+            return target
+        clean_stale(root, target.name)  # a killed rendering's .NAME.partial-PID folder
+        d = cfg.data
+        noise = noise_config(d.noise, **dict(d.noise_overrides or {}))
+        # make_dataset renders into a hidden folder and renames it when complete: no half data set is reused
+        make_dataset(target, list(d.classes), d.per_class, noise, cfg.seed, workers=d.workers)
     return target
 
 
@@ -57,30 +74,36 @@ def read_items(data: Path) -> list[Item]:
     try:
         manifest = json.loads(path.read_text())
         return [Item(str(it["id"]), str(it["class"]), str(it["dir"])) for it in manifest["items"]]
-    except (OSError, json.JSONDecodeError, KeyError, TypeError) as e:
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError) as e:
         raise InputError(path, f"cannot read the data set manifest: {e}") from None
 
 
-def facts_dir(cfg: dict, out: Path, modality: str, refine: bool) -> Path:
-    root = Path(cfg["data"]["cache"]) / "facts" if cfg["data"]["cache"] else Path(out) / "facts"
+def facts_dir(cfg: StudyConfig, out: Path, modality: str, refine: bool) -> Path:
+    root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else Path(out) / "facts"
     return root / digest(data_key(cfg)) / facts_version() / f"{modality}-refine{int(refine)}"
 
 
-def _facts_job(args) -> str:
-    """Compute and store the facts of one image (runs in a worker process)."""
-    item_dir, scene_id, modality, refine, dest = args
+def facts_job(job: tuple, shared=None) -> dict:
+    """The cache record of one image's facts: ``{"facts": ..., "error": None or why the pipeline found
+    nothing}`` (runs in a worker; the caller writes it)."""
+    item_dir, scene_id, modality, refine = job
     from ..pipeline import scene_facts
     from ..rgbd import load_item
 
     try:
         facts = scene_facts(load_item(Path(item_dir)), scene_id, modality, refine=refine, confidences=True)
-        record = {"facts": facts.to_json(), "error": None}
+        return {"facts": facts.to_json(), "error": None}
     except InputError as e:  # e.g. no object found: the system sees an empty scene, and we count it
-        record = {"facts": SceneFacts(scene_id, modality, [], None).to_json(), "error": str(e)}
-    tmp = Path(dest).with_suffix(".tmp")
-    tmp.write_text(json.dumps(record))
-    os.replace(tmp, dest)
-    return scene_id
+        return {"facts": SceneFacts(scene_id, modality, [], None).to_json(), "error": str(e)}
+
+
+def _read_facts(path: Path) -> tuple[SceneFacts, str | None] | None:
+    """A cached record, or None when the file is missing or unreadable (it is then computed again)."""
+    try:
+        record = json.loads(path.read_text())
+        return SceneFacts.from_json(record["facts"], str(path)), record["error"]
+    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, InputError):
+        return None
 
 
 def without_confidences(facts: SceneFacts) -> SceneFacts:
@@ -90,32 +113,42 @@ def without_confidences(facts: SceneFacts) -> SceneFacts:
                       facts.target)
 
 
-def ensure_facts(cfg: dict, out: Path, data: Path, items: list[Item], modality: str, refine: bool,
-                 confidences: bool = True, workers: int = 1) -> tuple[dict[str, SceneFacts], dict[str, str]]:
+def ensure_facts(cfg: StudyConfig, out: Path, data: Path, items: list[Item], modality: str, refine: bool,
+                 confidences: bool = True, workers: int = 1, executor=None
+                 ) -> tuple[dict[str, SceneFacts], dict[str, str]]:
     """Facts of every item for one modality: ({id: SceneFacts}, {id: error} for scenes the pipeline
-    could not read). Missing cache entries are computed (in ``workers`` processes)."""
+    could not read). Missing or unreadable cache entries are computed (on ``executor``, default ``workers``
+    local processes) and written here as they come back."""
     dest = facts_dir(cfg, out, modality, refine)
     dest.mkdir(parents=True, exist_ok=True)
-    todo = [(str(data / it.dir), it.id, modality, refine, str(dest / f"{it.id}.json"))
-            for it in items if not (dest / f"{it.id}.json").is_file()]
+    clean_stale(dest)
+    have = {it.id: _read_facts(dest / f"{it.id}.json") for it in items}
+    todo = [it for it in items if have[it.id] is None]
     if todo:
-        desc = f"facts {modality} refine={refine}"
-        if workers > 1:
-            with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
-                for _ in tqdm(pool.map(_facts_job, todo), total=len(todo), desc=desc):
-                    pass
-        else:
-            for job in tqdm(todo, desc=desc):
-                _facts_job(job)
+        jobs = [(str(Path(data) / it.dir), it.id, modality, refine) for it in todo]
+        executor = executor or LocalExecutor(workers)
+        for i, record in tqdm(executor.map(facts_job, jobs, workers=workers), total=len(jobs),
+                              desc=f"facts {modality} refine={refine}"):
+            write_atomic(dest / f"{todo[i].id}.json", json.dumps(record))
+            have[todo[i].id] = (SceneFacts.from_json(record["facts"], todo[i].id), record["error"])
     facts, errors = {}, {}
     for it in items:
-        path = dest / f"{it.id}.json"
-        record = json.loads(path.read_text())
-        sf = SceneFacts.from_json(record["facts"], str(path))
+        sf, error = have[it.id]
         facts[it.id] = sf if confidences else without_confidences(sf)
-        if record["error"]:
-            errors[it.id] = record["error"]
+        if error:
+            errors[it.id] = error
     return facts, errors
+
+
+def _read_pixels(path: Path, items: list[Item], size: int) -> dict[str, np.ndarray] | None:
+    try:
+        with np.load(path) as z:
+            have = dict(zip(z["ids"].tolist(), z["x"]))
+    except (OSError, EOFError, ValueError, KeyError, zipfile.BadZipFile):
+        return None  # cut short or corrupt: computed again
+    if not all(it.id in have and have[it.id].shape == (4, size, size) for it in items):
+        return None
+    return {it.id: have[it.id] for it in items}
 
 
 def ensure_pixels(data: Path, items: list[Item], size: int) -> dict[str, np.ndarray]:
@@ -125,13 +158,12 @@ def ensure_pixels(data: Path, items: list[Item], size: int) -> dict[str, np.ndar
 
     path = Path(data) / f"pixels-{size}.npz"
     if path.is_file():
-        z = np.load(path)
-        have = dict(zip(z["ids"].tolist(), z["x"]))
-        if all(it.id in have for it in items):
-            return {it.id: have[it.id] for it in items}
+        got = _read_pixels(path, items, size)
+        if got is not None:
+            return got
     x = np.stack([frame_tensor(load_item(Path(data) / it.dir), "rgbd", size)
                   for it in tqdm(items, desc=f"pixels {size}x{size}")])
-    tmp = path.with_name(path.stem + ".tmp.npz")
-    np.savez_compressed(tmp, ids=np.array([it.id for it in items]), x=x)
-    os.replace(tmp, path)
+    buf = io.BytesIO()
+    np.savez_compressed(buf, ids=np.array([it.id for it in items]), x=x)
+    write_atomic(path, buf.getvalue())
     return {it.id: x[i] for i, it in enumerate(items)}

@@ -7,11 +7,13 @@ when the study has several conditions).
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 from pathlib import Path
 
-from .config import LOGIC_SYSTEMS
+from ..output import write_atomic
+from .config import LOGIC_SYSTEMS, StudyConfig
 from .folds import fold_path
 from .stats import mean_std, paired
 
@@ -40,19 +42,24 @@ def default_pairs(systems: list[str]) -> list[list[str]]:
     return pairs
 
 
-def summarise(out: Path, cfg: dict) -> tuple[dict, list[dict]]:
+def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[dict]]:
     """(summary of one condition, CSV rows) from its fold files."""
-    classes = list(cfg["data"]["classes"])
+    classes = list(cfg.data.classes)
     rows, summary = [], {"systems": {}, "tests": []}
     cells: dict[str, dict[tuple[int, str], float]] = {}
-    for s in cfg["systems"]:
-        recs = _load(out, cfg["_condition"], s, cfg["folds"])
+    for s in cfg.systems:
+        recs = _load(out, condition, s, cfg.folds)
         cells[s] = {}
-        per = {"folds_done": len(recs), "classes": {}, "errors": 0}
+        per = {"folds_done": len(recs), "classes": {}, "errors": 0, "learn_failures": 0, "learn_failure_examples": []}
         for r in recs:
             per["errors"] = max(per["errors"], len(r.get("pipeline_errors", {})))
+            for task, why in sorted(r.get("learn_failures", {}).items()):
+                for cls, reason in sorted(why.items()):
+                    per["learn_failures"] += 1
+                    if len(per["learn_failure_examples"]) < 3:
+                        per["learn_failure_examples"].append(f"fold {r['fold']} {task} {cls}: {reason}")
             for task, sc in r["tasks"].items():
-                rows.append({"condition": cfg["_condition"], "system": s, "fold": r["fold"], "task": task,
+                rows.append({"condition": condition, "system": s, "fold": r["fold"], "task": task,
                              "accuracy": sc["accuracy"], "balanced_accuracy": sc.get("balanced_accuracy", ""),
                              "n": sc["n"], "seconds": sc["seconds"]})
                 if task != "multiclass":
@@ -66,7 +73,7 @@ def summarise(out: Path, cfg: dict) -> tuple[dict, list[dict]]:
         per["seconds"] = sum(r["seconds"] for r in recs)
         per["code"] = sorted({r["code"] for r in recs if r.get("code")})
         summary["systems"][s] = per
-    for a, b in cfg["stats"]["pairs"] or default_pairs(cfg["systems"]):
+    for a, b in cfg.stats.pairs or default_pairs(list(cfg.systems)):
         common = sorted(set(cells[a]) & set(cells[b]))
         if common:
             t = paired([cells[a][c] for c in common], [cells[b][c] for c in common])
@@ -115,6 +122,13 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
                 lines.append(f"| {t['a']} | {t['b']} | {t['cells']} | {100 * t['mean_diff']:+.1f} | "
                              f"{100 * lo:+.1f} to {100 * hi:+.1f} | {sg['wins']} | "
                              f"{sg['losses']} | {sg['ties']} | {sg['p']:.4g} | {t['wilcoxon']['p']:.4g} |")
+        failing = {s: per for s, per in summ["systems"].items() if per.get("learn_failures")}
+        if failing:
+            lines += ["", "Classes the learner found no program for (their tasks answer \"unknown\", the negative "
+                      "answer; counted in the accuracies above):", ""]
+            for s, per in failing.items():
+                lines.append(f"- {s}: {per['learn_failures']} (" + "; ".join(per["learn_failure_examples"]) +
+                             ("; ..." if per["learn_failures"] > len(per["learn_failure_examples"]) else "") + ")")
         best = summ.get("against_best_cnn")
         if best:
             lo, hi = best["ci95"]
@@ -169,20 +183,21 @@ def plot(out: Path, summaries: dict[str, dict], classes: list[str]) -> None:
         plt.close(fig)
 
 
-def write_report(out: Path, cfg: dict, conds: dict[str, dict]) -> dict:
+def write_report(out: Path, cfg: StudyConfig, conds: dict[str, StudyConfig]) -> dict:
     """Write results.{csv,json,md} and the plots into ``out``; returns the summaries per condition."""
     out = Path(out)
     summaries, rows = {}, []
     for cname, c in conds.items():
-        summ, r = summarise(out, {**c, "_condition": cname})
+        summ, r = summarise(out, c, cname)
         summaries[cname] = summ
         rows += r
-    with open(out / "results.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, ["condition", "system", "fold", "task", "accuracy", "balanced_accuracy", "n", "seconds"])
-        w.writeheader()
-        w.writerows(rows)
-    (out / "results.json").write_text(json.dumps({"name": cfg["name"], "conditions": summaries}, indent=1))
-    classes = list(cfg["data"]["classes"])
-    (out / "results.md").write_text(markdown(cfg["name"], summaries, classes))
+    buf = io.StringIO(newline="")
+    w = csv.DictWriter(buf, ["condition", "system", "fold", "task", "accuracy", "balanced_accuracy", "n", "seconds"])
+    w.writeheader()
+    w.writerows(rows)
+    write_atomic(out / "results.csv", buf.getvalue())
+    write_atomic(out / "results.json", json.dumps({"name": cfg.name, "conditions": summaries}, indent=1))
+    classes = list(cfg.data.classes)
+    write_atomic(out / "results.md", markdown(cfg.name, summaries, classes))
     plot(out, summaries, classes)
     return summaries

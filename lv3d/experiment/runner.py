@@ -4,13 +4,20 @@ under ``<out>/folds/``, skipped on a rerun when it was made from the same settin
 systems, the same version of lv3d's code: see code_version.py).
 
 Every system sees the same images, folds and training samples: the samples are drawn from seeds
-that depend on (study seed, fold, class) only, never on the system.
+that depend on (study seed, fold, class) only, never on the system. The cells (condition, system, fold)
+are independent jobs, run one after another here or on an executor (executor.py: local processes or a
+Dask cluster) with the same results; this process alone writes into ``--out``, which it holds locked.
+
+A class the learner finds no program for (its search runs out of time, nothing covers the positives,
+perception found no object in any positive) is recorded in the fold file under ``learn_failures`` with
+the reason, and counted in the report; a learn call that fails for a reason of the input stops the study.
 """
 
 from __future__ import annotations
 
 import json
-import os
+import shutil
+import tempfile
 import time
 from pathlib import Path
 
@@ -18,10 +25,11 @@ import numpy as np
 import yaml
 from tqdm import tqdm
 
-from ..output import claim
+from ..output import claim, clean_stale, locked, write_atomic
 from . import data as data_mod
 from .code_version import learner_version
-from .config import LOGIC_SYSTEMS, conditions, digest, load_config
+from .config import LOGIC_SYSTEMS, Study, StudyConfig, digest, load_study
+from .executor import LocalExecutor
 from .folds import Item, class_task, fold_path, multiclass_task, split, stratified_folds
 from .report import write_report
 from .systems import make_system, modality_of, negative_label
@@ -32,19 +40,22 @@ def task_seed(seed: int, fold: int, task: int, draw: int = 0) -> int:
     return int(np.random.SeedSequence([seed, fold, task] + ([draw] if draw else [])).generate_state(1)[0])
 
 
-def result_key(cfg: dict, system: str, fold: int) -> str:
+def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
     """What a fold result depends on: a finished result with another key is recomputed."""
-    relevant = {k: cfg[k] for k in ("seed", "folds", "data", "train")}
+    d = cfg.to_dict() if isinstance(cfg, StudyConfig) else cfg
+    relevant = {k: d[k] for k in ("seed", "folds", "data", "train")}
     if relevant["train"].get("draws") == 1:  # one draw is the protocol from before draws: its results keep their keys
         relevant["train"] = {k: v for k, v in relevant["train"].items() if k != "draws"}
     relevant["system"] = system
     relevant["fold"] = fold
     if system in LOGIC_SYSTEMS:
-        relevant["settings"] = {k: v for k, v in cfg["lv3d"].items() if k != "workers"}  # workers: speed only
+        relevant["settings"] = {k: v for k, v in d["lv3d"].items() if k != "workers"}  # workers: speed only
         relevant["code"] = learner_version()  # changed perception, grounding or learner: recompute
     else:
-        relevant["settings"] = cfg["baselines"]
-    relevant["data"] = data_mod.data_key(cfg)
+        relevant["settings"] = d["baselines"]
+    relevant["data"] = {"classes": d["data"]["classes"], "per_class": d["data"]["per_class"],
+                        "noise": d["data"]["noise"], "noise_overrides": d["data"]["noise_overrides"] or {},
+                        "seed": d["seed"]}
     return digest(relevant)
 
 
@@ -64,20 +75,24 @@ def score_binary(preds: list[tuple[str, float]], test: list[Item], cls: str) -> 
             "tp": tp, "fp": fp, "tn": tn, "fn": fn, "n": n}
 
 
-def run_fold(system, cfg: dict, train: list[Item], test: list[Item], fold: int,
+def run_fold(system, cfg: StudyConfig, train: list[Item], test: list[Item], fold: int,
              programs: Path | None) -> dict:
     """Train and test every task of one fold for one bound system; returns the fold's record.
 
     With ``train.draws`` > 1 each task is trained on that many independently seeded samples: its accuracies
     are their means, its counts their sums, ``per_draw`` lists each draw's accuracy, its predictions and
-    programs are per draw (``draw<d>``); draw 0 is the sample one draw takes."""
-    t = cfg["train"]
-    draws = t.get("draws", 1)
-    classes = list(cfg["data"]["classes"])
+    programs are per draw (``draw<d>``); draw 0 is the sample one draw takes. ``learn_failures`` maps a
+    task (``task`` or ``task/draw<d>``) to {class: why no program was learned}."""
+    t = cfg.train
+    draws = t.draws
+    classes = list(cfg.data.classes)
     test_ids = [it.id for it in test]
-    record: dict = {"tasks": {}, "predictions": {}}
+    record: dict = {"tasks": {}, "predictions": {}, "learn_failures": {}}
 
     def save(fitted, task: str, d: int) -> None:
+        failures = dict(getattr(fitted, "failures", None) or {})
+        if failures:
+            record["learn_failures"][task if draws == 1 else f"{task}/draw{d}"] = failures
         if programs is not None:
             fitted.save(programs / task if draws == 1 else programs / task / f"draw{d}")
 
@@ -96,8 +111,8 @@ def run_fold(system, cfg: dict, train: list[Item], test: list[Item], fold: int,
     for j, cls in enumerate(classes):
         scores, preds = [], []
         for d in range(draws):
-            seed = task_seed(cfg["seed"], fold, j, d)
-            examples, positive = class_task(train, cls, t["positives"], t["negatives_per_positive"], seed)
+            seed = task_seed(cfg.seed, fold, j, d)
+            examples, positive = class_task(train, cls, t.positives, t.negatives_per_positive, seed)
             labels = [cls if p else negative_label(cls) for p in positive]
             t0 = time.perf_counter()
             fitted = system.fit([it.id for it in examples], labels, seed, positive=cls)
@@ -108,11 +123,11 @@ def run_fold(system, cfg: dict, train: list[Item], test: list[Item], fold: int,
             scores.append(score)
             save(fitted, cls, d)
         keep(cls, scores, preds)
-    if t["multiclass"]:
+    if t.multiclass:
         scores, preds = [], []
         for d in range(draws):
-            seed = task_seed(cfg["seed"], fold, len(classes), d)
-            examples = multiclass_task(train, t["positives"], seed)
+            seed = task_seed(cfg.seed, fold, len(classes), d)
+            examples = multiclass_task(train, t.positives, seed)
             t0 = time.perf_counter()
             fitted = system.fit([it.id for it in examples], [it.cls for it in examples], seed)
             preds.append(fitted.predict(test_ids))
@@ -121,14 +136,33 @@ def run_fold(system, cfg: dict, train: list[Item], test: list[Item], fold: int,
                            "seconds": round(time.perf_counter() - t0, 3)})
             save(fitted, "multiclass", d)
         keep("multiclass", scores, preds)
+    if not record["learn_failures"]:
+        del record["learn_failures"]
     return record
+
+
+def run_cell(job: tuple, inputs: dict) -> tuple[dict, dict[str, str]]:
+    """One (condition, system, fold) cell, wherever it runs: (its record, its programs as {relative path:
+    text}). ``job``: (condition config, system, fold, training items, test items)."""
+    ccfg, sname, k, train, test = job
+    system = make_system(sname, ccfg, inputs)
+    t0 = time.perf_counter()
+    files: dict[str, str] = {}
+    if sname in LOGIC_SYSTEMS:
+        with tempfile.TemporaryDirectory(prefix="lv3d-programs-") as tmp:
+            record = run_fold(system, ccfg, train, test, k, Path(tmp))
+            files = {str(p.relative_to(tmp)): p.read_text() for p in sorted(Path(tmp).rglob("*")) if p.is_file()}
+    else:
+        record = run_fold(system, ccfg, train, test, k, None)
+    record["seconds"] = round(time.perf_counter() - t0, 3)
+    return record, files
 
 
 class _Inputs:
     """What each system sees, computed on first use (facts per modality, pixels once)."""
 
-    def __init__(self, cfg: dict, out: Path, data: Path, items: list[Item]):
-        self.cfg, self.out, self.data, self.items = cfg, out, data, items
+    def __init__(self, cfg: StudyConfig, out: Path, data: Path, items: list[Item], executor=None):
+        self.cfg, self.out, self.data, self.items, self.executor = cfg, out, data, items, executor
         self._facts: dict[str, dict] = {}
         self._pixels = None
         self.errors: dict[str, dict[str, str]] = {}
@@ -137,38 +171,53 @@ class _Inputs:
         if name in LOGIC_SYSTEMS:
             m = modality_of(name)
             if m not in self._facts:
-                lv = self.cfg["lv3d"]
+                lv = self.cfg.lv3d
                 self._facts[m], self.errors[m] = data_mod.ensure_facts(
-                    self.cfg, self.out, self.data, self.items, m, lv["refine"], lv["confidences"], lv["workers"])
+                    self.cfg, self.out, self.data, self.items, m, lv.refine, lv.confidences, lv.workers,
+                    executor=self.executor)
             return self._facts[m]
         if self._pixels is None:
-            self._pixels = data_mod.ensure_pixels(self.data, self.items, self.cfg["baselines"]["image_size"])
+            self._pixels = data_mod.ensure_pixels(self.data, self.items, self.cfg.baselines.image_size)
         return self._pixels
 
 
 def _write_json(path: Path, obj) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(obj, indent=1))
-    os.replace(tmp, path)  # a fold file is complete or absent, never half-written
+    write_atomic(path, json.dumps(obj, indent=1))  # a fold file is complete or absent, never half-written
 
 
-def run_study(config: Path, out: Path, overrides: list[str] = (), progress: bool = True) -> dict:
+def _write_programs(folder: Path, files: dict[str, str]) -> None:
+    """The programs of one cell, replacing what an earlier run of the cell left there."""
+    if folder.exists():
+        shutil.rmtree(folder)
+    for rel, text in files.items():
+        write_atomic(folder / rel, text)
+
+
+def run_study(config: Path, out: Path, overrides: list[str] = (), progress: bool = True, executor=None) -> dict:
     """Run (or resume) the study of ``config`` into ``out``; writes the fold files and the report.
-    Returns ``{"ran": n, "skipped": n, "report": summary}``."""
+    ``executor``: where the cells run (default: one after another in this process).
+    Returns ``{"ran": n, "skipped": n, "report": summary, "learn_failures": n}``."""
     config, out = Path(config), Path(out)
-    cfg = load_config(config, list(overrides))
-    conds = conditions(cfg, config)
+    study = load_study(config, list(overrides))
     claim(out, (config,), own=_is_study)  # a new, empty or lv3d-written folder; filled in place, so it resumes
-    (out / "config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
-    jobs = [(c, s, k) for c in conds for s in conds[c]["systems"] for k in range(conds[c]["folds"])]
-    ran = skipped = 0
+    with locked(out):
+        return _run(study, out, progress, executor or LocalExecutor(1))
+
+
+def _run(study: Study, out: Path, progress: bool, executor) -> dict:
+    conds = study.conditions
+    write_atomic(out / "config.yaml", yaml.safe_dump(study.merged, sort_keys=False))
+    for p in (out / "folds").glob("*/*") if (out / "folds").is_dir() else ():
+        clean_stale(p)  # fold files a killed run was writing
+    jobs = [(c, s, k) for c in conds for s in conds[c].systems for k in range(conds[c].folds)]
+    ran = skipped = failed = 0
     done = _finished_keys(out)
-    bar = tqdm(total=len(jobs), desc=cfg["name"], disable=not progress)
+    bar = tqdm(total=len(jobs), desc=study.name, disable=not progress)
+    remote = executor if getattr(executor, "name", "local") != "local" else None
     for cname, ccfg in conds.items():
         pending = []
-        for s in ccfg["systems"]:
-            for k in range(ccfg["folds"]):
+        for s in ccfg.systems:
+            for k in range(ccfg.folds):
                 path, key = fold_path(out, cname, s, k), result_key(ccfg, s, k)
                 if _finished(path, key):
                     continue
@@ -177,32 +226,37 @@ def run_study(config: Path, out: Path, overrides: list[str] = (), progress: bool
                     _write_json(path, {**record, "condition": cname, "reused_from": str(done[key].relative_to(out))})
                     continue
                 pending.append((s, k))
-        skipped += ccfg["folds"] * len(ccfg["systems"]) - len(pending)
-        bar.update(ccfg["folds"] * len(ccfg["systems"]) - len(pending))
+        skipped += ccfg.folds * len(ccfg.systems) - len(pending)
+        bar.update(ccfg.folds * len(ccfg.systems) - len(pending))
         if not pending:
             continue
         data = data_mod.ensure_dataset(ccfg, out)
         items = data_mod.read_items(data)
-        folds = stratified_folds(items, ccfg["folds"], ccfg["seed"])
-        inputs = _Inputs(ccfg, out, data, items)
+        folds = stratified_folds(items, ccfg.folds, ccfg.seed)
+        inputs = _Inputs(ccfg, out, data, items, remote)
+        by_system: dict[str, list[int]] = {}
         for sname, k in pending:
-            bar.set_postfix_str(f"{cname} {sname} fold {k}")
-            system = make_system(sname, ccfg, inputs.for_system(sname))
-            train, test = split(folds, k)
-            programs = out / "programs" / cname / sname / f"fold{k}" if sname in LOGIC_SYSTEMS else None
-            t0 = time.perf_counter()
-            record = run_fold(system, ccfg, train, test, k, programs)
-            record.update(key=result_key(ccfg, sname, k), condition=cname, system=sname, fold=k,
-                          test_ids=[it.id for it in test], seconds=round(time.perf_counter() - t0, 3),
-                          pipeline_errors=inputs.errors.get(modality_of(sname), {}) if sname in LOGIC_SYSTEMS else {},
-                          code=learner_version() if sname in LOGIC_SYSTEMS else None)
-            _write_json(fold_path(out, cname, sname, k), record)
-            done.setdefault(record["key"], fold_path(out, cname, sname, k))
-            ran += 1
-            bar.update(1)
+            by_system.setdefault(sname, []).append(k)
+        for sname, ks in by_system.items():
+            shared = inputs.for_system(sname)
+            cells = [(ccfg, sname, k, *split(folds, k)) for k in ks]
+            bar.set_postfix_str(f"{cname} {sname}")
+            for i, (record, files) in executor.map(run_cell, cells, shared):
+                k, test = ks[i], cells[i][4]
+                if sname in LOGIC_SYSTEMS:
+                    _write_programs(out / "programs" / cname / sname / f"fold{k}", files)
+                record.update(key=result_key(ccfg, sname, k), condition=cname, system=sname, fold=k,
+                              test_ids=[it.id for it in test],
+                              pipeline_errors=inputs.errors.get(modality_of(sname), {}) if sname in LOGIC_SYSTEMS
+                              else {}, code=learner_version() if sname in LOGIC_SYSTEMS else None)
+                _write_json(fold_path(out, cname, sname, k), record)
+                done.setdefault(record["key"], fold_path(out, cname, sname, k))
+                failed += sum(len(v) for v in record.get("learn_failures", {}).values())
+                ran += 1
+                bar.update(1)
     bar.close()
-    summary = write_report(out, cfg, conds)
-    return {"ran": ran, "skipped": skipped, "report": summary}
+    summary = write_report(out, study.base, conds)
+    return {"ran": ran, "skipped": skipped, "report": summary, "learn_failures": failed}
 
 
 def _is_study(folder: Path) -> bool:
@@ -216,7 +270,7 @@ def _finished_keys(out: Path) -> dict[str, Path]:
     for p in sorted((Path(out) / "folds").glob("*/*/fold*.json")):
         try:
             keys.setdefault(json.loads(p.read_text())["key"], p)
-        except (OSError, json.JSONDecodeError, KeyError):
+        except (OSError, ValueError, KeyError, TypeError):
             continue
     return keys
 
@@ -226,5 +280,5 @@ def _finished(path: Path, key: str) -> bool:
         return False
     try:
         return json.loads(path.read_text()).get("key") == key
-    except (OSError, json.JSONDecodeError):
+    except (OSError, ValueError, AttributeError):
         return False

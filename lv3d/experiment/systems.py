@@ -2,9 +2,9 @@
 
 ``make_system(name, cfg, inputs)`` binds a system to what it sees of every image (``inputs``: id ->
 SceneFacts for lv3d-*, id -> (4, S, S) pixel tensor for the baselines). ``fit(ids, labels, seed)``
-returns a fitted system whose ``predict(ids)`` gives (label, confidence) per image and whose
+returns a fitted system whose ``predict(ids)`` gives (label, confidence) per image, whose
 ``save(folder)`` writes what it learned that a person can read (the lv3d programs; nothing for
-the baselines). Labels are strings: class names, or ``not_<class>`` for the negatives of a class task.
+the baselines) and whose ``failures`` says, per class it could learn no program for, why. Labels are strings: class names, or ``not_<class>`` for the negatives of a class task.
 """
 
 from __future__ import annotations
@@ -14,10 +14,12 @@ from typing import Protocol
 
 import numpy as np
 
-from .config import LOGIC_SYSTEMS
+from .config import LOGIC_SYSTEMS, BaselineConfig, StudyConfig
 
 
 class Fitted(Protocol):
+    failures: dict[str, str]
+
     def predict(self, ids: list[str]) -> list[tuple[str, float]]: ...
 
     def save(self, folder: Path) -> None: ...
@@ -48,16 +50,20 @@ class LogicSystem:
         keep = [(self.facts[i], y) for i, y in zip(ids, labels) if self.facts[i].target is not None]
         present = {y for _, y in keep}
         classes = [c for c in ([positive] if positive else sorted(present)) if c in present]
+        wanted = [positive] if positive else sorted(set(labels))
+        missing = {c: "perception found no object in any of its training images" for c in wanted if c not in present}
         if not classes:  # perception found no object in any positive: nothing to learn from
-            return FittedLogic(Model({}, self.settings), self.facts)
+            return FittedLogic(Model({}, self.settings), self.facts, missing)
         model = Model.fit([f for f, _ in keep], [y for _, y in keep], settings=self.settings or None, seed=seed,
                           classes=classes)
-        return FittedLogic(model, self.facts)
+        return FittedLogic(model, self.facts, missing)
 
 
 class FittedLogic:
-    def __init__(self, model, facts: dict):
+    def __init__(self, model, facts: dict, missing: dict[str, str] | None = None):
         self.model, self.facts = model, facts
+        # class -> why no program was learned for it (the learner's reasons, and classes without examples)
+        self.failures = {**dict(missing or {}), **dict(getattr(model, "failures", None) or {})}
 
     def predict(self, ids: list[str]) -> list[tuple[str, float]]:
         """(label, confidence of the best proof); "unknown" where no program proves the target (or
@@ -79,7 +85,7 @@ class FittedLogic:
 class PixelSystem:
     """A CNN or a decision tree over the pixel tensors of one modality."""
 
-    def __init__(self, name: str, pixels: dict[str, np.ndarray], baselines: dict):
+    def __init__(self, name: str, pixels: dict[str, np.ndarray], baselines: BaselineConfig):
         self.name, self.pixels, self.b = name, pixels, baselines
         self.modality = modality_of(name)
         self.channels = {"rgb": slice(0, 3), "depth": slice(3, 4), "rgbd": slice(0, 4)}[self.modality]
@@ -93,17 +99,19 @@ class PixelSystem:
 
         b = self.b
         if self.name.startswith("tree-"):
-            model = PixelTree(cells=b["tree_cells"], min_samples_leaf=b["tree_min_samples_leaf"])
+            model = PixelTree(cells=b.tree_cells, min_samples_leaf=b.tree_min_samples_leaf)
         else:
-            settings = CNNSettings(epochs=b["epochs"], batch_size=b["batch_size"], lr=b["lr"],
-                                   weight_decay=b["weight_decay"], augment=b["augment"], width=b["width"],
-                                   threads=b["threads"], patience=b["patience"], val_fraction=b["val_fraction"])
+            settings = CNNSettings(epochs=b.epochs, batch_size=b.batch_size, lr=b.lr, weight_decay=b.weight_decay,
+                                   augment=b.augment, width=b.width, threads=b.threads, patience=b.patience,
+                                   val_fraction=b.val_fraction)
             model = CNNClassifier(self.modality, "twostream" if self.name.endswith("-2s") else "early", settings)
         model.fit(self._x(ids), labels, seed=seed)
         return FittedPixels(model, self)
 
 
 class FittedPixels:
+    failures: dict[str, str] = {}
+
     def __init__(self, model, system: PixelSystem):
         self.model, self.system = model, system
 
@@ -114,7 +122,7 @@ class FittedPixels:
         """Nothing a person can read: the baselines' weights are not kept."""
 
 
-def make_system(name: str, cfg: dict, inputs: dict):
+def make_system(name: str, cfg: StudyConfig, inputs: dict):
     if name in LOGIC_SYSTEMS:
-        return LogicSystem(name, inputs, cfg["lv3d"]["settings"])
-    return PixelSystem(name, inputs, cfg["baselines"])
+        return LogicSystem(name, inputs, cfg.lv3d.settings)
+    return PixelSystem(name, inputs, cfg.baselines)

@@ -70,6 +70,8 @@ def derived_preds() -> tuple[tuple[str, int], ...]:
 
 
 def _value(v) -> str:
+    if isinstance(v, bool):  # Prolog's true and false, not 1 and 0
+        return "true" if v else "false"
     if isinstance(v, str):
         return quote(v)
     if isinstance(v, (list, tuple)):

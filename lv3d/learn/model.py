@@ -12,6 +12,7 @@ from ..facts import PREDICATES, SceneFacts
 from . import engine
 from .engine import LearnError
 from .program import Program
+from .settings import check_settings
 
 # Metarules for shape concepts, in search order: a part with a property, a part with two, a
 # conjunction on the object, then a part in a relation with another part.
@@ -90,7 +91,7 @@ def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: d
     neg = [s.target for s, y in zip(scenes, labels) if y != target]
     if not pos:
         raise InputError("labels", f"no scene is labelled {target!r}")
-    opts = {**SHAPE_SETTINGS, **(settings or {}), "seed": int(seed)}
+    opts = {**SHAPE_SETTINGS, **check_settings(settings), "seed": int(seed)}
     preds = engine.plist(f"{p}/{a}" for p, a in body_preds(modality))
     mrs = engine.plist(opts.pop("metarules", SHAPE_METARULES))
     goal = (f"{_load(FIT_MODULE, scenes)}, "
@@ -162,6 +163,7 @@ class Model:
             classes: list[str] | None = None) -> "Model":
         """A program for each class in ``classes`` (default: every label). A class whose search finds
         nothing or runs out of time gets no program (it is never predicted); ``failures`` says why."""
+        settings = check_settings(settings) or None  # a bad setting stops here, not as every class's failure
         programs, failures = {}, {}
         for c in classes or sorted(set(labels)):
             try:

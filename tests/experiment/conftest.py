@@ -99,7 +99,7 @@ def _synthetic_data_and_facts(monkeypatch):
     def ensure_dataset(cfg, out):
         target = data_mod.dataset_dir(cfg, out)
         if not (target / "manifest.json").is_file():
-            write_dataset(target, cfg["data"]["classes"], cfg["data"]["per_class"], cfg["seed"])
+            write_dataset(target, cfg.data.classes, cfg.data.per_class, cfg.seed)
         return target
 
     monkeypatch.setattr(data_mod, "ensure_dataset", ensure_dataset)

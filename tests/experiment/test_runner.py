@@ -95,7 +95,7 @@ def test_learner_settings_reach_the_learner(tmp_path, tiny_config, fake_world):
 
 
 def test_draws_average_independent_samples_and_one_draw_keeps_the_old_keys(tmp_path, tiny_config, fake_world):
-    from lv3d.experiment.config import conditions, load_config
+    from lv3d.experiment.config import load_study
     from lv3d.experiment.runner import result_key
 
     one, three = tmp_path / "one", tmp_path / "three"
@@ -112,8 +112,7 @@ def test_draws_average_independent_samples_and_one_draw_keeps_the_old_keys(tmp_p
     positives = lambda sc: sc["tp"] + sc["fn"]  # noqa: E731
     assert positives(r3["tasks"]["cube"]) == 3 * positives(r1["tasks"]["cube"])
     # a study written before draws existed (no train.draws) has the key a one-draw study has now
-    cfg = load_config(tiny_config, sets)
-    ccfg = conditions(cfg, tiny_config)["base"]
+    ccfg = load_study(tiny_config, sets).conditions["base"].to_dict()
     before = {**ccfg, "train": {k: v for k, v in ccfg["train"].items() if k != "draws"}}
     assert result_key(ccfg, "tree-rgbd", 0) == result_key(before, "tree-rgbd", 0)
     three_draws = {**ccfg, "train": {**ccfg["train"], "draws": 3}}
@@ -124,8 +123,8 @@ def test_draws_must_be_a_positive_integer(tmp_path, tiny_config):
     import pytest
 
     from lv3d.errors import InputError
-    from lv3d.experiment.config import load_config
+    from lv3d.experiment.config import load_study
 
     for bad in ("0", "1.5", "true"):
         with pytest.raises(InputError, match="train.draws"):
-            load_config(tiny_config, [f"train.draws={bad}"])
+            load_study(tiny_config, [f"train.draws={bad}"])

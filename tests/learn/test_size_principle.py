@@ -32,7 +32,7 @@ def test_prefers_the_hypothesis_true_of_fewer_objects():
     assert "square(B)" in prog.clauses[0] and "quadrilateral" not in prog.clauses[0]
     # without the size principle the caller's predicate order decides: quadrilateral comes first
     old = fit(scenes, labels, "box", settings={"metarules": ["part"], "disjunctions": 0,
-                                                "size_principle": "false"})
+                                                "size_principle": False})
     assert "quadrilateral(B)" in old.clauses[0]
 
 

@@ -1,0 +1,128 @@
+"""Where a study's independent jobs run: its cells (condition, system, fold) and the facts of its images.
+
+- :class:`LocalExecutor` (the default): ``workers`` processes of this machine (started by spawn, each dying
+  with this process: lv3d.workers); one worker runs the jobs in this process, one after another.
+- :class:`DaskExecutor`: the workers of a Dask distributed cluster, at ``address`` (``tcp://host:8786``,
+  started with ``dask scheduler`` and ``dask worker ... --nthreads 1``) or, without one, a cluster of
+  ``workers`` processes on this machine. The workers must have lv3d installed and see the study's data
+  folder at the same path (a shared file system); what they compute comes back to this process, which
+  alone writes into ``--out``.
+
+A job is ``fn(job, shared)``: ``shared`` (the facts or pixels every cell of a system reads) is sent once
+per map to a Dask cluster, with each job to local processes. Each job computes from its own seeds only,
+so the results are the same, bit for bit, wherever and in whatever order the jobs run.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from typing import Any
+
+from ..errors import InputError
+
+EXECUTORS = ("local", "dask")
+
+
+class LocalExecutor:
+    name = "local"
+
+    def __init__(self, workers: int = 1):
+        self.workers = max(1, int(workers))
+        self._pool = None
+
+    def map(self, fn: Callable, jobs: list, shared: Any = None, workers: int | None = None
+            ) -> Iterator[tuple[int, Any]]:
+        """(index of the job, its result), as jobs finish. ``workers``: at most this many processes for this
+        map (default: the executor's)."""
+        n = min(self.workers if workers is None else max(1, workers), len(jobs))
+        if n <= 1:
+            for i, job in enumerate(jobs):
+                yield i, fn(job, shared)
+            return
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+        from multiprocessing import get_context
+
+        from ..workers import die_with_parent
+
+        with ProcessPoolExecutor(n, mp_context=get_context("spawn"), initializer=die_with_parent) as pool:
+            futures = {pool.submit(fn, job, shared): i for i, job in enumerate(jobs)}
+            try:
+                for f in as_completed(futures):
+                    yield futures[f], _result(f)
+            except BaseException:
+                for f in futures:
+                    f.cancel()
+                raise
+
+    def close(self) -> None:
+        pass
+
+
+def _result(future):
+    from concurrent.futures.process import BrokenProcessPool
+
+    try:
+        return future.result()
+    except BrokenProcessPool as e:
+        raise RuntimeError(f"a worker process died ({e}); rerun to resume") from None
+
+
+class DaskExecutor:
+    """Jobs on a Dask distributed cluster: ``address`` of its scheduler, or (None) a local cluster of
+    ``workers`` processes (``processes=False``: threads of this process, for tests)."""
+
+    name = "dask"
+
+    def __init__(self, address: str | None = None, workers: int = 1, processes: bool = True):
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:
+            raise InputError("--executor", "dask needs the 'distributed' package (pip install distributed)") from None
+        self._cluster = None
+        try:
+            if address:
+                self.client = Client(address, timeout="20s")
+            else:
+                self._cluster = LocalCluster(n_workers=max(1, int(workers)), threads_per_worker=1,
+                                             processes=processes, dashboard_address=None)
+                self.client = Client(self._cluster)
+        except (OSError, TimeoutError) as e:
+            self.close()
+            raise InputError("--address", f"cannot reach the Dask scheduler at {address}: {e}") from None
+
+    def map(self, fn: Callable, jobs: list, shared: Any = None, workers: int | None = None
+            ) -> Iterator[tuple[int, Any]]:
+        from distributed import as_completed
+
+        if not jobs:
+            return
+        handle = self.client.scatter(shared, broadcast=True) if shared is not None else None
+        futures = [self.client.submit(fn, job, handle, pure=False) for job in jobs]
+        index = {f.key: i for i, f in enumerate(futures)}
+        try:
+            for f in as_completed(futures):
+                yield index[f.key], f.result()
+        except BaseException:
+            self.client.cancel(futures)
+            raise
+        finally:
+            del handle
+
+    def close(self) -> None:
+        client, self.client = getattr(self, "client", None), None
+        if client is not None:
+            client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+            self._cluster = None
+
+
+def make_executor(kind: str = "local", workers: int = 1, address: str | None = None):
+    """The executor named ``kind`` (:data:`EXECUTORS`); InputError for an unknown name or a bad pairing."""
+    if kind not in EXECUTORS:
+        raise InputError("--executor", f"unknown executor {kind!r}; known: {', '.join(EXECUTORS)}")
+    if address and kind != "dask":
+        raise InputError("--address", "an address needs --executor dask")
+    if kind == "dask":
+        return DaskExecutor(address, workers)
+    return LocalExecutor(workers)
