@@ -35,3 +35,13 @@ def test_the_top_level_table_picks_the_best_baseline_and_keeps_its_labels(mod):
     label = lines[i].split("|")[1]
     lines[i] = f"|{label}| 1.0 / 2.0 (depth) | 3.0 / 4.0 (rgbd) |"
     assert mod.rewrite_top("\n".join(lines)) == text
+
+
+def test_a_changed_replicate_figure_is_rewritten(mod):
+    text = mod.README.read_text()
+    lines = text.split("\n")
+    i = next(k for k, line in enumerate(lines) if line.startswith("| 3 | realsense |"))
+    cells = lines[i].split("|")
+    cells[3] = " 1.0 / 2.0 "
+    lines[i] = "|".join(cells)
+    assert mod.rewrite("\n".join(lines)) == text
