@@ -139,7 +139,7 @@ learn_noisy(Task, Settings0, Best, Score) :-
 %   knows to generalise badly from one view: docs/learner.md).
 %   Then the old key (Soft, support, cost, order).
 %   Only for few-shot tasks (at most few_shot(K) positives): with many positives the n log |h|
-%   term favours the most specific of J's ties, which cost a multi-class scene on both dev seeds.
+%   term favours the most specific of J's ties, and J has the data to decide.
 best_specific(_, Settings, Pos, All, Best, Score) :-
     (   option(size_principle(false), Settings) -> true
     ;   option(few_shot(K), Settings), length(Pos, NP), NP > K

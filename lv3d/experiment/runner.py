@@ -44,7 +44,7 @@ def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
     """What a fold result depends on: a finished result with another key is recomputed."""
     d = cfg.to_dict() if isinstance(cfg, StudyConfig) else cfg
     relevant = {k: d[k] for k in ("seed", "folds", "data", "train")}
-    if relevant["train"].get("draws") == 1:  # one draw is the protocol from before draws: its results keep their keys
+    if relevant["train"].get("draws") == 1:  # one draw: the key leaves draws out, as results made without it have
         relevant["train"] = {k: v for k, v in relevant["train"].items() if k != "draws"}
     relevant["system"] = system
     relevant["fold"] = fold

@@ -23,9 +23,9 @@ SHAPE_METARULES = ("part", "part2", "part_pair")
 NEAR_MISS = 0.1
 # Learning from many examples (docs/learner.md, "Imperfect labels"): 16 samples of 2 positives and
 # 6 negatives; with 20 % wrong labels, 3 to 7 of them hold none, where 8 samples of 2 + 12 held 0.3 to 2.
-# In few-shot tasks a `regular` literal costs 0.5 nats of prior (docs/learner.md, issue 6): every class
-# shows a regular face in most views, so among the clauses one positive cannot tell apart those
-# resting on it were 4 points less accurate held out (dev seeds 778 and 1234, rgbd and depth alike).
+# In few-shot tasks a `regular` literal costs 0.5 nats of prior (docs/learner.md, Settings): every class
+# shows a regular face in most views, so among the clauses one positive cannot tell apart, those
+# resting on it generalise worst.
 SHAPE_SETTINGS = {"max_clauses": 1, "max_inventions": 0, "time_limit": 20, "disjunctions": 20, "extra_literals": 1,
                   "samples": 16, "sample_neg": 6, "predicate_prior": [["regular", 0.5]]}
 FIT_MODULE, SCENE_MODULE = "lv3d_fit", "lv3d_scene"

@@ -42,8 +42,8 @@ def test_normals_within_an_object_leave_the_wall_behind_it_out():
 
 
 def test_heavy_noise_lies_between_the_realsense_and_hard_presets():
-    # slope noise in pixel footprints over the renders' focal length (615 px): the most the 490 realsense frames of
-    # the dev seeds read, and the least the hard preset's read (docs/perception.md, session 26)
+    # slope noise in pixel footprints over the renders' focal length (615 px): the most that 490 realsense frames
+    # of the benchmark's seeds read, and the least that the hard preset's read
     assert not heavy_noise(2.77 / 615)
     assert heavy_noise(3.65 / 615)
 

@@ -1,5 +1,6 @@
-"""The original presets render bit-identically whatever appearance knobs exist beside them: colour,
-depth, face mask and ground truth of fixed scenes are pinned by their sha256."""
+"""The presets clean, mild, realsense and hard, which use none of the realism knobs (printed faces, multi-hue
+solids, contacts, small tables), render bit-identically whatever knobs exist beside them: colour, depth, face
+mask and ground truth of fixed scenes are pinned by their sha256."""
 
 import hashlib
 import json
@@ -113,7 +114,7 @@ PINNED = [
      "1c050bc64e1f7635f29ffee60c6deb1378eaa6e8b206d592383302c4ce3dd901"),
 ]
 
-# truth keys that the old presets carry besides the pinned ones: no contacts, and the target stands on the table
+# truth keys these presets carry besides the pinned ones: no contacts, and the target stands on the table
 _ADDED_TRUTH_KEYS = ("contacts", "table_plane")
 
 
@@ -123,7 +124,7 @@ def _sha(b: bytes) -> str:
 
 @pytest.mark.parametrize("preset, cls, seed, width, height, color, depth, faces, truth", PINNED,
                          ids=[f"{p[0]}-{p[1]}-{p[3]}" for p in PINNED])
-def test_old_presets_render_bit_identically(preset, cls, seed, width, height, color, depth, faces, truth):
+def test_presets_without_realism_knobs_render_bit_identically(preset, cls, seed, width, height, color, depth, faces, truth):
     frame, mask = render_scene(cls, seed, preset, width, height)
     assert _sha(frame.color.tobytes()) == color
     assert _sha(frame.depth.tobytes()) == depth
