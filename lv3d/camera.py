@@ -36,15 +36,18 @@ class Intrinsics:
     @classmethod
     def from_dict(cls, d: dict, where: str = "intrinsics") -> "Intrinsics":
         """Build from a mapping with fx, fy, cx, cy, width, height; validate (InputError on absurd values)."""
-        try:
-            k = cls(
-                fx=float(d["fx"]), fy=float(d["fy"]), cx=float(d["cx"]), cy=float(d["cy"]),
-                width=int(d["width"]), height=int(d["height"]),
-            )
-        except KeyError as e:
-            raise InputError(where, f"intrinsics lack {e.args[0]!r} (need fx, fy, cx, cy, width, height)") from None
-        except (TypeError, ValueError) as e:
-            raise InputError(where, f"intrinsics are not numbers: {e}") from None
+        if not isinstance(d, dict):
+            raise InputError(where, f"intrinsics must be a JSON object, got {d!r}")
+        for key in ("fx", "fy", "cx", "cy", "width", "height"):
+            if key not in d or d[key] is None:
+                raise InputError(where, f"intrinsics lack {key!r} (need fx, fy, cx, cy, width, height)")
+            v = d[key]
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise InputError(where, f"intrinsics {key}: must be a number, got {v!r}")
+            if key in ("width", "height") and not float(v).is_integer():
+                raise InputError(where, f"intrinsics {key}: must be a whole number of pixels, got {v!r}")
+        k = cls(fx=float(d["fx"]), fy=float(d["fy"]), cx=float(d["cx"]), cy=float(d["cy"]),
+                width=int(d["width"]), height=int(d["height"]))
         k.validate(where)
         return k
 
@@ -54,6 +57,9 @@ class Intrinsics:
             raise InputError(where, "intrinsics contain NaN or infinity")
         if not (8 <= self.width <= 16384 and 8 <= self.height <= 16384):
             raise InputError(where, f"absurd image size {self.width}x{self.height}")
+        from .limits import check_pixels
+
+        check_pixels(self.width, self.height, where, "an image")
         if not (0.1 * self.width <= self.fx <= 20 * self.width and 0.1 * self.height <= self.fy <= 20 * self.height):
             raise InputError(where, f"absurd focal length fx={self.fx}, fy={self.fy} "
                                     f"for a {self.width}x{self.height} image")

@@ -145,10 +145,12 @@ def replacing(out: Path, inputs: Iterable[Path | None] = (), option: str = "--ou
         if blocked is not None:
             raise InputError(where, f"cannot replace it: {blocked} is read-only")
     _make_parent(target, where)
+    lock = lock_beside(target, where)  # a second run writing the same --out stops here
     try:
         clean_stale(target.parent, target.name)
         tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.partial-{os.getpid()}-", dir=target.parent))
     except OSError as e:
+        lock.release()
         raise InputError(where, f"cannot write beside it: {e.strerror}") from None
     try:
         yield tmp
@@ -157,6 +159,8 @@ def replacing(out: Path, inputs: Iterable[Path | None] = (), option: str = "--ou
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+    finally:
+        lock.release()
 
 
 def _swap_in(new: Path, target: Path, where: str) -> None:
@@ -190,11 +194,16 @@ def _swap_in(new: Path, target: Path, where: str) -> None:
 # ---- one run at a time, complete files, and what killed runs left behind --------------------------------
 
 class _Lock:
-    def __init__(self, fd: int, path: Path):
-        self.fd, self.path = fd, path
+    def __init__(self, fd: int, path: Path, remove: bool = False):
+        self.fd, self.path, self.remove = fd, path, remove
 
     def release(self) -> None:
         if self.fd >= 0:
+            if self.remove:  # removed while still held: a waiting run then finds it gone and takes a new one
+                try:
+                    os.unlink(self.path)
+                except OSError:
+                    pass
             os.close(self.fd)  # closing the descriptor drops the flock
             self.fd = -1
 
@@ -202,9 +211,38 @@ class _Lock:
 def lock_folder(folder: Path, where: str, wait: bool = False) -> _Lock:
     """Take the lock of ``folder`` (an existing folder lv3d writes into). Held: an InputError naming the
     process holding it, or with ``wait`` block until it is free."""
+    return _lock_file(Path(folder) / LOCK, where, wait, remove=False)
+
+
+def lock_beside(target: Path, where: str, wait: bool = False) -> _Lock:
+    """The lock of an output that is made beside ``target`` and moved into its place (``.NAME.lock`` in its
+    folder, removed when released)."""
+    target = Path(target).expanduser().absolute()
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(where, f"cannot create {target.parent}: {e.strerror}") from None
+    return _lock_file(target.parent / f".{target.name}.lock", where, wait, remove=True)
+
+
+def _lock_file(path: Path, where: str, wait: bool, remove: bool) -> _Lock:
+    while True:
+        lock = _try_lock(path, where, wait)
+        if not remove:
+            return lock
+        try:  # the file a run released and removed while we waited for it: take the new one instead
+            same = os.path.samestat(os.fstat(lock.fd), os.stat(path))
+        except OSError:
+            same = False
+        if same:
+            lock.remove = True
+            return lock
+        lock.release()
+
+
+def _try_lock(path: Path, where: str, wait: bool) -> _Lock:
     import fcntl
 
-    path = Path(folder) / LOCK
     try:
         fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o644)
     except OSError as e:

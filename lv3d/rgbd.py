@@ -34,11 +34,36 @@ class RGBD:
         return self.intrinsics.back_project(u, v, self.depth[v, u]), np.stack([u, v], axis=1)
 
 
+def _check_size(path: Path, what: str) -> None:
+    """Refuse an image above lv3d.limits.MAX_PIXELS from its header, before decoding it."""
+    from .limits import check_pixels
+
+    try:
+        from PIL import Image
+
+        Image.MAX_IMAGE_PIXELS = None  # the bound is lv3d's own, checked below
+        with Image.open(path) as im:
+            w, h = im.size
+    except Exception:  # a format PIL cannot read the header of: checked after decoding
+        return
+    check_pixels(w, h, path, what)
+
+
+def _imread(path: Path, flags: int, what: str) -> np.ndarray | None:
+    from .limits import check_pixels
+
+    _check_size(path, what)
+    img = cv2.imread(str(path), flags)
+    if img is not None:
+        check_pixels(img.shape[1], img.shape[0], path, what)
+    return img
+
+
 def read_color(path: Path) -> np.ndarray:
     path = Path(path)
     if not path.is_file():
         raise InputError(path, "colour image not found")
-    img = cv2.imread(str(path), cv2.IMREAD_COLOR)
+    img = _imread(path, cv2.IMREAD_COLOR, "colour image")
     if img is None:
         raise InputError(path, "cannot read the colour image (corrupt or not an image)")
     return cv2.cvtColor(img, cv2.COLOR_BGR2RGB)
@@ -52,26 +77,34 @@ DEPTH_RANGE_M = (0.15, 8.0)
 
 def read_depth(path: Path, depth_scale_m: float, scale_option: str = "--depth-scale") -> np.ndarray:
     """A 16-bit depth image (PNG or TIFF) times ``depth_scale_m`` -> float32 metres; 0 stays 'no reading'.
-    A median reading outside :data:`DEPTH_RANGE_M` is an InputError that suggests a scale (named as
-    ``scale_option``, the option or key the user sets it with)."""
+    A floating-point depth image (32- or 64-bit TIFF) holds metres already: the scale, which is that of
+    integer depth units, does not apply to it. A median reading outside :data:`DEPTH_RANGE_M` is an
+    InputError that suggests a scale (named as ``scale_option``, the option or key the user sets it with)."""
     path = Path(path)
     if not path.is_file():
         raise InputError(path, "depth image not found")
-    raw = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    raw = _imread(path, cv2.IMREAD_UNCHANGED, "depth image")
     if raw is None:
         raise InputError(path, "cannot read the depth image (corrupt or not an image)")
     if raw.ndim != 2:
         raise InputError(path, f"depth must have one channel, this image has shape {raw.shape}")
     if raw.dtype == np.uint16:
         depth = raw.astype(np.float32) * np.float32(depth_scale_m)
-    elif raw.dtype == np.float32:
-        depth = np.nan_to_num(raw, nan=0.0, posinf=0.0, neginf=0.0) * np.float32(depth_scale_m)
+    elif raw.dtype in (np.float32, np.float64):
+        depth = np.nan_to_num(raw.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+        depth[depth < 0] = 0
+        valid = depth[depth > 0]
+        if valid.size and not DEPTH_RANGE_M[0] <= float(np.median(valid)) <= DEPTH_RANGE_M[1]:
+            raise InputError(path, f"median depth {float(np.median(valid)):.4g} is outside the {DEPTH_RANGE_M[0]:g}-"
+                                   f"{DEPTH_RANGE_M[1]:g} m an RGB-D sensor reads; floating-point depth is read as "
+                                   "metres (save millimetres as 16-bit integers, with their depth scale)")
     else:
-        raise InputError(path, f"depth must be uint16 (or float32), not {raw.dtype}")
+        raise InputError(path, f"depth must be uint16 (or float32 metres), not {raw.dtype}")
     valid = depth[depth > 0]
     if valid.size == 0:
         raise InputError(path, "depth is all zero (no readings)")
-    _check_depth_range(path, float(np.median(valid)), depth_scale_m, scale_option)
+    if raw.dtype == np.uint16:
+        _check_depth_range(path, float(np.median(valid)), depth_scale_m, scale_option)
     return depth
 
 
@@ -108,8 +141,10 @@ def load_frame(color_path: Path, depth_path: Path | None, intrinsics: Intrinsics
     if (intrinsics.width, intrinsics.height) != (w, h):
         raise InputError(color_path, f"image is {w}x{h} but the intrinsics are for "
                                      f"{intrinsics.width}x{intrinsics.height}")
-    if not (1e-6 < depth_scale_m <= 1.0):
-        raise InputError(depth_path or color_path, f"absurd depth scale {depth_scale_m} m per unit")
+    if not (isinstance(depth_scale_m, (int, float)) and not isinstance(depth_scale_m, bool)
+            and 1e-6 < depth_scale_m <= 1.0):
+        raise InputError(depth_path or color_path, f"{scale_option}: absurd depth scale {depth_scale_m!r} m per unit "
+                                                   "(need above 1e-06 and at most 1)")
     if depth_path is None:
         depth = np.zeros((h, w), np.float32)
     else:
@@ -127,14 +162,25 @@ def read_intrinsics(path: Path, frame: str | None = None) -> tuple[Intrinsics, f
     if not isinstance(d, dict):
         raise InputError(path, "intrinsics must be a JSON object")
     if "intrinsics" in d and isinstance(d["intrinsics"], dict):  # a data set's meta.json
-        return Intrinsics.from_dict(d["intrinsics"], str(path)), float(d.get("depth_scale_m", 0.001))
+        return Intrinsics.from_dict(d["intrinsics"], str(path)), _depth_scale(d, path, "depth_scale_m")
     if "frames" in d:
         frames = d["frames"]
+        if not isinstance(frames, dict) or not all(isinstance(v, dict) for v in frames.values()):
+            raise InputError(path, "frames: must map each frame's name to its intrinsics {fx, fy, cx, cy, ...}")
         if frame is None or frame not in frames:
             raise InputError(path, f"no intrinsics for frame {frame!r}; known: {', '.join(sorted(frames))}")
         entry = {"width": d.get("width"), "height": d.get("height"), **frames[frame]}
-        return Intrinsics.from_dict(entry, str(path)), float(entry.get("depth_scale_m", 0.001))
-    return Intrinsics.from_dict(d, str(path)), float(d.get("depth_scale_m", 0.001))
+        return Intrinsics.from_dict(entry, str(path)), _depth_scale(entry, path, f"frames.{frame}.depth_scale_m")
+    return Intrinsics.from_dict(d, str(path)), _depth_scale(d, path, "depth_scale_m")
+
+
+def _depth_scale(d: dict, path: Path, key: str) -> float:
+    """The entry's depth_scale_m (default 0.001: millimetres), a number in (1e-6, 1] metres per unit."""
+    v = d.get("depth_scale_m", 0.001)
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not 1e-6 < v <= 1.0:
+        raise InputError(path, f"{key}: must be a number of metres per depth unit above 1e-06 and at most 1 "
+                               f"(0.001 for millimetres), got {v!r}")
+    return float(v)
 
 
 def load_item(item_dir: Path) -> RGBD:
@@ -145,7 +191,7 @@ def load_item(item_dir: Path) -> RGBD:
     if not isinstance(meta, dict) or "intrinsics" not in meta:
         raise InputError(meta_path, "no intrinsics")
     k = Intrinsics.from_dict(meta["intrinsics"], str(meta_path))
-    return load_frame(item_dir / "color.png", item_dir / "depth.png", k, float(meta.get("depth_scale_m", 0.001)),
+    return load_frame(item_dir / "color.png", item_dir / "depth.png", k, _depth_scale(meta, meta_path, "depth_scale_m"),
                       name=meta.get("id", item_dir.name), meta=meta, scale_option="depth_scale_m in meta.json")
 
 

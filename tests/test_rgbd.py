@@ -95,14 +95,44 @@ def test_depth_in_the_right_unit_loads(tmp_path):
     assert np.isclose(np.median(f.depth[f.depth > 0]), 0.65)
 
 
-def test_float_depth_in_metres_takes_scale_one(tmp_path):
+def test_float_depth_is_metres_whatever_the_scale_of_integer_depth(tmp_path):
     c, _ = _write(tmp_path)
     d = tmp_path / "d.tiff"
     cv2.imwrite(str(d), np.full((48, 64), 1.5, np.float32))
     k = Intrinsics(60, 60, 32, 24, 64, 48)
-    with pytest.raises(InputError, match=r"d\.tiff.*0\.0015 m.*--depth-scale 1\b"):
-        load_frame(c, d, k, 0.001)
+    assert np.allclose(load_frame(c, d, k, 0.001).depth, 1.5)  # not scaled by 0.001 again
     assert np.allclose(load_frame(c, d, k, 1.0).depth, 1.5)
+    cv2.imwrite(str(d), np.full((48, 64), 1500.0, np.float32))  # millimetres in a float image
+    with pytest.raises(InputError, match=r"d\.tiff.*read as metres"):
+        load_frame(c, d, k, 0.001)
+
+
+def test_images_above_the_pixel_limit_are_refused_before_decoding(tmp_path):
+    from lv3d.limits import MAX_PIXELS
+
+    big = tmp_path / "big.png"
+    cv2.imwrite(str(big), np.zeros((2100, 2100, 3), np.uint8))
+    assert 2100 * 2100 > MAX_PIXELS
+    with pytest.raises(InputError, match=r"big\.png: colour image of 2100x2100 pixels is larger"):
+        load_frame(big, None, None)
+
+
+@pytest.mark.parametrize("text, key", [
+    ('{"fx": 60, "fy": 60, "cx": 32, "cy": 24, "width": 640.7, "height": 48}', "width"),
+    ('{"fx": 60, "fy": 60, "cx": 32, "cy": 24, "width": 64, "height": 48, "depth_scale_m": "x"}', "depth_scale_m"),
+    ('{"width": 64, "height": 48, "frames": [1, 2]}', "frames"),
+    ('{"width": 64, "height": 48, "frames": {"f": 3}}', "frames"),
+    ('{"fx": "60", "fy": 60, "cx": 32, "cy": 24, "width": 64, "height": 48}', "fx"),
+    ('{"fx": 60, "fy": 60, "cx": 32, "cy": 24, "width": 64, "height": 48, "depth_scale_m": 0}', "depth_scale_m"),
+])
+def test_bad_intrinsics_are_one_line_errors(tmp_path, text, key):
+    from lv3d.rgbd import read_intrinsics
+
+    p = tmp_path / "k.json"
+    p.write_text(text)
+    with pytest.raises(InputError) as e:
+        read_intrinsics(p, "f")
+    assert str(p) in str(e.value) and key in str(e.value)
 
 
 def test_extract_reports_the_wrong_scale_in_one_line(tmp_path, capsys):

@@ -39,18 +39,34 @@ def cli():
     """lv3d: learn 3D shape concepts from a few RGB-D images, with an explanation for every answer."""
 
 
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
 def main(argv=None) -> int:
-    """Entry point: bad input becomes one line on stderr and exit code 2."""
+    """Entry point: bad input (a bad option, value, file or setting) becomes one line on stderr and exit code
+    2; a run that cannot finish for another reason one line and exit code 1. Worker processes started from
+    here die with this process (lv3d.workers)."""
+    from ..workers import install
+
+    install()
     try:
         cli.main(args=argv, prog_name="lv3d", standalone_mode=False)
     except InputError as e:
-        click.echo(f"lv3d: error: {e}", err=True)
+        click.echo(f"lv3d: error: {_one_line(e)}", err=True)
         return 2
     except click.exceptions.Abort:
         click.echo("lv3d: aborted", err=True)
         return 130
+    except click.UsageError as e:
+        if type(e).__name__ == "NoArgsIsHelpError":  # a group without its subcommand: its help
+            click.echo(e.ctx.get_help() if e.ctx is not None else str(e))
+            return 0
+        where = e.ctx.command_path if e.ctx is not None else "lv3d"
+        click.echo(f"lv3d: error: {where}: {_one_line(e.format_message())} (see {where} --help)", err=True)
+        return 2
     except click.ClickException as e:
-        e.show()
+        click.echo(f"lv3d: error: {_one_line(e.format_message())}", err=True)
         return e.exit_code
     except click.exceptions.Exit as e:
         return e.exit_code

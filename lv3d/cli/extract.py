@@ -18,8 +18,9 @@ from ..output import check_out, replacing
 @click.option("--intrinsics", type=click.Path(path_type=Path), default=None,
               help="Intrinsics JSON (plain, a data set's meta.json, or the real-data layout with 'frames'); needed "
               "with depth only: colour alone works in pixels.")
-@click.option("--depth-scale", type=float, default=None, help="Metres per depth unit (default: from the intrinsics "
-              "file, else 0.001).")
+@click.option("--depth-scale", type=click.FloatRange(0, 1, min_open=True), default=None,
+              help="Metres per 16-bit depth unit (default: from the intrinsics file, else 0.001); float depth is "
+              "read as metres.")
 @click.option("--modality", type=click.Choice(["rgb", "depth", "rgbd"]), default="rgbd", show_default=True)
 @click.option("--scene-id", default="s000000", show_default=True, help="Scene id, a Prolog atom like s000123.")
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder.")
@@ -34,6 +35,11 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
     from ..perception.overlay import draw_overlay
     from ..perception.perceive import perceive
 
+    import re
+
+    if not re.fullmatch(r"[a-z][a-zA-Z0-9_]*", scene_id):
+        raise InputError("--scene-id", f"must be a Prolog atom like s000123 (a lower-case letter, then letters, "
+                                       f"digits or _), got {scene_id!r}")
     if modality in ("depth", "rgbd") and depth is None:
         raise InputError("--depth", f"modality {modality!r} needs a depth image")
     if intrinsics is None and modality != "rgb":

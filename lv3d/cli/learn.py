@@ -14,7 +14,8 @@ from ..facts import MODALITIES
 
 @click.command()
 @click.argument("task", type=click.Path(path_type=Path))
-@click.option("--time-limit", type=float, default=None, help="seconds for the search (default: the task's, else 10)")
+@click.option("--time-limit", type=click.FloatRange(0, 86400, min_open=True), default=None,
+              help="seconds for the search (default: the task's, else 10)")
 def mil(task: Path, time_limit: float | None):
     """Learn the Metagol-style TASK file and print the program."""
     from ..learn.engine import LearnError
@@ -41,8 +42,13 @@ def _dataset_scenes(data: Path, modality: str, facts: str):
         raise InputError(data, "not a data set (no manifest.json)")
     try:
         items = json.loads(manifest.read_text())["items"]
-    except (json.JSONDecodeError, KeyError, TypeError) as e:
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError) as e:
         raise InputError(manifest, f"malformed: {e}") from None
+    if not isinstance(items, list):
+        raise InputError(manifest, "items: must be a list of {id, class, dir}")
+    for i, it in enumerate(items):
+        if not (isinstance(it, dict) and all(isinstance(it.get(k), str) and it.get(k) for k in ("id", "class", "dir"))):
+            raise InputError(manifest, f"items[{i}]: must be {{id, class, dir}} (texts), got {it!r}")
     scenes, labels = [], []
     for it in items:
         item_dir = data / it["dir"]
@@ -73,18 +79,26 @@ _facts = click.option("--facts", type=click.Choice(["truth", "pipeline"]), defau
 @_facts
 @click.option("--classes", default=None, help="comma-separated classes to learn (default: all in the data)")
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="directory for the programs")
-@click.option("--seed", type=int, default=0, show_default=True)
-@click.option("--time-limit", type=float, default=None, help="seconds per class")
+@click.option("--seed", type=click.IntRange(0, 2 ** 32 - 1), default=0, show_default=True)
+@click.option("--time-limit", type=click.FloatRange(0, 86400, min_open=True), default=None, help="seconds per class")
 def fit(data: Path, modality: str, facts: str, classes: str | None, out: Path, seed: int, time_limit: float | None):
     """Learn one program per class and save them as .pl files in OUT."""
     from ..output import check_out, replacing
     from ..learn.model import Model
 
     check_out(out, (data,))  # before any work: a file, a folder lv3d did not write or one holding the data
-    wanted = [c.strip() for c in classes.split(",")] if classes else None
+    wanted = [c.strip() for c in classes.split(",") if c.strip()] if classes is not None else None
+    if wanted is not None and not wanted:
+        raise InputError("--classes", "no class given")
     scenes, labels = _dataset_scenes(data, modality, facts)
-    settings = {"time_limit": time_limit} if time_limit else None
+    for c in wanted or ():
+        if c not in labels:
+            raise InputError("--classes", f"no item of {data} is a {c!r}; its classes: {', '.join(sorted(set(labels)))}")
+    settings = {"time_limit": time_limit} if time_limit is not None else None
     model = Model.fit(scenes, labels, settings=settings, seed=seed, classes=wanted)
+    if not model.programs and model.failures:  # nothing learned: no empty model is saved
+        why = "; ".join(f"{c}: {w}" for c, w in model.failures.items())
+        raise click.ClickException(f"no program learned for any class ({why})")
     with replacing(out, (data,)) as tmp:  # written beside OUT, then moved into its place
         model.save(tmp)
     for c, p in model.programs.items():
@@ -105,6 +119,12 @@ def predict(data: Path, modality: str, facts: str, model_dir: Path, explain: boo
     from ..learn.model import Model
 
     model = Model.load(model_dir)
+    learned = sorted({p.modality for p in model.programs.values() if p.modality})
+    if not model.programs:
+        raise InputError(model_dir, "the model holds no program")
+    if learned and learned != [modality]:
+        raise InputError("--modality", f"the model in {model_dir} was learned from {', '.join(learned)} facts; "
+                                       f"predict with --modality {learned[0]}")
     scenes, labels = _dataset_scenes(data, modality, facts)
     correct = 0
     for s, y in zip(scenes, labels):
