@@ -22,7 +22,7 @@ from .cloud import PointGrid, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
 from .curved import CurvedFace, CurvedSettings, fan_cylinder, largest_piece
 from .objects import DepthObject, heavy_noise, segment_objects, support_band
-from .planes import DepthPlane, object_planes, plane_adjacency
+from .planes import DepthPlane, merge_coplanar, object_planes, plane_adjacency
 from .plane_outline import simplify_on_plane
 from .polygons import merge_close_corners
 from .snap import add_triple_corners, snap_polygons
@@ -142,6 +142,7 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
     t_planes = t_boundary = 0.0
     for k, (o, planes) in enumerate(solids):
         ta = time.perf_counter()
+        planes = merge_coplanar(planes)
         adj = plane_adjacency(planes)
         planes, adj, curved = _curved(grid, o, planes, adj, settings.curved)
         curved_adj = [(i, j) for j, c in enumerate(curved) for i, p in enumerate(planes)

@@ -157,6 +157,37 @@ def merge_strips(planes: list[DepthPlane], dist_m: float, max_median: float = 0.
     return planes
 
 
+def merge_coplanar(planes: list[DepthPlane], max_deg: float = 8.0) -> list[DepthPlane]:
+    """``planes`` of one solid with every pair that is one plane merged and refitted: normals within ``max_deg``
+    and the smaller one's points (median) within the inlier distance of the larger one's plane. A solid has no two faces in
+    one plane; one face seen in two parts (around an occluder, or split by a sample of RANSAC) is one face.
+    ``max_deg``: twice the normal error of a plane fitted to a few hundred noisy points, well below any
+    polyhedron's edge (the hexagonal prism's sides turn by 60 deg)."""
+    planes = sorted(planes, key=lambda p: -len(p.points))
+    cos_max = np.cos(np.radians(max_deg))
+    merged = True
+    while merged:
+        merged = False
+        for i in range(len(planes)):
+            for j in range(i + 1, len(planes)):
+                a, b = planes[i], planes[j]
+                if abs(float(a.plane.n @ b.plane.n)) < cos_max:
+                    continue
+                dist_m = noise_threshold(float(np.median(np.concatenate([a.points[:, 2], b.points[:, 2]]))))
+                if np.median(np.abs(a.plane.distance(b.points))) > dist_m:
+                    continue  # the smaller piece off the larger's plane (the better measured of the two)
+                pts = np.concatenate([a.points, b.points])
+                plane = refine(pts.astype(np.float64))
+                rms = float(np.sqrt(np.mean(plane.distance(pts) ** 2)))
+                planes[i] = DepthPlane(plane, a.mask | b.mask, pts, rms)
+                del planes[j]
+                merged = True
+                break
+            if merged:
+                break
+    return planes
+
+
 def _holds_face(far: np.ndarray, n: int, dist_m: float, others: list[Plane], min_share: float = 0.25,
                 min_far: int = 20, max_rms: float = 0.05) -> bool:
     """True when the points ``far`` (m, 3) metres of a piece of ``n`` points, those more than ``dist_m`` off the
