@@ -1,4 +1,4 @@
-"""Session fixtures of rendered clean scenes (see learn_scenes.py)."""
+"""Fixtures of rendered clean scenes, made once per test run (see learn_scenes.py)."""
 
 import pytest
 from learn_scenes import SHAPES, rendered_facts
