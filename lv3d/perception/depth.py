@@ -21,6 +21,7 @@ from .boundary import mask_polygon
 from .cloud import PointGrid, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
 from .curved import CurvedFace, CurvedSettings, fan_cylinder, largest_piece
+from .occlusion import OcclusionSettings, join_occluded
 from .objects import DepthObject, heavy_noise, segment_objects, support_band
 from .planes import DepthPlane, merge_coplanar, object_planes, plane_adjacency
 from .plane_outline import simplify_on_plane
@@ -54,6 +55,7 @@ class DepthSettings:
     centre) over what part of it (support.support_plane).
     ``convexity``: the cut at concave creases (convexity.ConvexitySettings).
     ``curved``: a fan of planes read as one cylindrical face (curved.CurvedSettings).
+    ``occlusion``: two pieces of one solid seen around an occluder joined (occlusion.OcclusionSettings).
     """
 
     max_objects: int = 24
@@ -69,6 +71,7 @@ class DepthSettings:
     support_inner: float = 0.85
     convexity: ConvexitySettings = field(default_factory=ConvexitySettings)
     curved: CurvedSettings = field(default_factory=CurvedSettings)
+    occlusion: OcclusionSettings = field(default_factory=OcclusionSettings)
 
     def __post_init__(self) -> None:
         if not isinstance(self.max_objects, int) or self.max_objects < 1:
@@ -133,6 +136,7 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
                   "max_need": max(1, round(settings.plane_max_frac * cells)),
                   "min_points": max(3, round(settings.plane_min_frac * cells))}
     solids = _solids(grid, support, objs, seed, plane_args, settings.convexity)
+    solids = join_occluded(solids, grid.xyz, grid.valid, settings.occlusion)
     solids.sort(key=lambda op: (-op[0].size, int(np.argmax(op[0].mask))))
     dropped = max(0, len(solids) - settings.max_objects)
     solids = solids[:settings.max_objects]
