@@ -71,7 +71,7 @@ def _centroid(polys: list[np.ndarray]) -> tuple[float, float]:
 
 def _colour_objects(frame: RGBD, scene_id: str, timings: dict[str, float]) -> list[SceneObject]:
     """The colour path on the whole frame: its faces grouped into objects; its stage times added to ``timings``."""
-    res = rgb_faces(frame.color, colour_alone=True)
+    res = rgb_faces(frame.color)
     for key, v in res.timings_ms.items():
         timings[key] = timings.get(key, 0.0) + v
     return _rgb_objects(scene_id, res.faces, res.groups, res.adjacency)

@@ -41,7 +41,6 @@ class RGBResult:
     groups: list[list[int]]           # indices into faces, one list per object, largest first
     adjacency: list[tuple[int, int]]  # pairs of face indices sharing a graph edge, i < j
     timings_ms: dict[str, float]
-    edge_dist: np.ndarray             # (h, w) px from each pixel of the searched box to the nearest edge
 
 
 # a part cut off a traced face at most this wide (twice its area over its perimeter, px) is outlined anew from the
@@ -93,15 +92,14 @@ def _contains(outer: np.ndarray, inner: np.ndarray) -> bool:
     return all(cv2.pointPolygonTest(c, (float(x), float(y)), False) >= 0 for x, y in inner)
 
 
-def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, min_area_px: float = 150.0,
-              max_area_frac: float = 0.35, min_support: float = 0.55, colour_alone: bool = False) -> RGBResult:
-    """Faces in the colour image (H, W, 3) uint8 RGB, or only inside ``box`` = (u0, v0, u1, v1) pixels
-    (a crop around an object found in depth). Faces smaller than ``min_area_px``, larger than ``max_area_frac``
-    of the searched area, hugging its frame, non-simple, poorly supported by edges (< ``min_support`` of the
-    perimeter), or containing another face (a background region around an object) are dropped.
+def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: float = 0.35,
+              min_support: float = 0.55) -> RGBResult:
+    """Faces in the colour image (H, W, 3) uint8 RGB, seen by colour alone (no depth to find or part faces), grouped
+    into objects. Faces smaller than ``min_area_px``, larger than ``max_area_frac`` of the image, hugging its frame,
+    non-simple, poorly supported by edges (< ``min_support`` of the perimeter), or containing another face (a
+    background region around an object) are dropped.
 
-    With ``colour_alone`` (no depth to find or part faces), the sides of the solids' silhouettes, told from the
-    floor by chromaticity, join the segments (silhouette.py), segments are carried on across gaps in their edges
+    The sides of the solids' silhouettes, told from the floor by chromaticity, join the segments (silhouette.py), segments are carried on across gaps in their edges
     where the colour still steps (gaps.close_gaps), faces on two separate silhouettes or of two chromaticities are
     never neighbours (the graph joins solids that nearly touch or overlap; a solid is taken to be of one colour, so
     a printed carton comes out as one object per colour: _same_solid), and a kept face whose outline the graph
@@ -113,18 +111,15 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     short of and two faces of one colour traced as one. The parts of the silhouettes left outside every face, each
     of a colour of its own or a whole solid none of whose faces was traced, are then faces too
     (untraced.untraced_faces: slivers whose corners the graph collapsed; clean rgb recall rose on 4 of 6 dev seeds
-    and fell on none; docs/perception.md, session 28), each cut from side to side as above (session 30). Faces
-    of the colour of the image's border (floor texture, shadows, painted lines) are then dropped
-    (background.background_faces): most false colour-only faces on noisy renders are such; those much smoother than
-    the floor of their hue are kept (background.smooth_faces: an object of the table's hue). With depth (rgbd), the
-    planes find and part such faces; cut there too, the colour part that keeps a thin neighbour's strip outvotes
-    that neighbour's plane (realsense rgbd recall fell by one face on dev seeds 1000 and 2000)."""
+    and fell on none; docs/perception.md), each cut from side to side as above. Faces of the colour of the image's
+    border (floor texture, shadows, painted lines) are then dropped (background.background_faces): most false
+    colour-only faces on noisy renders are such; those much smoother than the floor of their hue are kept
+    (background.smooth_faces: an object of the table's hue). (rgbd does not trace colour faces: fuse.py.)"""
     import time
 
     t0 = time.perf_counter()
     h, w = color.shape[:2]
-    u0, v0, u1, v1 = box if box is not None else (0, 0, w, h)
-    crop = np.ascontiguousarray(color[v0:v1, u0:u1])
+    crop = np.ascontiguousarray(color)
     chans = channels(crop)
     per_channel = [channel_edges(c) for c in chans]
     edges = np.maximum.reduce([c.edges for c in per_channel])
@@ -132,16 +127,13 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     dist = edge_distance(edges)
     t1 = time.perf_counter()
     segs = detect_color_segments(chans)
-    sgrads = solids = chroma = None
-    if colour_alone:
-        sgrads = smoothed_gradients(chans)  # for close_gaps and step_cut
-        solids = foreground(crop)  # regions not of the border's chromaticity
-        chroma = chromaticity(crop)  # for background_faces and _same_solid
-        segs = close_gaps(np.concatenate([segs, silhouette_segments(solids, grad)]), sgrads)
+    sgrads = smoothed_gradients(chans)  # for close_gaps and step_cut
+    solids = foreground(crop)  # regions not of the border's chromaticity
+    chroma = chromaticity(crop)  # for background_faces and _same_solid
+    segs = close_gaps(np.concatenate([segs, silhouette_segments(solids, grad)]), sgrads)
     t2 = time.perf_counter()
     g = build_graph(segs, edge_dist=dist)
-    cw, ch = u1 - u0, v1 - v0
-    frame = (0, 0, cw - 1, ch - 1)
+    frame = (0, 0, w - 1, h - 1)
     cands = []
     # made-up edge keys (k, k), k < 0: a cut the graph lacks, shared by the parts either side of it (so that they
     # count as neighbours), or a thin face's contact with the faces beside it (_touching_cands)
@@ -162,12 +154,12 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         sup = edge_support(poly, dist)
         if sup < min_support:
             continue
-        # colour alone, a concave outline is first cut along a faint straight edge from one of its corners (two faces
-        # of one colour traced with a third as one outline): split_concave cuts only from corner to corner and reads
-        # Canny's gradient, which the faint edge is under. Stricter than step_cut on whole faces (a step 10 times its
+        # a concave outline is first cut along a faint straight edge from one of its corners (two faces of one colour
+        # traced with a third as one outline): split_concave cuts only from corner to corner and reads Canny's
+        # gradient, which the faint edge is under. Stricter than step_cut on whole faces (a step 10 times its
         # control, 12 clear samples: a short edge ending on a side keeps few); the parts, their corners found again,
-        # are then split as before (docs/perception.md, session 23)
-        concave = colour_alone and bool(reflex_corners(poly))
+        # are then split as before (docs/perception.md)
+        concave = bool(reflex_corners(poly))
         lines = step_lines(poly, sgrads) if concave else None
         stepped = step_cut(poly, sgrads, min_area_px, rel_step=10.0, min_samples=12, lines=lines) \
             if lines is not None else None
@@ -202,7 +194,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
         if around:
             continue
         parts = None
-        if colour_alone and whole:
+        if whole:
             parts = _faint_cut(poly, sgrads, min_area_px, measured[i] if i in measured else step_lines(poly, sgrads))
         if parts is None:
             kept.append((poly, es, sup, a))
@@ -214,34 +206,32 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     n_traced = len(cands)
     cands += _touching_cands(cands, thin_faces(segs, dist, [c[0] for c in cands], min_area_px), dist, made_up)
     cands = _join_thin_to_traced(cands, n_traced, dist)
-    if colour_alone:
-        untraced = untraced_faces(solids, [c[0] for c in cands], dist, crop, min_area_px, max_area_frac * w * h)
-        # a whole solid none of whose faces was traced is cut from side to side where its faces' shared edge
-        # steps clearly; the corner and fork cuts, looser, cost realsense multi-class accuracy (docs/perception.md)
-        new = []
-        for q in untraced:
-            parts = side_cut(q, sgrads, min_area_px)
-            group = _touching_cands(cands, [_outline(x) for x in parts] if parts else [q], dist, made_up)
-            if parts:  # the parts of one cut are neighbours
-                cut = next(made_up)
-                group = [(p, es | {cut}, sup, a) for p, es, sup, a in group]
-            new += group
-        cands += new
-    hues = [None] * len(cands)  # each face's chromaticity, for background_faces and _same_solid (colour alone)
-    if colour_alone and cands:
+    untraced = untraced_faces(solids, [c[0] for c in cands], dist, crop, min_area_px, max_area_frac * w * h)
+    # a whole solid none of whose faces was traced is cut from side to side where its faces' shared edge
+    # steps clearly; the corner and fork cuts, looser, cost realsense multi-class accuracy (docs/perception.md)
+    new = []
+    for q in untraced:
+        parts = side_cut(q, sgrads, min_area_px)
+        group = _touching_cands(cands, [_outline(x) for x in parts] if parts else [q], dist, made_up)
+        if parts:  # the parts of one cut are neighbours
+            cut = next(made_up)
+            group = [(p, es | {cut}, sup, a) for p, es, sup, a in group]
+        new += group
+    cands += new
+    hues = []  # each face's chromaticity, for background_faces and _same_solid
+    if cands:
         hues = [face_chromaticity(np.asarray(c[0], np.float64), chroma) for c in cands]
         bg = background_faces(hues, chroma)
         if any(bg):  # unless a face is much smoother than the floor of its hue: an object of the floor's hue
             smooth = smooth_faces([c[0] for c in cands], hues, bg, chroma, log_gradient(crop))
             bg = [b and not s for b, s in zip(bg, smooth)]
         cands, hues = [c for c, b in zip(cands, bg) if not b], [h for h, b in zip(hues, bg) if not b]
-    faces = [(RGBFace(p + np.array([u0, v0], float), e, s, a), hue) for (p, e, s, a), hue in zip(cands, hues)]
+    faces = [(RGBFace(p, e, s, a), hue) for (p, e, s, a), hue in zip(cands, hues)]
     faces.sort(key=lambda fh: (-fh[0].area_px, float(fh[0].polygon[0, 0]), float(fh[0].polygon[0, 1])))
     faces, hues = [f for f, _ in faces], [h for _, h in faces]
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
                  if faces[i].edges & faces[j].edges]
-    if colour_alone:
-        adjacency = _same_solid(adjacency, [f.polygon - np.array([u0, v0], float) for f in faces], hues, solids)
+    adjacency = _same_solid(adjacency, [f.polygon for f in faces], hues, solids)
     lab = union_find_labels(len(faces), np.array(adjacency, int).reshape(-1, 2))
     groups: dict[int, list[int]] = {}
     for i, l in enumerate(lab):
@@ -249,7 +239,7 @@ def rgb_faces(color: np.ndarray, box: tuple[int, int, int, int] | None = None, m
     ordered = sorted(groups.values(), key=lambda idx: (-sum(faces[i].area_px for i in idx), idx[0]))
     t3 = time.perf_counter()
     timings = {"edges": (t1 - t0) * 1e3, "segments": (t2 - t1) * 1e3, "faces": (t3 - t2) * 1e3}
-    return RGBResult(faces, ordered, adjacency, timings, dist)
+    return RGBResult(faces, ordered, adjacency, timings)
 
 
 def _faint_cut(poly: np.ndarray, sgrads: np.ndarray, min_area_px: float, lines) -> list[np.ndarray] | None:

@@ -44,8 +44,7 @@ def test_colour_alone_drops_the_shadow_beside_a_solid():
     def shadow_found(faces):
         return any(abs(f.area_px - 2700) < 300 and f.polygon[:, 0].min() > 125 for f in faces)
 
-    assert shadow_found(rgb_faces(img).faces)
-    faces = rgb_faces(img, colour_alone=True).faces
+    faces = rgb_faces(img).faces
     assert not shadow_found(faces)
     assert any(abs(f.area_px - 80 * 80) < 300 for f in faces)
 
@@ -78,5 +77,5 @@ def test_a_plain_face_of_the_floors_hue_is_told_from_the_floor_by_its_texture():
 def test_colour_alone_keeps_a_solid_of_the_floors_hue():
     square = rasterize(SQUARE, (200, 200))
     ious = [np.count_nonzero(square & m) / np.count_nonzero(square | m)
-            for m in (rasterize(f.polygon, (200, 200)) for f in rgb_faces(_grained(), colour_alone=True).faces)]
+            for m in (rasterize(f.polygon, (200, 200)) for f in rgb_faces(_grained(), ).faces)]
     assert max(ious, default=0.0) >= 0.8

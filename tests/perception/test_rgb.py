@@ -49,15 +49,6 @@ def test_plain_image_has_no_face():
     assert rgb_faces(_canvas()).faces == []
 
 
-def test_box_limits_the_search():
-    img = _canvas()
-    cv2.rectangle(img, (20, 20), (80, 80), (20, 20, 20), -1)
-    cv2.rectangle(img, (200, 120), (280, 200), (20, 20, 20), -1)
-    res = rgb_faces(img, box=(180, 100, 300, 220))
-    assert len(res.faces) == 1
-    assert res.faces[0].polygon[:, 0].min() > 180
-
-
 def test_traced_part_keeps_the_traced_bends_between_outline_corners():
     from lv3d.perception.polygons import clockwise
     from lv3d.perception.rgb import _traced_part
@@ -90,11 +81,11 @@ def test_a_faint_edge_inside_a_concave_outline_is_cut_before_the_outline_is_spli
     for poly, colour in ((top, (192, 202, 142)), (front, (188, 198, 138)), (left, (93, 99, 69))):
         cv2.fillPoly(img, [poly.astype(np.int32)], colour)
 
-    res = rgb_faces(img, colour_alone=True)
+    res = rgb_faces(img)
     assert min(_best_iou(res, p, img.shape[:2]) for p in (top, front, left)) > 0.9
     # with no step between top and front no cut is made along their line
     cv2.fillPoly(img, [front.astype(np.int32)], (192, 202, 142))
-    assert _best_iou(rgb_faces(img, colour_alone=True), top, img.shape[:2]) < 0.8
+    assert _best_iou(rgb_faces(img), top, img.shape[:2]) < 0.8
 
 
 def test_a_short_faint_edge_that_steps_clearly_cuts_a_small_face_off():
@@ -107,10 +98,10 @@ def test_a_short_faint_edge_that_steps_clearly_cuts_a_small_face_off():
     for poly, colour in ((large, (116, 125, 97)), (small, (111, 119, 93))):
         cv2.fillPoly(img, [np.round(poly).astype(np.int32)], colour)
 
-    res = rgb_faces(img, colour_alone=True)
+    res = rgb_faces(img)
     assert len(res.faces) == 2 and min(_best_iou(res, p, img.shape[:2]) for p in (small, large)) > 0.8
     cv2.fillPoly(img, [np.round(small).astype(np.int32)], (116, 125, 97))  # one colour: no edge, no cut
-    assert len(rgb_faces(img, colour_alone=True).faces) == 1
+    assert len(rgb_faces(img).faces) == 1
 
 
 def test_a_faint_edge_from_side_to_side_cuts_two_faces_of_one_colour_apart(monkeypatch):
@@ -122,8 +113,8 @@ def test_a_faint_edge_from_side_to_side_cuts_two_faces_of_one_colour_apart(monke
     for poly, colour in ((top, (170, 165, 115)), (front, (160, 155, 105))):
         cv2.fillPoly(img, [poly.astype(np.int32)], colour)
 
-    res = rgb_faces(img, colour_alone=True)
+    res = rgb_faces(img)
     assert len(res.faces) == 2 and min(_best_iou(res, p, img.shape[:2]) for p in (top, front)) > 0.95
     # the edge map and the corner cuts miss this edge: without the side-to-side cut the two faces are one
     monkeypatch.setattr(rgb, "side_cut", lambda *a, **k: None)
-    assert len(rgb_faces(img, colour_alone=True).faces) == 1
+    assert len(rgb_faces(img).faces) == 1

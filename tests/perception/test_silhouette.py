@@ -77,13 +77,11 @@ def test_regions_of_names_the_region_holding_most_of_each_polygon():
 def test_faces_of_two_solids_that_nearly_touch_are_two_objects():
     img = _floor(seed=2)
     # two boxes of two faces each (top lighter than front), 8 px of floor between them: the graph joins the two
-    # (without colour alone, the strip between them closes faces and every face is one object's)
     _square(img, 40, 50, 110, 90, shade=1.2)
     _square(img, 40, 90, 110, 150, shade=0.7)
     _square(img, 118, 60, 190, 100, shade=1.2)  # of one colour: their hue does not part them
     _square(img, 118, 100, 190, 150, shade=0.7)
-    assert len(rgb_faces(img).groups) == 1
-    res = rgb_faces(img, colour_alone=True)
+    res = rgb_faces(img)
     assert len(res.faces) == 4 and len(res.groups) == 2
     for group in res.groups:
         xs = [float(res.faces[i].polygon[:, 0].mean()) for i in group]
@@ -97,7 +95,7 @@ def test_solids_of_two_colours_that_touch_are_two_objects():
     _square(img, 40, 90, 110, 150, shade=0.7)
     _square(img, 110, 60, 190, 100, colour=(60, 130, 150), shade=1.2)
     _square(img, 110, 100, 190, 150, colour=(60, 130, 150), shade=0.7)
-    res = rgb_faces(img, colour_alone=True)
+    res = rgb_faces(img)
     assert len(res.faces) == 4 and len(res.groups) == 2
     for group in res.groups:
         xs = [float(res.faces[i].polygon[:, 0].mean()) for i in group]
