@@ -1,9 +1,9 @@
 """Per-type ECE of the calibrated fact confidences on rows from benchmarks/calibration_data.py: each set of rows alone
 and all of them pooled, beside the target (ECE <= 0.05 per fact type on rendered realsense scenes).
 
-    .venv/bin/python benchmarks/calibration_data.py --fresh --seed 7000 --per-class 900 --modalities rgbd --out out/calib/held7000.pkl
-    .venv/bin/python benchmarks/calibration_data.py --fresh --seed 500000 --per-class 900 --modalities rgbd --out out/calib/held500000.pkl
-    .venv/bin/python benchmarks/calibration_check.py out/calib/held7000.pkl out/calib/held500000.pkl
+    .venv/bin/python -m benchmarks.calibration_data --fresh --seed 7000 --per-class 900 --modalities rgbd --out out/calib/held7000.pkl
+    .venv/bin/python -m benchmarks.calibration_data --fresh --seed 500000 --per-class 900 --modalities rgbd --out out/calib/held500000.pkl
+    .venv/bin/python -m benchmarks.calibration_check out/calib/held7000.pkl out/calib/held500000.pkl
 
 The rows hold raw probabilities; they are calibrated here with the maps lv3d ships (lv3d/data/calibration.json,
 lv3d.calibration), and facts are grouped by predicate (the kinds filed apart, e.g. ``acute_touch``, count as their
@@ -22,11 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-
-from benchmarks.calibration_error import ECE_TARGET, chance_ece, ece, ece_verdict, log_loss, scene_interval  # noqa: E402
-from benchmarks.fit_calibration import MIN_CONF, row_key, scene_of  # noqa: E402
+from benchmarks.calibration_error import ECE_TARGET, chance_ece, ece, ece_verdict, log_loss, scene_interval
+from benchmarks.fit_calibration import MIN_CONF, row_key, scene_of
 
 
 def score(rows: list[dict], modality: str) -> tuple[np.ndarray, dict]:

@@ -1,7 +1,7 @@
 """Candidate facts of perceived dev scenes with their ground-truth labels and the measurements behind them:
 the data the confidence calibration (grounding/_calibration.py) is fitted on and checked against.
 
-    .venv/bin/python benchmarks/calibration_data.py --fresh --seed 30000 --per-class 50 --modalities rgbd,depth --out out/calib/s6_a50.pkl
+    .venv/bin/python -m benchmarks.calibration_data --fresh --seed 30000 --per-class 50 --modalities rgbd,depth --out out/calib/s6_a50.pkl
 
 Scenes are ``render_scene(cls, seed + 1000 * class_index + i, preset)`` for the 7 bench classes: dev seeds
 only (never the study's seed-0 data set). Each row: modality, predicate, raw probability (before any
@@ -19,10 +19,7 @@ import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-
-from benchmarks.grounding_truth import truth_labels  # noqa: E402
+from benchmarks.grounding_truth import truth_labels
 
 CLASSES = ["cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
            "tetrahedron"]
@@ -57,6 +54,7 @@ def main(argv=None) -> int:
     ap.add_argument("--fresh", action="store_true", help="start --out over instead of resuming it")
     a = ap.parse_args(argv)
     done = pickle.loads(a.out.read_bytes()) if a.out.exists() and not a.fresh else {"rows": [], "scenes": []}
+    done["made_by"] = " ".join(["python -m benchmarks.calibration_data", *(sys.argv[1:] if argv is None else argv)])
     a.out.parent.mkdir(parents=True, exist_ok=True)
     t0 = time.time()
     for s in range(a.per_class):

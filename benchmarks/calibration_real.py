@@ -2,8 +2,8 @@
 (benchmarks/fit_calibration.py), with what bench_real.py's box and calibration figures need to be recomputed
 for any set of calibration maps without perceiving the frames again.
 
-    .venv/bin/python benchmarks/calibration_real.py ../shared/data/real/osd-learn --out out/calib/real_osd-learn.pkl
-    .venv/bin/python benchmarks/calibration_real.py ../shared/data/real/ycb-realsense --out out/calib/real_ycb-realsense.pkl
+    .venv/bin/python -m benchmarks.calibration_real ../shared/data/real/osd-learn --out out/calib/real_osd-learn.pkl
+    .venv/bin/python -m benchmarks.calibration_real ../shared/data/real/ycb-realsense --out out/calib/real_ycb-realsense.pkl
 
 Each folder is in the layout of ../shared/data/real/README.md. Every frame is perceived
 (lv3d.perception.perceive) and grounded (lv3d.describe.ground, raw probabilities) once per modality, as
@@ -31,11 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-
-from benchmarks import bench_real as br  # noqa: E402
-from benchmarks.calibration_error import ece  # noqa: E402
+from benchmarks import bench_real as br
+from benchmarks.calibration_error import ece
 
 MODALITIES = ("depth", "rgbd")  # the modalities that see planes, so that say `perpendicular` at all
 PRED = "perpendicular"
@@ -186,7 +183,7 @@ def main(argv=None) -> int:
     a.out.parent.mkdir(parents=True, exist_ok=True)
     a.out.write_bytes(pickle.dumps({"rows": rows_of(frames), "frames": frames,
                                     "folders": [f.name for f in a.folders],
-                                    "made_by": " ".join(["benchmarks/calibration_real.py", *(argv or sys.argv[1:])])}))
+                                    "made_by": " ".join(["python -m benchmarks.calibration_real", *(argv or sys.argv[1:])])}))
     return 0
 
 

@@ -5,49 +5,51 @@ The fit reads candidate facts with their truth from two kinds of data:
 - rendered dev scenes (benchmarks/calibration_data.py): every fact type, truth from the renderer;
 - labelled real frames (benchmarks/calibration_real.py, ``--real``): ``perpendicular`` only, truth from the
   labelled shape (adjacent faces of a box are perpendicular, of a cylinder or bowl not; bench_real.py's
-  definition). Rendered scenes hold no curved solids, and their perception errors are smaller than a real
-  sensor's; the real rows teach the maps both.
+  definition). A real sensor's errors are larger than the renderer's, and real scenes hold curved solids the
+  renderer has none of; the real rows teach the maps both.
 
-The whole fit, on one core (the rendered sets ~6 min each for both modalities, the real folders ~1 min, the fit
-a few minutes)::
+The whole fit, from the repository root (each rendered set of 840 scenes ~15 min on one core for both
+modalities, the two real folders ~4 min, the fit with its checks ~10 min)::
 
-    for a in "30000 r30000" "40000 r40000" "60000 r60000" "80000 r80000" "100000 chk100000" "150000 chk150000"; do
-        set -- $a
-        .venv/bin/python benchmarks/calibration_data.py --fresh --seed $1 --per-class 150 --modalities rgbd,depth \\
+    for a in "30000 s30000" "40000 s40000" "60000 s60000" "100000 chk100000"; do set -- $a
+        .venv/bin/python -m benchmarks.calibration_data --fresh --seed $1 --per-class 120 --modalities rgbd,depth \
             --out out/calib/$2.pkl
     done
     for f in osd-learn ycb-realsense; do
-        .venv/bin/python benchmarks/calibration_real.py ../shared/data/real/$f --out out/calib/real_$f.pkl
+        .venv/bin/python -m benchmarks.calibration_real ../shared/data/real/$f --out out/calib/real_$f.pkl
     done
-    .venv/bin/python benchmarks/fit_calibration.py out/calib/r{30000,40000,60000,80000}.pkl \\
-        --real out/calib/real_osd-learn.pkl out/calib/real_ycb-realsense.pkl \\
-        --check out/calib/chk100000.pkl out/calib/chk150000.pkl --holdout
+    .venv/bin/python -m benchmarks.fit_calibration out/calib/s{30000,40000,60000}.pkl \
+        --real out/calib/real_osd-learn.pkl out/calib/real_ycb-realsense.pkl --check out/calib/chk100000.pkl --holdout
 
 Rows come from dev seeds only, never the study's data. After perception or grounding changed, all of it is rerun
-(:func:`lv3d.calibration.stale_sources` names what changed since the shipped fit).
+(lv3d.calibration.stale_sources names what changed since the shipped fit; calibration_check.py prints it).
 
 The maps. For each (modality, key) (``grounding.calibration_key``: the predicate, or a kind filed apart) several
 maps compete by scene-grouped 5-fold cross-validated log loss (a scene's or real frame's facts share its view and
 its perception errors): the raw probability unchanged, a shift in logit space, Platt scaling (bias + slope on
 logit p), and Platt plus face measurements (``FEATURES``; for predicates with a tolerance also ``tol_frac``, the
 measured value in tolerances), each with and without how well the faces fit a polygon and a plane
-(``FIT_FEATURES``); for facts about two faces (``PAIR_PREDS``) also those plus the side the two share
-(``PAIR_FEATURES``), for parallel (``PLANE_GAP_PREDS``) plus how far the faces are from one plane. The winner is
-refitted on all rows (L2-regularised logistic regression, measurements standardised, the standardisation folded
-into the coefficients); a map whose slope on logit p comes out negative is refitted without it (confidence
-must not fall as the measured probability rises). Then the final maps: per modality one isotonic map of every
-key's out-of-fold confidences pooled, one of the per-face keys (``FACE_PREDS``) pooled, and per key the best by
-scene-grouped CV log loss of none, its group's pooled map and its own (:func:`fit_final`).
+(``FIT_FEATURES``) and with those and a slope on logit p that depends on them (``GATE_FEATURES``: the measured
+probability counts as far as the outlines are straight and the corners sharp); for facts about two faces
+(``PAIR_PREDS``) also those plus the side the two share (``PAIR_FEATURES``), for parallel (``PLANE_GAP_PREDS``)
+plus how far the faces are from one plane. The winner is refitted on all rows (L2-regularised logistic
+regression, inputs standardised, the standardisation folded into the coefficients); a map whose slope on logit p
+comes out negative on most rows is refitted without the terms on p (confidence must not fall as the measured
+probability rises; grounding holds the slope at 0 where it would). Then the final maps: per modality one isotonic
+map of every key's out-of-fold confidences pooled, one of the per-face keys (``FACE_PREDS``) pooled, and per key
+the best by scene-grouped CV log loss of none, its group's pooled map and its own (:func:`fit_final`).
 
 Weights. Where a key has rows of both kinds, the real rows carry ``REAL_SHARE`` of its total weight (each kind's
-rows equal among themselves, weights averaging 1): a few hundred real candidates against tens of thousands of
-rendered ones would otherwise leave the maps as they were. The real frames also check the fit: ``--holdout``
-fits once without each real pickle and prints bench_real's figures on the one left out, before the fit on all.
+rows equal among themselves, weights averaging 1): a few hundred real candidates against thousands of rendered
+ones would otherwise leave the maps as they were.
 
-``--check`` prints per-type ECE on other rendered dev sets (facts with confidence >= 0.05, as they are emitted)
-for the raw probabilities, the shipped maps and the new ones; real pickles print bench_real's box and
-calibration figures (benchmarks/calibration_real.figures) for the shipped and the new maps. The written file
-holds the maps, those figures (``checks``) and the provenance (lv3d.calibration).
+Checks. ``--holdout`` first fits without each real pickle and prints bench_real's figures on the one left out
+(a sensor the fit has not seen), then fits in ``HOLDOUT_FOLDS`` frame-grouped folds over all real frames and prints
+the figures of each frame's out-of-fold confidences (new frames of the sensors it has seen), per folder and
+pooled. ``--check`` prints per-key ECE on other rendered dev sets (facts with confidence >= 0.05, as they are
+emitted) for the raw probabilities, the shipped maps and the new ones. The figures of the final fit on the real
+frames are in-sample. The written file holds the maps, these figures (``checks``) and the provenance
+(lv3d.calibration).
 """
 
 from __future__ import annotations
@@ -65,18 +67,21 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
 
-from benchmarks.calibration_error import chance_ece, ece, log_loss  # noqa: E402
-from grounding._calibration import SHARED_SIDE_PREDS, TOL_FRAC_PREDS, calibrate_with, calibration_key, inputs  # noqa: E402
-from lv3d.describe import SIDE_NAMES  # noqa: E402
-from lv3d.facts import PREDICATES  # noqa: E402
+from benchmarks.calibration_error import chance_ece, ece, log_loss
+from grounding._calibration import (SHARED_SIDE_PREDS, TOL_FRAC_PREDS, calibrate_with, calibration_key, factors,
+                                    inputs, is_slope, logit)
+from lv3d.describe import SIDE_NAMES
+from lv3d.facts import PREDICATES
 
 MODALITIES = ("rgbd", "depth")  # rgb is left raw: its facts' truth needs a look first (docs/grounding.md)
 FEATURES = ["support", "log_area_px", "min_turn_z", "min_side_px"]
 # how well the faces are a polygon and a plane (lv3d.describe._face_features): outlines off straight edges and
 # surfaces off their plane are what a curved solid read as planar faces shows, and rendered scenes have none
 FIT_FEATURES = ["edge_scale2", "plane_rms_mm"]
+# the slope on logit p may grow or shrink with how straight the outlines are and how sharp the weakest corner:
+# the measured probability is trusted as far as the faces look like faces of a polyhedron (grounding._calibration)
+GATE_FEATURES = ["logit_p*edge_scale2", "logit_p*min_turn_z"]
 MIN_ROWS = 12        # fewer rows (or one class of label only): keep the raw probability
 C_REG = 0.5          # inverse L2 strength of the logistic fits (standardised inputs, weights averaging 1)
 MIN_CONF = 0.05      # facts below this confidence are not emitted (lv3d.describe.MIN_CONF): ECE is over the rest
@@ -86,6 +91,7 @@ FINAL_REPEATS = 5    # fold draws the final maps are chosen over (_choose_final)
 # the share of a key's total fit weight its real rows carry where it has rows of both kinds: the two kinds count
 # alike (the maps must hold on both; neither is the other's special case)
 REAL_SHARE = 0.5
+HOLDOUT_FOLDS = 5    # --holdout: frame-grouped folds over the real frames (each fold ~12 of 59 dev frames)
 SUPPORT_PREDS = ("face_of", "adjacent", "object")  # p is edge support, not a geometric probability: may be ignored
 # facts about two faces whose map may also read the side the faces share (0: none, e.g. pyramid laterals
 # touching at the apex); parallel is offered it beside the plane gap (PLANE_GAP_PREDS)
@@ -154,6 +160,29 @@ def _predict(bias, coef, x):
     return 1.0 / (1.0 + np.exp(-np.clip(bias + x @ coef, -50, 50)))
 
 
+def _slope(coef, feats: list[str], rows: list[dict]) -> np.ndarray:
+    """The slope on logit p of a map (bias, ``coef`` of ``feats``) at each row (grounding._calibration)."""
+    on_p = np.array([is_slope(n) for n in feats], bool)
+    if not on_p.any():
+        return np.zeros(len(rows))
+    g = np.array([factors(r["pred"], r, feats) for r in rows]).reshape(len(rows), len(feats))
+    return g[:, on_p] @ np.asarray(coef)[on_p]
+
+
+def predict_rows(bias, coef, feats: list[str], rows: list[dict]) -> np.ndarray:
+    """The map's confidences of ``rows`` as grounding applies it: the slope on logit p never below 0."""
+    coef = np.asarray(coef, float)
+    if not len(feats):
+        return np.full(len(rows), 1.0 / (1.0 + np.exp(-bias)))
+    on_p = np.array([is_slope(n) for n in feats], bool)
+    x = np.array([inputs(r["pred"], r["p"], r, feats) for r in rows]).reshape(len(rows), len(feats))
+    z = bias + x[:, ~on_p] @ coef[~on_p]
+    if on_p.any():
+        lp = np.array([logit(r["p"]) for r in rows])
+        z = z + np.maximum(_slope(coef, feats, rows), 0.0) * lp
+    return 1.0 / (1.0 + np.exp(-np.clip(z, -50, 50)))
+
+
 def _fit_shift(rows: list[dict], w: np.ndarray):
     """(bias, coef, features) of ``sigmoid(logit p + bias)``: the raw probability moved in logit space by
     one smoothed constant (types whose dev candidates were all true or all false keep p's order)."""
@@ -170,9 +199,10 @@ def _fit_shift(rows: list[dict], w: np.ndarray):
 
 
 def _fit_monotone(rows: list[dict], feats: list[str] | None, w: np.ndarray):
-    """(bias, coef, features) of a logistic map (``feats`` None: :func:`_fit_shift`); refitted without logit p
-    when its slope comes out negative (where p carries no information, e.g. always 1, the map must not turn it
-    upside down)."""
+    """(bias, coef, features) of a logistic map (``feats`` None: :func:`_fit_shift`); refitted without the terms
+    on logit p when its slope (:func:`_slope`) comes out negative on most (weighted) rows (where p carries no
+    information, e.g. always 1, the map must not turn it upside down; where it is negative on a few rows, grounding
+    holds it at 0 there)."""
     if feats is None:
         return _fit_shift(rows, w)
     y = np.array([r["y"] for r in rows], float)
@@ -180,8 +210,9 @@ def _fit_monotone(rows: list[dict], feats: list[str] | None, w: np.ndarray):
         return float(np.log((np.sum(w * y) + .5) / (np.sum(w * (1 - y)) + .5))), np.zeros(0), []
     x = np.array([inputs(r["pred"], r["p"], r, feats) for r in rows])
     b, c = _fit(x, y, w)
-    if feats[0] == "logit_p" and c[0] < 0:
-        return _fit_monotone(rows, feats[1:], w)
+    if np.average(_slope(c, feats, rows) < 0, weights=w) > 0.5:
+        # the fit would lower the confidence as p rises on most rows: p is left out
+        return _fit_monotone(rows, [n for n in feats if not is_slope(n)], w)
     return b, c, feats
 
 
@@ -198,9 +229,12 @@ def candidate_maps(pred: str) -> dict:
     tol = ["tol_frac"] if pred in TOL_FRAC_PREDS else []  # the measured value in tolerances
     cands = {"raw": "raw", "shift": None, "platt": ["logit_p"], "platt+measures": ["logit_p"] + FEATURES + tol,
              "platt+measures+fit": ["logit_p"] + FEATURES + FIT_FEATURES + tol}
+    cands["platt+measures+fit+gated"] = ["logit_p"] + FEATURES + FIT_FEATURES + tol + GATE_FEATURES
     if pred in PAIR_PREDS:
         cands["platt+measures+shared"] = ["logit_p"] + FEATURES + PAIR_FEATURES + tol
         cands["platt+measures+shared+fit"] = ["logit_p"] + FEATURES + PAIR_FEATURES + FIT_FEATURES + tol
+        cands["platt+measures+shared+fit+gated"] = (["logit_p"] + FEATURES + PAIR_FEATURES + FIT_FEATURES + tol
+                                                    + GATE_FEATURES)
     if pred in PLANE_GAP_PREDS:
         cands["platt+measures+gap"] = ["logit_p"] + FEATURES + PLANE_GAP_FEATURES + tol
         cands["platt+measures+gap+shared"] = ["logit_p"] + FEATURES + PLANE_GAP_FEATURES + PAIR_FEATURES + tol
@@ -230,8 +264,7 @@ def fit_one(rows: list[dict], seed: int = 0, w: np.ndarray | None = None):
                 continue
             trows = [r for r, t in zip(rows, tr) if t]
             b, c, f = _fit_monotone(trows, feats, w[tr])
-            x = np.array([inputs(r["pred"], r["p"], r, f) for r, t in zip(rows, te) if t]).reshape(int(te.sum()), len(f))
-            pred[te] = _predict(b, c, x)
+            pred[te] = predict_rows(b, c, f, [r for r, t in zip(rows, te) if t])
         losses[name], oof[name] = _wlog_loss(pred, y, w), pred
     name = min(losses, key=losses.get)
     if cands[name] == "raw":
@@ -313,8 +346,11 @@ def fit_final(oof: dict, seed: int = 0) -> tuple[dict, dict]:
     return {**final, "by_pred": by_pred}, losses
 
 
-def fit(rows: list[dict], modalities, real_share: float = REAL_SHARE, log=print) -> tuple[dict, dict]:
-    """(table, final) fitted on ``rows`` (rendered and real together) for ``modalities``."""
+def fit(rows: list[dict], modalities, real_share: float = REAL_SHARE, log=print,
+        memo: dict | None = None) -> tuple[dict, dict]:
+    """(table, final) fitted on ``rows`` (rendered and real together) for ``modalities``. ``memo``: a dict that
+    keeps the per-key fits of keys without real rows between calls on the same rendered rows (the held-out fits
+    differ in their real rows only)."""
     by = defaultdict(list)
     for r in rows:
         if r["modality"] in modalities and r["p"] > 0:
@@ -323,10 +359,15 @@ def fit(rows: list[dict], modalities, real_share: float = REAL_SHARE, log=print)
     oof = defaultdict(dict)  # per modality, per key: out-of-fold confidences, truth, scenes, weights
     for key in sorted(by):
         rs = by[key]
-        w = row_weights(rs, real_share)
-        entry, losses, conf = fit_one(rs, w=w)
-        oof[key[0]][key[1]] = (conf, np.array([r["y"] for r in rs], float), np.array([scene_of(r) for r in rs]), w)
         n_real = sum(is_real(r) for r in rs)
+        w = row_weights(rs, real_share)
+        if memo is not None and not n_real and (key, len(rs)) in memo:
+            entry, losses, conf = memo[(key, len(rs))]
+        else:
+            entry, losses, conf = fit_one(rs, w=w)
+            if memo is not None and not n_real:
+                memo[(key, len(rs))] = entry, losses, conf
+        oof[key[0]][key[1]] = (conf, np.array([r["y"] for r in rs], float), np.array([scene_of(r) for r in rs]), w)
         log(f"  {key[0]:5s} {key[1]:20s} n={len(rs):5d} ({n_real} real)  cv log loss "
             + "  ".join(f"{k} {v:.4f}" for k, v in losses.items())
             + f"  -> {'raw' if entry is None else entry['map'] + ' ' + ','.join(entry['features'])}")
@@ -401,23 +442,48 @@ def report_rendered(rows: list[dict], table: tuple, title: str, shipped: tuple |
         print(line)
 
 
-def real_figures(frames: list[dict], maps: tuple) -> dict:
-    """bench_real's box and calibration figures (calibration_real.figures) of real frame entries under ``maps``."""
+def real_figures(frames: list[dict], maps: tuple | None = None, conf: dict | None = None) -> dict:
+    """bench_real's box and calibration figures (calibration_real.figures) of real frame entries under ``maps``
+    (table, final), or with each candidate's confidence looked up in ``conf`` {id(row): confidence}."""
     from benchmarks.calibration_real import figures
 
+    if conf is not None:
+        return figures(frames, lambda r: conf[id(r)])
     return figures(frames, lambda r: calibrate_with(maps[0], r["modality"], r["key"], r["p"], r, maps[1]))
 
 
-def print_real(title: str, figs: dict, before: dict | None = None) -> None:
+def frame_folds(real: list[tuple[Path, dict, str]], k: int = 5, seed: int = 0) -> dict[str, int]:
+    """{folder/frame: one of ``k`` folds}, each folder's frames dealt out over the folds in a seeded random order
+    (so every fold holds frames of every folder)."""
+    rng = np.random.default_rng(seed)
+    out = {}
+    for _, d, _ in real:
+        names = sorted({f"{e['folder']}/{e['frame']}" for e in d["frames"]})
+        out.update({n: i % k for n, i in zip(names, rng.permutation(len(names)))})
+    return out
+
+
+def print_real(title: str, sets: dict[str, dict], before: dict[str, dict] | None = None) -> None:
+    """One line per set (folder, or "pooled") and modality: the figures, after the shipped ones if given."""
     print(f"== {title}")
-    for m, f in sorted(figs.items()):
-        b = (before or {}).get(m, {})
-        cells = []
-        for k in ("perpendicular_ece", "box_perpendicular_frac", "cylinder_as_prism_frac"):
-            v = f[k]
-            was = f"{b[k]:.3f} -> " if b.get(k) is not None else ""
-            cells.append(f"{k} {was}{'null' if v is None else f'{v:.3f}'}")
-        print(f"  {m:5s} " + "  ".join(cells) + f"  ({f['pairs']} pairs)")
+    for name, figs in sets.items():
+        for m, f in sorted(figs.items()):
+            b = (before or {}).get(name, {}).get(m, {})
+            cells = []
+            for k in ("perpendicular_ece", "box_perpendicular_frac", "cylinder_as_prism_frac"):
+                v = f[k]
+                was = f"{b[k]:.3f} -> " if b.get(k) is not None else ""
+                cells.append(f"{k} {was}{'null' if v is None else f'{v:.3f}'}")
+            print(f"  {name:16s} {m:5s} " + "  ".join(cells) + f"  ({f['pairs']} pairs)")
+
+
+def real_sets(real: list[tuple[Path, dict, str]], **kw) -> dict[str, dict]:
+    """:func:`real_figures` of each real pickle's frames and of all of them pooled."""
+    sets = {d["folders"][0] if len(d.get("folders", [])) == 1 else p.name: real_figures(d["frames"], **kw)
+            for p, d, _ in real}
+    if len(real) > 1:
+        sets["pooled"] = real_figures([e for _, d, _ in real for e in d["frames"]], **kw)
+    return sets
 
 
 # ---------------------------------------------------------------------------------------------- provenance
@@ -442,17 +508,25 @@ def provenance(argv: list[str], data: list[tuple[Path, dict, str]]) -> dict:
 
     dirty = _git("status", "--porcelain", "--", "grounding", "lv3d/perception", "lv3d/describe.py", "benchmarks")
     return {
-        "command": " ".join(["benchmarks/fit_calibration.py", *argv]),
+        "command": " ".join(["python -m benchmarks.fit_calibration", *argv]),
         "git_commit": _git("rev-parse", "HEAD"),
         "uncommitted": sorted(line[3:] for line in (dirty or "").splitlines()),
         "sources_sha256": source_digests(),
         "fitted_at": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "data": [{"file": p.name, "kind": kind, "sha256": _sha256(p), "rows": len(d["rows"]),
                   "scenes": len({scene_of(r) for r in d["rows"]}),
-                  "made_by": d.get("made_by") or ("benchmarks/calibration_data.py" if kind == "rendered"
-                                                  else "benchmarks/calibration_real.py")}
+                  "made_by": d.get("made_by")}
                  for p, d, kind in data],
     }
+
+
+def to_json(doc: dict) -> str:
+    """``doc`` as indented JSON with every list of numbers or strings on one line (knots and coefficients)."""
+    import re
+
+    text = json.dumps(doc, indent=1)
+    return re.sub(r"\[[^\[\]{}]*\]", lambda m: " ".join(m.group(0).split()).replace("[ ", "[").replace(" ]", "]"),
+                  text) + "\n"
 
 
 def _read(path: Path, what: str) -> dict:
@@ -474,7 +548,8 @@ def main(argv=None) -> int:
     ap.add_argument("--real", type=Path, nargs="*", default=[], help="pickles from benchmarks/calibration_real.py")
     ap.add_argument("--check", type=Path, nargs="*", default=[], help="rendered dev sets to report ECE on")
     ap.add_argument("--holdout", action="store_true",
-                    help="first fit once without each --real pickle and report the figures on the one left out")
+                    help="first check on real frames left out of the fit: each --real pickle in turn, then the real "
+                         f"frames in {HOLDOUT_FOLDS} frame-grouped folds")
     ap.add_argument("--real-share", type=float, default=REAL_SHARE,
                     help=f"share of a key's fit weight its real rows carry (default {REAL_SHARE})")
     ap.add_argument("--out", type=Path, default=DATA)
@@ -491,35 +566,50 @@ def main(argv=None) -> int:
     shipped = None if shipped_file is None else (shipped_file["table"], shipped_file["final"])
     render_rows = [r for _, d, _ in rendered for r in d["rows"]]
     check_rows = [r for _, d, _ in checks for r in d["rows"]]
-    out_checks: dict = {"real_held_out": {}}
+    out_checks: dict = {}
 
     def quiet(*_args, **_kw):
         return None
 
-    if a.holdout:
+    memo: dict = {}
+    before = real_sets(real, maps=shipped) if shipped and real else None
+    if a.holdout and real:
+        # 1. a new sensor: fit without each real pickle, figures on the one left out
+        held = {}
         for i, (path, d, _) in enumerate(real):
             others = [r for j, (_, e, _) in enumerate(real) if j != i for r in e["rows"]]
-            maps = fit(render_rows + others, mods, a.real_share, log=quiet)
-            figs = real_figures(d["frames"], maps)
-            before = real_figures(d["frames"], shipped) if shipped else None
-            print_real(f"held out {path.name}: fitted on the rendered sets and "
-                       f"{', '.join(p.name for j, (p, _, _) in enumerate(real) if j != i) or 'no real set'}"
-                       + ("; shipped -> held-out fit" if shipped else ""), figs, before)
-            out_checks["real_held_out"][path.name] = figs
-            if check_rows:
-                e = rendered_ece(check_rows, maps)
-                print("  rendered check sets, ECE over all emitted facts: "
-                      + "  ".join(f"{m} {e[m]['all'][0]:.3f}" for m in sorted(e)))
+            maps = fit(render_rows + others, mods, a.real_share, log=quiet, memo=memo)
+            name = d["folders"][0] if len(d.get("folders", [])) == 1 else path.name
+            held[name] = real_figures(d["frames"], maps)
+        print_real("each real set left out of the fit (fitted on the rendered rows and the other real sets)"
+                   + ("; shipped -> held out" if before else ""), held, before)
+        out_checks["real_held_out"] = held
+        # 2. new frames of the same sensors: frame-grouped folds over every real set
+        folds = frame_folds(real, HOLDOUT_FOLDS)
+        conf = {}
+        for k in range(HOLDOUT_FOLDS):
+            train = [r for _, d, _ in real for r in d["rows"] if folds[r["scene"]] != k]
+            maps = fit(render_rows + train, mods, a.real_share, log=quiet, memo=memo)
+            for _, d, _ in real:
+                for e in d["frames"]:
+                    if folds[f"{e['folder']}/{e['frame']}"] == k:
+                        for r in e["cands"]:
+                            conf[id(r)] = calibrate_with(maps[0], r["modality"], r["key"], r["p"], r, maps[1])
+        cv = real_sets(real, conf=conf)
+        print_real(f"real frames in {HOLDOUT_FOLDS} frame-grouped folds, each fold's confidences from a fit without "
+                   "it" + ("; shipped -> out of fold" if before else ""), cv, before)
+        out_checks["real_frame_folds"] = cv
     print("== fit on every set")
-    maps = fit(render_rows + [r for _, d, _ in real for r in d["rows"]], mods, a.real_share)
+    maps = fit(render_rows + [r for _, d, _ in real for r in d["rows"]], mods, a.real_share, memo=memo)
     for m in MODALITIES:  # a modality not refitted keeps the shipped maps
         if m not in mods and shipped is not None:
             maps[0][m], maps[1][m] = shipped[0].get(m, {}), shipped[1].get(m, {})
-    for path, d, _ in real:
-        figs = real_figures(d["frames"], maps)
-        print_real(f"{path.name} (in the fit)" + ("; shipped -> calibrated" if shipped else ""), figs,
-                   real_figures(d["frames"], shipped) if shipped else None)
-        out_checks.setdefault("real_in_fit", {})[path.name] = figs
+    if real:
+        in_fit = real_sets(real, maps=maps)
+        print_real("real sets in the fit" + ("; shipped -> calibrated" if before else ""), in_fit, before)
+        out_checks["real_in_fit"] = in_fit
+        if before:
+            out_checks["real_shipped_before"] = before
     report_rendered(render_rows, maps, f"fit rows ({', '.join(p.name for p in a.data)})")
     if check_rows:
         report_rendered(check_rows, maps, f"check rows ({', '.join(p.name for p in a.check)})", shipped)
@@ -532,7 +622,7 @@ def main(argv=None) -> int:
            "provenance": provenance(argv, rendered + real + checks), "checks": out_checks,
            "table": maps[0], "final": maps[1]}
     a.out.parent.mkdir(parents=True, exist_ok=True)
-    a.out.write_text(json.dumps(doc, indent=1, sort_keys=False) + "\n")
+    a.out.write_text(to_json(doc))
     print(f"wrote {a.out}")
     return 0
 

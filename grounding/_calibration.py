@@ -6,13 +6,17 @@ corner on a long side (a pentagon that is a quadrilateral), a face split in two,
 an edge, a curved surface read as a plane. A per-(modality, key) logistic map turns the raw probability ``p``
 and a few measurements of the faces behind it into a calibrated one:
 
-    conf = sigmoid(bias + sum_k coef_k x_k),  x = (logit p, measurements named in the map)
+    conf = sigmoid(bias + sum_k coef_k m_k + max(0, slope) logit p),  slope = sum_j coef_j g_j
 
-then a final non-decreasing piecewise-linear map (knots of an isotonic regression) corrects what the logistic
-form leaves over. Per (modality, key) the final map is the key's own, one pooled over the modality's facts
-about one face (``"faces"``), one pooled over every key, or none (``"by_pred"`` names the choice; a key it does
-not name takes the pooled one). Both stages are monotone increasing in ``p`` (the ``logit_p`` coefficient is
-kept positive), so a more certain measurement never gets a lower confidence, other things equal.
+with ``m`` the measurements named in the map and ``g`` the factors of its ``logit_p`` inputs: ``"logit_p"``
+itself (g = 1) and products ``"logit_p*NAME"`` (g = the measurement NAME), so that how far the measured
+probability is trusted may depend on how the faces look (a measured angle says little about faces whose
+outlines are not straight). Then a final non-decreasing piecewise-linear map (knots of an isotonic regression)
+corrects what the logistic form leaves over. Per (modality, key) the final map is the key's own, one pooled over
+the modality's facts about one face (``"faces"``), one pooled over every key, or none (``"by_pred"`` names the
+choice; a key it does not name takes the pooled one). Both stages are monotone non-decreasing in ``p`` (the
+slope on logit p is never below 0), so a more certain measurement never gets a lower confidence, other things
+equal.
 
 This package holds no maps: :class:`Calibration` is built from them (``{"table": {modality: {key: map}},
 "final": {modality: final maps}}``, the layout the fitting code writes); a (modality, key) without a map keeps
@@ -95,9 +99,26 @@ def calibration_key(pred: str, fewer: bool = False, shared_side_px: float | None
     return pred
 
 
+LOGIT_P = "logit_p"  # the input logit(p); "logit_p*NAME": logit(p) times the measurement NAME
+
+
 def inputs(pred: str, p: float, x: dict, names: list[str]) -> list[float]:
-    """The inputs of ``pred``'s calibration map: ``logit(p)`` then the named measurements of ``x``."""
-    return [logit(p) if k is None else scale(float(x.get(k, 0.0))) for k, scale in _inputs(pred, names)]
+    """The named inputs of ``pred``'s calibration map, on their scales: ``"logit_p"`` logit(p), ``"logit_p*NAME"``
+    logit(p) times measurement NAME, NAME the measurement of ``x``."""
+    lp = logit(p)
+    return [(lp if slope else 1.0) * (1.0 if k is None else scale(float(x.get(k, 0.0))))
+            for slope, k, scale in _inputs(pred, names)]
+
+
+def factors(pred: str, x: dict, names: list[str]) -> list[float]:
+    """The factor each named input multiplies (``"logit_p"``: 1, ``"logit_p*NAME"``: measurement NAME) or, for
+    a plain measurement, its value: the terms the map's slope on logit p and its other terms are made of."""
+    return [1.0 if k is None else scale(float(x.get(k, 0.0))) for _, k, scale in _inputs(pred, names)]
+
+
+def is_slope(name: str) -> bool:
+    """Whether the input ``name`` multiplies logit p (a term of the slope on logit p)."""
+    return name == LOGIT_P or name.startswith(LOGIT_P + "*")
 
 
 def calibrate_with(table: dict, modality: str, pred: str, p: float, x: dict | None = None,
@@ -146,10 +167,17 @@ def _predicate(key: str) -> str:
 
 
 def _inputs(key: str, names: list[str]) -> list:
-    """[(key of the measurement in x, or None for logit p; its scale)] of the named inputs of the map filed under
-    ``key`` (a predicate, or the key of a kind filed apart: its predicate's tolerance)."""
-    return [(None, None) if n == "logit_p" else ("value", _tol_fraction(_predicate(key))) if n == "tol_frac"
-            else (n, _SCALE.get(n, float)) for n in names]
+    """[(whether it multiplies logit p, key of the measurement in x or None for none, its scale)] of the named
+    inputs of the map filed under ``key`` (a predicate, or the key of a kind filed apart: its predicate's
+    tolerance)."""
+    out = []
+    for n in names:
+        slope = is_slope(n)
+        m = n[len(LOGIT_P) + 1:] if slope else n
+        out.append((slope, None, None) if not m else
+                   (slope, "value", _tol_fraction(_predicate(key))) if m == "tol_frac" else
+                   (slope, m, _SCALE.get(m, float)))
+    return out
 
 
 def _final_knots(pred: str, final: dict | None) -> dict | None:
@@ -164,13 +192,13 @@ def _final_knots(pred: str, final: dict | None) -> dict | None:
 
 
 def _compile(pred: str, entry: dict | None, final: dict | None):
-    """(bias, [(coefficient, key in x or None for logit p, scale)], final knots (xs, ys)) of ``pred``'s table
-    entry (bias and terms None without one) and its final map in its modality's ``final`` (None without
-    one); None if neither."""
+    """(bias, [(coefficient, whether it multiplies logit p, key in x or None for 1, scale)], final knots (xs, ys))
+    of ``pred``'s table entry (bias and terms None without one) and its final map in its modality's ``final`` (None
+    without one); None if neither."""
     knots = _final_knots(pred, final)
     if entry is None and knots is None:
         return None
-    terms = None if entry is None else [(c, k, s) for c, (k, s) in zip(entry["coef"], _inputs(pred, entry["features"]))]
+    terms = None if entry is None else [(c, *t) for c, t in zip(entry["coef"], _inputs(pred, entry["features"]))]
     return (None if entry is None else entry["bias"]), terms, (None if knots is None else (knots["x"], knots["y"]))
 
 
@@ -181,12 +209,14 @@ def _apply(compiled, p: float, x: dict | None) -> float:
     bias, terms, knots = compiled
     if terms is not None:
         x = x or {}
-        # plain left-to-right sum from 0 (what sum() over a generator gave on Python 3.11), without
-        # building a generator per candidate
-        s = 0
-        for c, n, scale in terms:
-            s += c * (logit(p) if n is None else scale(float(x.get(n, 0.0))))
-        z = bias + s
+        s = slope = 0.0
+        for c, on_p, n, scale in terms:
+            v = c * (1.0 if n is None else scale(float(x.get(n, 0.0))))
+            if on_p:
+                slope += v
+            else:
+                s += v
+        z = bias + s + max(slope, 0.0) * logit(p)
         p = 1.0 / (1.0 + math.exp(-max(min(z, 50.0), -50.0)))
     return p if knots is None else _interp(knots, p)
 

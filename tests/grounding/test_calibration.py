@@ -229,3 +229,20 @@ def test_facts_about_faces_that_touch_at_a_point_have_maps_of_their_own():
     assert math.isclose(calibrate_with(table, "rgbd", "acute", 0.6, {}), 0.6)
     assert math.isclose(calibrate_with(table, "rgbd", "acute_touch", 0.6, {}), 1 / (1 + math.exp(2 - math.log(1.5))))
     assert "acute_touch" in TABLE["rgbd"] and "perpendicular_touch" in TABLE["depth"]
+
+
+def test_the_slope_on_logit_p_may_depend_on_the_faces_and_never_falls_below_zero():
+    table = {"rgbd": {"perpendicular": {"features": ["logit_p", "logit_p*edge_scale2", "support"],
+                                        "bias": 0.0, "coef": [2.0, -1.0, 0.5]}}}
+
+    def conf(p, edge):
+        return calibrate_with(table, "rgbd", "perpendicular", p, {"edge_scale2": edge, "support": 1.0})
+
+    # slope 2 - log(edge_scale2): straight outlines (edge_scale2 1) trust p fully, ragged ones less
+    assert math.isclose(conf(0.9, 1.0), 1 / (1 + math.exp(-(0.5 + 2 * math.log(9)))))
+    assert math.isclose(conf(0.9, math.e), 1 / (1 + math.exp(-(0.5 + 1 * math.log(9)))))
+    # past edge_scale2 e^2 the slope would turn negative: it is held at 0, p no longer matters
+    assert math.isclose(conf(0.9, math.e ** 3), conf(0.2, math.e ** 3)) and math.isclose(conf(0.9, 50.0), 1 / (1 + math.exp(-0.5)))
+    cal = grounding.Calibration(table)
+    assert cal.calibrate("rgbd", "perpendicular", 0.9, {"edge_scale2": 2.0, "support": 1.0}) == conf(0.9, 2.0)
+    assert cal.measures_used("rgbd", "perpendicular") == ["logit_p*edge_scale2", "support"]
