@@ -9,6 +9,7 @@ angles. Pixel counts are derived from them for the frame at hand, so the same se
 
 from __future__ import annotations
 
+import hashlib
 import time
 from dataclasses import dataclass, field, replace
 
@@ -135,7 +136,8 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
     plane_args = {"min_frac": settings.noisy_plane_share if heavy_noise(noise_rel) else settings.plane_share,
                   "max_need": max(1, round(settings.plane_max_frac * cells)),
                   "min_points": max(3, round(settings.plane_min_frac * cells))}
-    solids = _solids(grid, support, objs, seed, plane_args, settings.convexity)
+    normals = _Normals(grid)
+    solids = _solids(grid, support, objs, seed, plane_args, settings.convexity, normals)
     solids = join_occluded(solids, grid.xyz, grid.valid, settings.occlusion)
     solids.sort(key=lambda op: (-op[0].size, int(np.argmax(op[0].mask))))
     dropped = max(0, len(solids) - settings.max_objects)
@@ -148,7 +150,7 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
         ta = time.perf_counter()
         planes = merge_coplanar(planes)
         adj = plane_adjacency(planes)
-        planes, adj, curved = _curved(grid, o, planes, adj, settings.curved)
+        planes, adj, curved = _curved(grid, o, planes, adj, settings.curved, normals)
         curved_adj = [(i, j) for j, c in enumerate(curved) for i, p in enumerate(planes)
                       if np.count_nonzero(cv2.dilate(c.mask.view(np.uint8), np.ones((5, 5), np.uint8)).view(bool)
                                           & p.mask) >= 4]
@@ -178,15 +180,31 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
     return DepthResult(grid, support, results, timings, dropped)
 
 
+class _Normals:
+    """Each object's normals on its bounding box of the grid, from its own points (cloud.crop_normals with
+    ``within``), computed once per object mask: the plane search and the cylinder search both need them."""
+
+    def __init__(self, grid: PointGrid):
+        self.grid = grid
+        self._memo: dict[bytes, np.ndarray] = {}
+
+    def __call__(self, mask: np.ndarray) -> np.ndarray:
+        key = hashlib.blake2b(np.packbits(mask).tobytes(), digest_size=16).digest()
+        if key not in self._memo:
+            rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+            self._memo[key] = crop_normals(self.grid, rows[0], cols[0], rows[-1] + 1, cols[-1] + 1, within=mask)
+        return self._memo[key]
+
+
 def _solids(grid: PointGrid, support: Plane | None, objs: list[DepthObject], seed: int, plane_args: dict,
-            convexity: ConvexitySettings) -> list[tuple[DepthObject, list[DepthPlane]]]:
+            convexity: ConvexitySettings, normals: _Normals) -> list[tuple[DepthObject, list[DepthPlane]]]:
     """Each object cut at concave creases into solids (convexity.split_at_concave), each solid with its planes: a
     cut piece gets its planes anew, which may cut it again."""
     out = []
     todo = list(objs)
     while todo:
         o = todo.pop(0)
-        planes = object_planes(grid, o.mask, seed=seed + len(out), **plane_args)
+        planes = object_planes(grid, o.mask, seed=seed + len(out), normals=normals(o.mask), **plane_args)
         pieces = split_at_concave(grid, o.mask, planes, convexity)
         if len(pieces) == 1:
             out.append((o, planes))
@@ -196,7 +214,7 @@ def _solids(grid: PointGrid, support: Plane | None, objs: list[DepthObject], see
 
 
 def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list[tuple[int, int]],
-            settings: CurvedSettings) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
+            settings: CurvedSettings, normals: _Normals) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
     """The object's planes and their adjacency with a fan of planes replaced by the cylindrical face it is
     (curved.fan_cylinder), and that face; the inputs unchanged when there is none."""
     if len(planes) < 2 or not adj:
@@ -204,7 +222,7 @@ def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list
     m = o.mask
     rows, cols = np.flatnonzero(m.any(axis=1)), np.flatnonzero(m.any(axis=0))
     i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
-    nrm = crop_normals(grid, i0, j0, i1, j1, within=m)[m[i0:i1, j0:j1]].astype(np.float64)
+    nrm = normals(m)[m[i0:i1, j0:j1]].astype(np.float64)
     pts = grid.xyz[m].astype(np.float64)
     plane_of = np.full(len(pts), -1)
     for k, p in enumerate(planes):

@@ -89,7 +89,7 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     fg_cut = cv2.morphologyEx(fg_cut.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)).astype(bool)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(fg_cut.astype(np.uint8), connectivity=4)
     if support is not None:
-        n, labels, stats = _split_by_height(labels, n, h_above, band, min_points, seed_bands)
+        n, labels, stats = _split_by_height(labels, n, stats, h_above, band, min_points, seed_bands)
     # foreground cells outside every piece: the cuts themselves, and what the opening removed. A face seen
     # nearly edge-on is all depth jumps between neighbouring cells, and a few cells wide: without these cells
     # it is lost whole
@@ -125,7 +125,8 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     return out
 
 
-def _split_by_height(labels: np.ndarray, n: int, h_above: np.ndarray, band_m: float, min_points: int,
+def _split_by_height(labels: np.ndarray, n: int, stats: np.ndarray, h_above: np.ndarray, band_m: float,
+                     min_points: int,
                      seed_bands: float = 3.0) -> tuple[int, np.ndarray, np.ndarray]:
     """Pieces of the foreground (``labels`` 1..n-1, 0 = none) parted where they dip towards the support between
     parts that stand higher: a marker-controlled watershed on the height above the support (``h_above``, metres).
@@ -141,11 +142,11 @@ def _split_by_height(labels: np.ndarray, n: int, h_above: np.ndarray, band_m: fl
     big = np.flatnonzero(st[:, cv2.CC_STAT_AREA] >= min_points)
     big = big[big > 0]
     if len(big) < 2:
-        return n, labels, _stats(labels, n)
+        return n, labels, stats
     piece_of_seed = {int(s): int(np.bincount(labels[seeds == s]).argmax()) for s in big}
     counts = np.bincount(list(piece_of_seed.values()), minlength=n)
     if counts.max() < 2:
-        return n, labels, _stats(labels, n)
+        return n, labels, stats
     markers = np.zeros(labels.shape, np.int16)
     for j, s in enumerate(big, start=1):
         if counts[piece_of_seed[int(s)]] >= 2:

@@ -35,14 +35,16 @@ def _largest_piece(mask: np.ndarray) -> np.ndarray:
 
 def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_planes: int = 6,
                   min_frac: float = 0.035, max_need: int = 1500, min_points: int = 25,
-                  max_angle_deg: float = 20.0, max_misses: int = 3) -> list[DepthPlane]:
+                  max_angle_deg: float = 20.0, max_misses: int = 3, normals: np.ndarray | None = None
+                  ) -> list[DepthPlane]:
     """Planes of the object whose grid cells are ``obj_mask`` (h, w) bool, largest first. A plane needs at least
     ``max(min_points, min(min_frac * object size, max_need))`` points in one connected piece: a share of the object
     keeps strips and noise out (depth.py asks more under heavy depth noise), and ``max_need`` lets a large object's
     small face in (hexagonal prism 2003's 2179 px side is 4.4% of its 47690 cells; docs/perception.md, session 27).
     A sample whose plane is too small a piece sets its points aside and the search goes on, ``max_misses`` times
     at most: a curved surface beside the object's planes (a can, a drill, in clutter) must not end the search
-    before the planes behind it are found."""
+    before the planes behind it are found. ``normals``: the object's normals on its bounding box of the grid, as
+    :func:`~lv3d.perception.cloud.crop_normals` gives them with ``within=obj_mask``, where already computed."""
     rng = np.random.default_rng(seed)
     rows, cols = np.flatnonzero(obj_mask.any(axis=1)), np.flatnonzero(obj_mask.any(axis=0))
     if len(rows) == 0:
@@ -51,7 +53,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     i0, j0, i1, j1 = rows[0], cols[0], rows[-1] + 1, cols[-1] + 1
     box = obj_mask[i0:i1, j0:j1]
     pts = grid.xyz[i0:i1, j0:j1][box].astype(np.float64)
-    nrm_grid = grid.normals[i0:i1, j0:j1]
+    nrm_grid = grid.normals[i0:i1, j0:j1] if normals is None else normals
     if not nrm_grid.any():
         # from the object's points alone: along its silhouette, normals mixed with the table's points agree with
         # none of its faces, and the score below gave a face's silhouette strip to its neighbour (tetrahedron 1005,
@@ -212,11 +214,18 @@ def plane_adjacency(planes: list[DepthPlane], min_contact: int = 4,
     """Pairs (i, j), i < j, of planes whose masks touch along at least ``min_contact`` grid cells and whose
     normals differ by at least ``min_angle_deg`` (two parallel touching pieces are one face, not an edge)."""
     out = []
-    grown = [cv2.dilate(p.mask.astype(np.uint8), np.ones((3, 3), np.uint8), iterations=2).astype(bool)
-             for p in planes]
+    if len(planes) < 2:
+        return out
+    # on the planes' bounding box grown by the dilation's reach: dilating whole grids costs more than the rest
+    rows = np.flatnonzero(np.any([p.mask.any(axis=1) for p in planes], axis=0))
+    cols = np.flatnonzero(np.any([p.mask.any(axis=0) for p in planes], axis=0))
+    h, w = planes[0].mask.shape
+    i0, i1, j0, j1 = max(0, rows[0] - 2), min(h, rows[-1] + 3), max(0, cols[0] - 2), min(w, cols[-1] + 3)
+    masks = [np.ascontiguousarray(p.mask[i0:i1, j0:j1]) for p in planes]
+    grown = [cv2.dilate(m.view(np.uint8), np.ones((3, 3), np.uint8), iterations=2).view(bool) for m in masks]
     for i in range(len(planes)):
         for j in range(i + 1, len(planes)):
-            contact = np.count_nonzero(grown[i] & planes[j].mask)
+            contact = np.count_nonzero(grown[i] & masks[j])
             ang = np.degrees(np.arccos(np.clip(abs(planes[i].plane.n @ planes[j].plane.n), -1, 1)))
             if contact >= min_contact and ang >= min_angle_deg:
                 out.append((i, j))

@@ -45,12 +45,12 @@ def test_height_valleys_part_two_objects_joined_by_a_ramp():
     # two bumps 10 cm high joined by a 1 cm ramp of smoothed readings, as one connected piece
     height = 0.1 * np.exp(-((jj - 30) / 12.0) ** 2) + 0.1 * np.exp(-((jj - 90) / 12.0) ** 2) + 0.01
     labels = np.ones((h, w), np.int32)
-    n, out, stats = _split_by_height(labels, 2, height.astype(np.float32), band_m=0.005, min_points=20)
+    n, out, stats = _split_by_height(labels, 2, None, height.astype(np.float32), band_m=0.005, min_points=20)
     assert n == 3 and stats[1:, 4].sum() == h * w
     assert out[30, 20] != out[30, 100] and out[30, 20] > 0 and out[30, 100] > 0
     # one bump: kept whole
     one = 0.1 * np.exp(-((jj - 60) / 20.0) ** 2) + 0.01
-    n, out, _ = _split_by_height(labels, 2, one.astype(np.float32), band_m=0.005, min_points=20)
+    n, out, _ = _split_by_height(labels, 2, None, one.astype(np.float32), band_m=0.005, min_points=20)
     assert n == 2 and np.all(out == 1)
 
 
