@@ -110,6 +110,8 @@ def _synthetic_data_and_facts(monkeypatch):
 def fake_world(monkeypatch):
     """Route the runner's data set, pipeline and learner to the synthetic stand-ins above."""
     _synthetic_data_and_facts(monkeypatch)
+    import lv3d.learn.settings  # noqa: F401  (the settings check stays the real one)
+
     learn = types.ModuleType("lv3d.learn")
     learn.Model = FakeModel
     monkeypatch.setitem(sys.modules, "lv3d.learn", learn)
