@@ -71,7 +71,15 @@ def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, offsets:
     ij = np.argwhere(labels > 0)
     extent = int((ij.max(axis=0) - ij.min(axis=0)).max()) + 1
     band = max(2, int(round(settings.band_frac * extent)))
-    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * band + 1, 2 * band + 1))
+    reach: list[np.ndarray | None] = [None] * k  # cells within ``band`` of each patch, made when first needed
+
+    def within(i: int) -> np.ndarray:
+        if reach[i] is None:
+            # Euclidean distance to the patch: the disc a dilation by an ellipse of radius ``band`` reaches
+            dist = cv2.distanceTransform((~masks[i]).view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+            reach[i] = dist <= band
+        return reach[i]
+
     masks = [labels == a for a in range(1, k + 1)]
     sizes = [int(np.count_nonzero(m)) for m in masks]
     touch = [cv2.dilate(m.view(np.uint8), np.ones((3, 3), np.uint8), iterations=2).view(bool) for m in masks]
@@ -84,8 +92,8 @@ def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, offsets:
             if not _meet(xyz, touch[b] & masks[a], normals[masks[b]][0], offsets[b + 1], settings) or \
                     not _meet(xyz, touch[a] & masks[b], normals[masks[a]][0], offsets[a + 1], settings):
                 continue
-            near_b = cv2.dilate(masks[b].view(np.uint8), kernel).view(bool) & masks[a]
-            near_a = cv2.dilate(masks[a].view(np.uint8), kernel).view(bool) & masks[b]
+            near_b = within(b) & masks[a]
+            near_a = within(a) & masks[b]
             na, nb = normals[near_b].sum(axis=0), normals[near_a].sum(axis=0)
             la, lb = np.linalg.norm(na), np.linalg.norm(nb)
             if la == 0 or lb == 0:
