@@ -1,7 +1,7 @@
 """Fusion (rgbd): each depth object with its faces as depth has them, colour confirming them and adding only the
 faces depth could not read.
 
-Depth gives the object and its faces: one per plane (depth.py). Colour never cuts a plane's face and never adds a
+Depth gives the object and its faces: one per plane, and its cylindrical faces (depth.py). Colour never cuts a plane's face and never adds a
 face on a plane: on real frames printed packaging draws edges across every face, and colour faces there are print,
 not faces. Colour's part is
 
@@ -46,36 +46,36 @@ def colour_edge_distance(color: np.ndarray, box: tuple[int, int, int, int]) -> n
     return edge_distance(np.maximum.reduce([channel_edges(c).edges for c in chans]))
 
 
-def fused_faces(frame: RGBD, planes: list, polygons: list[np.ndarray | None], adjacency: list[tuple[int, int]],
-                object_px: np.ndarray, box: tuple[int, int, int, int], unread: list[UnreadFace],
+def fused_faces(frame: RGBD, o, object_px: np.ndarray, box: tuple[int, int, int, int], unread: list[UnreadFace],
                 timings: dict[str, float]) -> tuple[list[Face], list[tuple[int, int]]]:
-    """The faces of one depth object under rgbd, and the pairs of them (indices) that share an edge.
-
-    ``planes``: the object's depth.DepthPlane list, ``polygons``: their outlines (full-frame pixels, None where the
-    plane's cells gave none), ``adjacency``: pairs of plane indices; ``object_px``: the object's pixels in ``box``
-    = (u0, v0, u1, v1), the crop the colour edges are searched in; ``unread``: the faces depth infers from holes
-    beside the object (holes.unread_faces). The colour edges' time is added to ``timings['edges']``."""
+    """The faces of depth object ``o`` (depth.DepthObjectResult) under rgbd, and the pairs of them (indices) that
+    share an edge: its planes and its cylindrical faces (each where its cells gave an outline), 'rgbd' where colour
+    edges confirm the outline (``CONFIRMED_SUPPORT``) and 'depth' where not, then the faces depth could not read
+    (holes.add_hole_faces, from ``unread``, the faces depth infers from holes beside the object, and colour's).
+    ``object_px``: the object's pixels in ``box`` = (u0, v0, u1, v1), the crop the colour edges are searched in.
+    The colour edges' time is added to ``timings['edges']``."""
     t0 = time.perf_counter()
     dist = colour_edge_distance(frame.color, box)
     timings["edges"] = timings.get("edges", 0.0) + (time.perf_counter() - t0) * 1e3
     off = np.array([box[0], box[1]], float)
-    shape = dist.shape
     faces: list[Face] = []
-    index: dict[int, int] = {}
-    for j, (p, poly) in enumerate(zip(planes, polygons)):
-        if poly is None:
-            continue
+
+    def add(poly: np.ndarray, **kw) -> int:
         sup = edge_support(poly - off, dist)
-        index[j] = len(faces)
-        faces.append(Face("", poly, "rgbd" if sup >= CONFIRMED_SUPPORT else "depth", plane=p.plane, points=p.points,
-                          edge_support=sup, plane_rms_m=p.rms_m))
-    pairs = {(index[a], index[b]) for a, b in adjacency if a in index and b in index}
+        faces.append(Face("", poly, "rgbd" if sup >= CONFIRMED_SUPPORT else "depth", edge_support=sup, **kw))
+        return len(faces) - 1
+
+    index = {j: add(poly, plane=p.plane, points=p.points, plane_rms_m=p.rms_m)
+             for j, (p, poly) in enumerate(zip(o.planes, o.polygons)) if poly is not None}
+    curved = {j: add(poly, points=c.points, plane_rms_m=c.rms_m, surface="cylinder", cylinder=c.cylinder)
+              for j, (c, poly) in enumerate(zip(o.curved, o.curved_polygons)) if poly is not None}
+    pairs = {(index[a], index[b]) for a, b in o.adjacency if a in index and b in index}
+    pairs |= {(index[i], curved[j]) for i, j in o.curved_adjacency if i in index and j in curved}
     keep = list(range(len(faces)))
-    masks = {i: rasterize(f.polygon - off, shape) for i, f in enumerate(faces)}
+    masks = {i: rasterize(f.polygon - off, dist.shape) for i, f in enumerate(faces)}
     keep += add_hole_faces(faces, pairs, keep, frame, box, object_px, dist, masks=masks, unread=unread,
                            min_unread_support=CONFIRMED_SUPPORT)
-    return [faces[i] for i in keep], sorted((keep.index(a), keep.index(b)) for a, b in pairs
-                                            if a in keep and b in keep)
+    return faces, sorted({tuple(sorted(p)) for p in pairs})
 
 
 def largest_first(faces: list[Face]) -> list[int]:

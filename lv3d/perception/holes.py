@@ -41,22 +41,40 @@ from .support import noise_threshold, ransac_plane
 _FILL = (0.85, 1.15)  # region area over its polygon's area: a convex region that the polygon describes
 # a plane seen within this angle of face-on is one the sensor reads: a RealSense reads to about 78 degrees
 _UNREAD_DEG = 70.0
+# sizes as fractions of the image diagonal (d, px), so that a frame of another resolution takes the same holes;
+# at 640x480 (d = 800 px) they are 150 px, 30 px and 4 px. A hole that may be a face covers at least
+# _MIN_HOLE_AREA * d^2 px (a face seen edge-on is a strip a few px wide and tens long; smaller gaps are the
+# sensor's speckle); a hole's rim needs at least _MIN_RIM * d read pixels for a plane to be fitted to it; a face
+# meets another (and a hole touches a face) along at least _MIN_TOUCH * d px
+_MIN_HOLE_AREA = 150.0 / 800.0 ** 2
+_MIN_RIM = 30.0 / 800.0
+_MIN_TOUCH = 4.0 / 800.0
+# a pixel's neighbourhood (px, not a scale): a band of a pixel or two between two regions drawn apart on the pixel
+# grid (rasterised outlines, a hole and the readings round it) is where they touch
+_RIM_PX = 2
 
 
-def hole_faces(no_reading: np.ndarray, object_px: np.ndarray, edge_dist: np.ndarray, min_area_px: float = 150.0,
+def hole_sizes(shape: tuple[int, ...]) -> tuple[float, int, int]:
+    """(least hole area px, least read rim px, least contact px) for an image of ``shape`` (H, W, ...)."""
+    d = float(np.hypot(shape[0], shape[1]))
+    return _MIN_HOLE_AREA * d * d, int(np.ceil(_MIN_RIM * d - 1e-9)), int(np.ceil(_MIN_TOUCH * d - 1e-9))
+
+
+def hole_faces(no_reading: np.ndarray, object_px: np.ndarray, edge_dist: np.ndarray, min_area_px: float,
                min_contact: float = 0.25, min_support: float = 0.55,
                fill: tuple[float, float] = _FILL) -> list[np.ndarray]:
     """Polygons (n, 2) pixels, clockwise, of the faces that are holes in the depth image, all in one crop.
 
     ``no_reading``: (H, W) bool, pixels without a depth reading; ``object_px``: (H, W) bool, the depth object's
-    pixels; ``edge_dist``: (H, W) float, distance (px) to the nearest colour edge pixel. A hole qualifies when
+    pixels; ``edge_dist``: (H, W) float, distance (px) to the nearest colour edge pixel; ``min_area_px``: the
+    least hole area (:func:`hole_sizes` of the whole image). A hole qualifies when
     it is one of :func:`hole_regions` (``min_area_px``, ``min_contact``, ``fill``) and at least ``min_support`` of
     its polygon's outline is on colour edges."""
     return [poly for poly, _ in hole_regions(no_reading, object_px, min_area_px, min_contact, fill)
             if edge_support(poly, edge_dist) >= min_support]
 
 
-def hole_regions(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float = 150.0,
+def hole_regions(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float,
                  min_contact: float = 0.25, fill: tuple[float, float] = _FILL) -> list[tuple[np.ndarray, np.ndarray]]:
     """The holes in the depth image (H, W) that may be faces, as (polygon (n, 2) pixels clockwise, region (H, W)
     bool): connected regions of ``no_reading`` outside ``object_px`` (both (H, W) bool) of at least
@@ -66,7 +84,7 @@ def hole_regions(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: flo
     return _holes(no_reading, object_px, min_area_px, min_contact, fill)[0]
 
 
-def _holes(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float = 150.0, min_contact: float = 0.25,
+def _holes(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float, min_contact: float = 0.25,
            fill: tuple[float, float] = _FILL) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[np.ndarray]]:
     """The regions of ``no_reading`` along the object as :func:`hole_regions` takes them, and the regions (H, W)
     bool it leaves (touching the crop's border, or not convex)."""
@@ -110,15 +128,14 @@ class UnreadFace(NamedTuple):
 
 def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plane_masks: list[np.ndarray],
                  known: list[Plane], box: tuple[int, int, int, int], min_graze_deg: float = _UNREAD_DEG,
-                 min_apart_deg: float = 20.0, min_on_plane: float = 0.6, min_rim: int = 30,
-                 max_on_object: float = 0.55, min_contact: int = 4, max_planes: int = 3,
-                 seed: int = 0) -> list[UnreadFace]:
+                 min_apart_deg: float = 20.0, min_on_plane: float = 0.6, max_on_object: float = 0.55,
+                 max_planes: int = 3, seed: int = 0) -> list[UnreadFace]:
     """Faces of one object that depth alone infers from the holes beside it where no colour confirms them: the
     readings stop at a face's own edges, on the object's neighbouring faces and on the table, so the points just
     outside a hole that is an unread face lie on the face's plane.
 
     A hole of :func:`hole_regions` is taken for a face when at least ``min_on_plane`` of its rim points (read
-    pixels within 2 px of it, at least ``min_rim``) lie on one plane (RANSAC within the noise threshold of their
+    pixels within 2 px of it, at least the least rim of :func:`hole_sizes`) lie on one plane (RANSAC within the noise threshold of their
     depth) that is seen at ``min_graze_deg`` or more from face-on (a plane the sensor reads well cannot be the
     reason for a hole: a blob of missing readings on a face or on the table has that face's or the table's plane as
     its rim) and stands at least ``min_apart_deg`` from every plane in ``known`` (the object's planes and the
@@ -132,15 +149,16 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
 
     ``depth``: (H, W) metres (0 = no reading); ``grid``: its point grid; ``object_px``: (v1 - v0, u1 - u0) bool,
     the object's pixels in ``box`` = (u0, v0, u1, v1); ``plane_masks``: the object's planes' grid masks, for the
-    planes each face meets (at least ``min_contact`` rim points on a plane's mask). Polygons are in full-frame
-    pixels."""
+    planes each face meets (at least the least contact of :func:`hole_sizes` in rim points on a plane's mask).
+    Polygons are in full-frame pixels."""
+    min_area_px, min_rim, min_contact = hole_sizes(depth.shape)
     u0, v0, u1, v1 = box
     crop = depth[v0:v1, u0:u1]
     read = np.isfinite(crop) & (crop > 0)
     rng = np.random.default_rng(seed)
     s = grid.stride
     off = np.array([u0, v0], float)
-    ring = np.ones((5, 5), np.uint8)
+    ring = np.ones((2 * _RIM_PX + 1, 2 * _RIM_PX + 1), np.uint8)
 
     def rim(region: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
         """The read pixels (v, u) around ``region``, their grid cells (i, j) and points (m, 3); None when the
@@ -171,7 +189,7 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
         return UnreadFace(poly + off, plane, pts, rms, meets)
 
     out = []
-    convex, merged = _holes(~read, object_px)
+    convex, merged = _holes(~read, object_px, min_area_px)
     for poly, region in convex:
         r = rim(region)
         if r is None or len(r[3]) < min_rim:
@@ -194,7 +212,7 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
             plane, inl = found
             hull = np.zeros(read.shape, np.uint8)
             cv2.fillPoly(hull, [cv2.convexHull(np.stack([uu[inl], vv[inl]], axis=1).astype(np.int32))], 1)
-            part = hole_regions(region & hull.astype(bool), object_px)
+            part = hole_regions(region & hull.astype(bool), object_px, min_area_px)
             if len(part) == 1 and rim(part[0][1]) is not None:
                 known = known + [plane]
                 out.append(face(part[0][0], plane, pts[inl], ij[:, inl]))
@@ -204,8 +222,7 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
 
 def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[int], frame: RGBD,
                    box: tuple[int, int, int, int], object_px: np.ndarray, edge_dist: np.ndarray,
-                   max_taken: float = 0.3, max_share: float = 0.5,
-                   masks: dict[int, np.ndarray] | None = None, unread: list[UnreadFace] = (),
+                   max_taken: float = 0.3, masks: dict[int, np.ndarray] | None = None, unread: list[UnreadFace] = (),
                    min_unread_support: float = 0.5) -> list[int]:
     """The faces depth has no reading of, appended to ``faces``: first the ``unread`` faces (:func:`unread_faces`,
     full-frame polygons, each with the plane through its rim) whose outline lies on colour edges for at least
@@ -217,10 +234,8 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
     ``masks``: the ``keep`` faces' masks in that crop when the caller has them already (index -> (H, W) bool;
     updated in place), else they are drawn here.
 
-    A hole that the kept faces cover for at most ``max_taken`` of its pixels is a face beside them. One that a
-    single kept face covers, as a part of at most ``max_share`` of that face, is a face that face's outline
-    swallowed: that face gives the hole's pixels up when what is left is one convex region with fewer corners.
-    Otherwise a face there was found already."""
+    A hole that the kept faces cover for at most ``max_taken`` of its pixels is a face beside them; otherwise a
+    face there was found already."""
     u0, v0, u1, v1 = box
     depth = frame.depth[v0:v1, u0:u1]
     no_reading = ~(np.isfinite(depth) & (depth > 0))
@@ -236,34 +251,33 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
     # it crosses the table. One that colour confirms comes first: it has a plane, a colour hole there has none
     found = [(u.polygon - off, Face("", u.polygon, "rgbd", plane=u.plane, points=u.points, plane_rms_m=u.rms_m))
              for u in unread if edge_support(u.polygon - off, edge_dist) >= min_unread_support]
-    found += [(poly, Face("", poly + off, "rgb")) for poly in hole_faces(no_reading, object_px, edge_dist)]
+    min_area_px, _, touch = hole_sizes(frame.shape)
+    found += [(poly, Face("", poly + off, "rgb")) for poly in hole_faces(no_reading, object_px, edge_dist, min_area_px)]
     for poly, face in found:
         hole = rasterize(poly, shape)
         a = max(1, np.count_nonzero(hole))
         cover = {i: np.count_nonzero(hole & m) for i, m in masks.items()}
         if sum(cover.values()) > max_taken * a:
-            over = [i for i, c in cover.items() if c > max_taken * a]
-            if len(over) != 1 or not _give_up(faces, masks, over[0], hole, off, max_share):
-                continue
-        grown = cv2.dilate(hole.astype(np.uint8), np.ones((5, 5), np.uint8)).astype(bool)
-        if face.plane is None and _extend(faces, masks, hole, grown, off):
+            continue  # a face there was found already
+        grown = cv2.dilate(hole.astype(np.uint8), np.ones((2 * _RIM_PX + 1, 2 * _RIM_PX + 1), np.uint8)).astype(bool)
+        if face.plane is None and _extend(faces, masks, hole, grown, off, touch):
             continue
         new = len(faces)
         faces.append(face)
-        pairs |= {(i, new) for i, m in masks.items() if np.count_nonzero(grown & m) >= 4}
+        pairs |= {(i, new) for i, m in masks.items() if np.count_nonzero(grown & m) >= touch}
         masks[new] = hole
         added.append(new)
     return added
 
 
 def _extend(faces: list[Face], masks: dict[int, np.ndarray], hole: np.ndarray, grown: np.ndarray, off: np.ndarray,
-            min_graze_deg: float = _UNREAD_DEG, fill: tuple[float, float] = _FILL) -> bool:
+            touch: int, min_graze_deg: float = _UNREAD_DEG, fill: tuple[float, float] = _FILL) -> bool:
     """Extends over ``hole`` (a region without readings, crop pixels; ``grown``: it dilated) the one face it
-    touches whose plane is seen at ``min_graze_deg`` or more from face-on, when the two make one convex region
+    touches (along ``touch`` px or more) whose plane is seen at ``min_graze_deg`` or more from face-on, when the two make one convex region
     (their union over its hull's area within ``fill``): the sensor read that face on part of it only, and the
     hole is the rest of it, not a face of its own. Updates the face's polygon and ``masks`` in place; True when it
     did."""
-    touching = [i for i, m in masks.items() if np.count_nonzero(grown & m) >= 4]
+    touching = [i for i, m in masks.items() if np.count_nonzero(grown & m) >= touch]
     grazing = [i for i in touching if faces[i].plane is not None and faces[i].points is not None
                and len(faces[i].points) and _graze_deg(faces[i]) >= min_graze_deg]
     if len(grazing) != 1:
@@ -284,25 +298,6 @@ def _graze_deg(face: Face) -> float:
     """The angle (degrees) from face-on at which the camera sees ``face``'s plane, at its points' centroid."""
     ray = np.asarray(face.points, np.float64).mean(axis=0)
     return float(np.degrees(np.arccos(min(1.0, abs(float(face.plane.n @ ray)) / float(np.linalg.norm(ray))))))
-
-
-def _give_up(faces: list[Face], masks: dict[int, np.ndarray], i: int, hole: np.ndarray, off: np.ndarray,
-             max_share: float, fill: tuple[float, float] = _FILL) -> bool:
-    """Cuts the ``hole`` pixels out of face ``i`` (its polygon and ``masks[i]``, in place) when they are at most
-    ``max_share`` of it and the rest is one convex region with fewer corners; True when it did."""
-    if np.count_nonzero(masks[i] & hole) > max_share * np.count_nonzero(masks[i]):
-        return False
-    # the opening removes the rim of a pixel or two that the two outlines leave between them
-    rest = cv2.morphologyEx((masks[i] & ~hole).astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
-    n = np.count_nonzero(rest)
-    poly = _outline(rest.astype(bool)) if n else None
-    # two convex faces in one outline have more corners than either; a hole that only nicks a face's rim (a
-    # strip of its own pixels lost at a grazing angle) leaves as many
-    if poly is None or len(poly) >= len(faces[i].polygon) or not fill[0] <= n / max(area(poly), 1e-9) <= fill[1]:
-        return False
-    faces[i].polygon = poly + off
-    masks[i] = rasterize(poly, hole.shape)
-    return True
 
 
 def _outline(mask: np.ndarray, eps_frac: float = 0.02) -> np.ndarray | None:

@@ -155,7 +155,7 @@ def _unread(frame: RGBD, dres: DepthResult, o: DepthObjectResult, box: tuple[int
 
 
 def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[str, float]) -> list[SceneObject]:
-    """Each depth object with its faces as rgbd sees them (fuse.fused_faces): depth's planes, confirmed by colour
+    """Each depth object with its faces as rgbd sees them (fuse.fused_faces): depth's faces, confirmed by colour
     edges, and the faces depth could not read where colour edges confirm them."""
     stride = dres.grid.stride
     h, w = frame.shape
@@ -167,8 +167,7 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         edges_before = timings["edges"]
         box = _crop_box(o, (h, w))
         object_px = grid_to_pixels(o.obj.mask, stride, box)
-        faces, pairs = fused_faces(frame, o.planes, o.polygons, o.adjacency, object_px, box,
-                                   _unread(frame, dres, o, box, object_px, seed=k), timings)
+        faces, pairs = fused_faces(frame, o, object_px, box, _unread(frame, dres, o, box, object_px, seed=k), timings)
         order = largest_first(faces)
         rank = {i: r for r, i in enumerate(order)}
         for i in order:

@@ -2,7 +2,7 @@ import cv2
 import numpy as np
 
 from lv3d.perception.edges import channel_edges, channels, edge_distance
-from lv3d.perception.holes import hole_faces
+from lv3d.perception.holes import hole_faces, hole_sizes
 from lv3d.perception.polygons import rasterize
 
 from .conftest import mask_iou as _iou
@@ -11,6 +11,7 @@ SHAPE = (200, 240)
 # the object's faces that depth saw, and beside them a strip seen nearly edge-on, with no depth reading
 OBJECT = np.array([(80, 40), (180, 50), (175, 160), (85, 150)], float)
 STRIP = np.array([(62, 45), (80, 40), (85, 150), (70, 148)], float)
+AREA = hole_sizes(SHAPE)[0]  # the least hole area in an image of SHAPE
 
 
 def _dist(strip_colour=(60, 20, 20)) -> np.ndarray:
@@ -21,10 +22,16 @@ def _dist(strip_colour=(60, 20, 20)) -> np.ndarray:
     return edge_distance(np.maximum.reduce([channel_edges(c).edges for c in channels(img)]))
 
 
+def test_hole_sizes_are_fractions_of_the_image_diagonal():
+    assert hole_sizes((480, 640)) == (150.0, 30, 4)
+    area, rim, touch = hole_sizes((960, 1280))
+    assert area == 600.0 and rim == 60 and touch == 8
+
+
 def test_hole_beside_the_object_on_colour_edges_is_a_face():
     obj = rasterize(OBJECT, SHAPE)
     hole = rasterize(STRIP, SHAPE) & ~obj
-    polys = hole_faces(hole, obj, _dist())
+    polys = hole_faces(hole, obj, _dist(), AREA)
     assert len(polys) == 1
     assert len(polys[0]) == 4
     assert _iou(rasterize(polys[0], SHAPE), rasterize(STRIP, SHAPE)) >= 0.8
@@ -34,20 +41,20 @@ def test_hole_is_no_face_without_colour_edges_apart_from_the_object_or_when_cut(
     obj = rasterize(OBJECT, SHAPE)
     hole = rasterize(STRIP, SHAPE) & ~obj
     # the same colour as the table: only the side along the object is on an edge
-    assert hole_faces(hole, obj, _dist(strip_colour=(200, 190, 170))) == []
+    assert hole_faces(hole, obj, _dist(strip_colour=(200, 190, 170)), AREA) == []
     # away from the object (a hole in the table's readings)
     away = np.roll(hole, -40, axis=1)
-    assert hole_faces(away, obj, _dist()) == []
+    assert hole_faces(away, obj, _dist(), AREA) == []
     # cut by the crop's border: the strip's top end lies outside the searched box
     dist = _dist()
-    assert hole_faces(hole[50:], obj[50:], dist[50:]) == []
+    assert hole_faces(hole[50:], obj[50:], dist[50:], AREA) == []
 
 
 def test_hole_that_is_not_convex_is_no_face():
     obj = rasterize(OBJECT, SHAPE)
     hole = rasterize(STRIP, SHAPE) & ~obj
     hole[60:80, 40:75] = True  # an arm out into the table: two regions without readings run together
-    assert hole_faces(hole, obj, _dist()) == []
+    assert hole_faces(hole, obj, _dist(), AREA) == []
 
 
 
@@ -75,19 +82,13 @@ def test_hole_face_is_added_as_a_colour_face_and_neighbour_of_the_face_it_touche
     assert _iou(rasterize(faces[1].polygon, SHAPE), rasterize(STRIP, SHAPE)) >= 0.8
 
 
-def test_a_face_that_swallowed_the_hole_gives_it_up_and_one_that_is_the_hole_keeps_it():
+def test_a_hole_a_face_covers_already_adds_nothing():
     from lv3d.perception.holes import add_hole_faces
     from lv3d.scene import Face
 
     frame, obj = _frame_and_object()
     box = (0, 0, SHAPE[1], SHAPE[0])
-    merged = np.array([(62, 45), (80, 40), (180, 50), (175, 160), (85, 150), (70, 148)], float)
-    faces, pairs = [Face("", merged, "rgb")], set()
-    assert add_hole_faces(faces, pairs, [0], frame, box, obj, _dist()) == [1]
-    assert _iou(rasterize(faces[0].polygon, SHAPE), rasterize(OBJECT, SHAPE)) >= 0.9
-    assert len(faces[0].polygon) == 4 and pairs == {(0, 1)}
-    # colour found the strip itself: nothing is added
-    faces = [Face("", OBJECT, "rgb"), Face("", STRIP, "rgb")]
+    faces = [Face("", OBJECT, "depth"), Face("", STRIP, "depth")]
     assert add_hole_faces(faces, set(), [0, 1], frame, box, obj, _dist()) == []
     assert np.array_equal(faces[1].polygon, STRIP)
 

@@ -86,3 +86,21 @@ def test_rgbd_has_the_faces_depth_has_and_print_adds_none(box_frame):
         assert sorted(map(tuple, (np.round(g.polygon, 3).ravel() for g in fused.faces))) == \
             sorted(map(tuple, (np.round(g.polygon, 3).ravel() for g in depth.faces)))
         assert len(fused.adjacency) == len(depth.adjacency) == 3
+
+
+@pytest.mark.real
+def test_rgbd_keeps_the_faces_of_every_depth_object_on_a_real_frame_cylinders_too():
+    from lv3d.rgbd import load_real
+    from tests.conftest import REAL_DIR
+
+    osd = REAL_DIR.parent / "osd-learn"
+    if not osd.is_dir():
+        pytest.skip(f"osd-learn frames not found at {osd}")
+    frame = load_real(osd, "learn35")  # cans on a table
+    depth, fused = perceive(frame, "depth"), perceive(frame, "rgbd")
+    assert len(depth.objects) == len(fused.objects) and any(f.surface == "cylinder" for o in depth.objects
+                                                            for f in o.faces)
+    for d, r in zip(depth.objects, fused.objects):
+        curved = lambda o: sorted(tuple(np.round(f.polygon, 3).ravel()) for f in o.faces  # noqa: E731
+                                  if f.surface == "cylinder")
+        assert curved(d) == curved(r)
