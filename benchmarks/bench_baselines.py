@@ -1,7 +1,7 @@
 """Speed and accuracy of the statistical baselines on a *dev* data set (never the seed protocol's).
 
     .venv/bin/python -m benchmarks.bench_baselines [--data /tmp/cnndev/data] [--seed 1234]
-        [--systems cnn-rgb,cnn-depth,cnn-rgbd,cnn-rgbd-2s,tree-rgbd] [--folds 1] [--threads 2]
+        [--systems cnn-rgb,cnn-depth,cnn-rgbd,cnn-rgbd-2s,tree-rgbd] [--folds 1] [--threads 2] [--epochs N]
 
 Renders 4 classes x 50 images (realsense noise) with the dev seed unless ``--data`` already holds
 them, deals seeded stratified folds with the dev seed, and runs the seed protocol's tasks (4 class
@@ -27,6 +27,7 @@ def main() -> None:
     ap.add_argument("--systems", default="cnn-rgb,cnn-depth,cnn-rgbd,cnn-rgbd-2s,tree-rgbd")
     ap.add_argument("--folds", type=int, default=1, help="how many of the 5 folds to run")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--epochs", type=int, default=None, help="CNN epochs (default: the studies' setting)")
     args = ap.parse_args()
 
     from lv3d.baselines import cnn as cnn_mod
@@ -36,7 +37,8 @@ def main() -> None:
     from lv3d.experiment.runner import run_fold
     from lv3d.experiment.systems import make_system
 
-    cfg = from_dict({"seed": args.seed, "baselines": {"threads": args.threads}}, "bench_baselines options")
+    baselines = {"threads": args.threads, **({"epochs": args.epochs} if args.epochs is not None else {})}
+    cfg = from_dict({"seed": args.seed, "baselines": baselines}, "bench_baselines options")
     if not (args.data / "manifest.json").is_file():
         from lv3d.render import make_dataset
         from lv3d.render.noise import noise_config

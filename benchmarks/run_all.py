@@ -12,7 +12,7 @@
 | bench_dataset | renderer throughput (images/s) | 8 images | 42 |
 | bench_learner | learner accuracy, clean against realsense, and speed | 8 scenes a class | 30 a class |
 | bench_pipeline_accuracy | per-class accuracy of each modality on bench_learner's DEV sets | rgbd, 2 folds | 3 modalities |
-| bench_baselines | CNN and decision tree: accuracy and seconds per training | one fold, cnn-rgbd and tree-rgbd | 5 systems |
+| bench_baselines | CNN and decision tree: accuracy and seconds per training | one fold, cnn-rgbd (3 epochs) and tree-rgbd | 5 systems |
 
 Each runs as ``python -m benchmarks.NAME`` in a process of its own, from the repository root; rendered data
 and DEV sets go under ``--work`` (default out/bench) and are reused by the next run. Exit status: 0 when
@@ -48,7 +48,7 @@ def commands(quick: bool, work: Path, json_dir: Path | None) -> list[tuple[str, 
         ("bench_pipeline_accuracy", [str(dev / f"clean{LEARNER_SEED}"), str(dev / f"realsense{LEARNER_SEED}")]
          + (["--modalities", "rgbd", "--folds", "2", "--positives", "4"] if quick else ["--modalities", "rgbd"])),
         ("bench_baselines", ["--data", str(work / "baselines_data")]
-         + (["--systems", "cnn-rgbd,tree-rgbd", "--folds", "1"] if quick else [])),
+         + (["--systems", "cnn-rgbd,tree-rgbd", "--folds", "1", "--epochs", "3"] if quick else [])),
     ]
 
 
