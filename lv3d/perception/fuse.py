@@ -1,12 +1,12 @@
 """Fusion (rgbd): each depth object with its faces as depth has them, colour confirming them and adding only the
 faces depth could not read.
 
-Depth gives the object and its faces: one per plane, and its cylindrical faces (depth.py). Colour never cuts a plane's face and never adds a
-face on a plane: on real frames printed packaging draws edges across every face, and colour faces there are print,
-not faces. Colour's part is
+Depth gives the object and its faces: one per plane, and its cylindrical faces (depth.py). Colour never cuts a
+depth face and never adds a face on a plane depth has: on real frames printed packaging draws edges across every
+face, and colour faces there are print, not faces. Colour's part is
 
-- to confirm: a plane's outline that lies on colour edges is a face both sensors see (provenance 'rgbd'), one that
-  does not keeps provenance 'depth' (grounding then fits it to depth's edges where colour has none near,
+- to confirm: a depth face whose outline lies on colour edges is a face both sensors see (provenance 'rgbd'), one
+  that does not keeps provenance 'depth' (grounding then fits it to depth's edges where colour has none near,
   lv3d.describe.edge_field); a face depth infers beside the object from a hole in its readings
   (holes.unread_faces) is kept only where colour edges run along its outline (a sensor's occlusion shadow has none
   where it crosses the table);
@@ -15,9 +15,9 @@ not faces. Colour's part is
 - to refine: grounding fits every outline to the colour image's edges (lv3d.describe), which places corners more
   sharply than the planes' cells do.
 
-Colour faces traced inside each object's box (rgb.rgb_faces) and matched to the planes gave no better figure on the
-real dev frames than depth's outlines refined by grounding, lost side counts on rendered scenes, and cost more than
-the depth stage; they are not traced here.
+Colour faces are not traced here (rgb.rgb_faces): matched to the planes, their outlines give no better figure on
+the real dev frames than depth's outlines refined by grounding, fewer right side counts on rendered scenes, and cost
+more than the depth stage itself.
 """
 
 from __future__ import annotations
@@ -71,10 +71,9 @@ def fused_faces(frame: RGBD, o, object_px: np.ndarray, box: tuple[int, int, int,
               for j, (c, poly) in enumerate(zip(o.curved, o.curved_polygons)) if poly is not None}
     pairs = {(index[a], index[b]) for a, b in o.adjacency if a in index and b in index}
     pairs |= {(index[i], curved[j]) for i, j in o.curved_adjacency if i in index and j in curved}
-    keep = list(range(len(faces)))
     masks = {i: rasterize(f.polygon - off, dist.shape) for i, f in enumerate(faces)}
-    keep += add_hole_faces(faces, pairs, keep, frame, box, object_px, dist, masks=masks, unread=unread,
-                           min_unread_support=CONFIRMED_SUPPORT)
+    add_hole_faces(faces, pairs, list(masks), frame, box, object_px, dist, masks=masks, unread=unread,
+                   min_unread_support=CONFIRMED_SUPPORT)  # appends to faces and pairs
     return faces, sorted({tuple(sorted(p)) for p in pairs})
 
 

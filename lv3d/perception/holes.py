@@ -134,13 +134,13 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
     readings stop at a face's own edges, on the object's neighbouring faces and on the table, so the points just
     outside a hole that is an unread face lie on the face's plane.
 
-    A hole of :func:`hole_regions` is taken for a face when at least ``min_on_plane`` of its rim points (read
-    pixels within 2 px of it, at least the least rim of :func:`hole_sizes`) lie on one plane (RANSAC within the noise threshold of their
-    depth) that is seen at ``min_graze_deg`` or more from face-on (a plane the sensor reads well cannot be the
-    reason for a hole: a blob of missing readings on a face or on the table has that face's or the table's plane as
-    its rim) and stands at least ``min_apart_deg`` from every plane in ``known`` (the object's planes and the
-    support), and when the object makes at most ``max_on_object`` of what surrounds it (a face seen edge-on lies
-    along the object's silhouette; a hole the object surrounds is a blob on one of its faces).
+    A hole of :func:`hole_regions` is taken for a face when at least ``min_on_plane`` of its rim points (read pixels
+    within 2 px of it, at least the least rim of :func:`hole_sizes`) lie on one plane (RANSAC within the noise
+    threshold of their depth) that is seen at ``min_graze_deg`` or more from face-on (a plane the sensor reads well
+    cannot be the reason for a hole: a blob of missing readings on a face or on the table has that face's or the
+    table's plane as its rim) and stands at least ``min_apart_deg`` from every plane in ``known`` (the object's
+    planes and the support), and when the object makes at most ``max_on_object`` of what surrounds it (a face seen
+    edge-on lies along the object's silhouette; a hole the object surrounds is a blob on one of its faces).
 
     A hole that runs into another (two faces seen edge-on side by side, or a face and a blob of missing readings)
     is not convex, or reaches the crop's border: up to ``max_planes`` planes are peeled off its rim, and each that
@@ -272,11 +272,11 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
 
 def _extend(faces: list[Face], masks: dict[int, np.ndarray], hole: np.ndarray, grown: np.ndarray, off: np.ndarray,
             touch: int, min_graze_deg: float = _UNREAD_DEG, fill: tuple[float, float] = _FILL) -> bool:
-    """Extends over ``hole`` (a region without readings, crop pixels; ``grown``: it dilated) the one face it
-    touches (along ``touch`` px or more) whose plane is seen at ``min_graze_deg`` or more from face-on, when the two make one convex region
-    (their union over its hull's area within ``fill``): the sensor read that face on part of it only, and the
-    hole is the rest of it, not a face of its own. Updates the face's polygon and ``masks`` in place; True when it
-    did."""
+    """Extends over ``hole`` (a region without readings, crop pixels; ``grown``: it dilated) the one face it touches
+    (along ``touch`` px or more) whose plane is seen at ``min_graze_deg`` or more from face-on, when the two make
+    one convex region (their union over its hull's area within ``fill``): the sensor read that face on part of it
+    only, and the hole is the rest of it, not a face of its own. Updates the face's polygon and ``masks`` in place;
+    True when it did."""
     touching = [i for i, m in masks.items() if np.count_nonzero(grown & m) >= touch]
     grazing = [i for i in touching if faces[i].plane is not None and faces[i].points is not None
                and len(faces[i].points) and _graze_deg(faces[i]) >= min_graze_deg]

@@ -99,22 +99,23 @@ def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: floa
     non-simple, poorly supported by edges (< ``min_support`` of the perimeter), or containing another face (a
     background region around an object) are dropped.
 
-    The sides of the solids' silhouettes, told from the floor by chromaticity, join the segments (silhouette.py), segments are carried on across gaps in their edges
-    where the colour still steps (gaps.close_gaps), faces on two separate silhouettes or of two chromaticities are
-    never neighbours (the graph joins solids that nearly touch or overlap; a solid is taken to be of one colour, so
-    a printed carton comes out as one object per colour: _same_solid), and a kept face whose outline the graph
-    traced whole, or a concave traced outline before it is split, is cut along a faint straight edge from one of its
-    corners (step_edge.step_cut), and a convex one that no such line cuts is cut at a fork of three faint edges from
-    three of its corners (step_edge.fork_cut: a solid showing three faces of one colour), or else along a faint edge
-    from side to side that steps far above its control (step_edge.side_cut: a cube's top and front whose left and
-    right sides run on in one line each): most colour-only misses on noisy renders are corners the segments stop
-    short of and two faces of one colour traced as one. The parts of the silhouettes left outside every face, each
-    of a colour of its own or a whole solid none of whose faces was traced, are then faces too
-    (untraced.untraced_faces: slivers whose corners the graph collapsed; clean rgb recall rose on 4 of 6 dev seeds
-    and fell on none; docs/perception.md), each cut from side to side as above. Faces of the colour of the image's
-    border (floor texture, shadows, painted lines) are then dropped (background.background_faces): most false
-    colour-only faces on noisy renders are such; those much smoother than the floor of their hue are kept
-    (background.smooth_faces: an object of the table's hue). (rgbd does not trace colour faces: fuse.py.)"""
+    The sides of the solids' silhouettes, told from the floor by chromaticity, join the segments (silhouette.py),
+    segments are carried on across gaps in their edges where the colour still steps (gaps.close_gaps), faces on two
+    separate silhouettes or of two chromaticities are never neighbours (the graph joins solids that nearly touch or
+    overlap; a solid is taken to be of one colour, so a printed carton comes out as one object per colour:
+    _same_solid), and a kept face whose outline the graph traced whole, or a concave traced outline before it is
+    split, is cut along a faint straight edge from one of its corners (step_edge.step_cut), and a convex one that no
+    such line cuts is cut at a fork of three faint edges from three of its corners (step_edge.fork_cut: a solid
+    showing three faces of one colour), or else along a faint edge from side to side that steps far above its
+    control (step_edge.side_cut: a cube's top and front whose left and right sides run on in one line each): most
+    colour-only misses on noisy renders are corners the segments stop short of and two faces of one colour traced as
+    one. The parts of the silhouettes left outside every face, each of a colour of its own or a whole solid none of
+    whose faces was traced, are then faces too (untraced.untraced_faces: slivers whose corners the graph collapsed;
+    clean rgb recall rose on 4 of 6 dev seeds and fell on none; docs/perception.md), each cut from side to side as
+    above. Faces of the colour of the image's border (floor texture, shadows, painted lines) are then dropped
+    (background.background_faces): most false colour-only faces on noisy renders are such; those much smoother than
+    the floor of their hue are kept (background.smooth_faces: an object of the table's hue). (rgbd does not trace
+    colour faces: fuse.py.)"""
     import time
 
     t0 = time.perf_counter()
