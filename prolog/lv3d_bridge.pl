@@ -2,23 +2,12 @@
     module per use, fit one target, classify with fixed programs, check program files.
     Everything handed back is atoms and numbers, which pyswip maps to str and float.
 */
-:- module(lv3d_bridge, [guard/4, learn_task/3, load_scene/3, drop_scene/1, fit/8, classify/6, check_program/4]).
+:- module(lv3d_bridge, [guard/4, load_scene/3, drop_scene/1, fit/8, classify/6, check_program/4]).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(library(solution_sequences)).
 :- use_module(mil).
 :- use_module(shape_bk).
-:- use_module(mil_task).
-
-%!  learn_task(+File, +Overrides, -Texts) is semidet.
-%   Learn the task file File (mil_task.pl format) with Metagol's search; Overrides (options)
-%   take precedence over the file's settings.  Texts: the program's clauses as atoms.
-learn_task(File, Overrides, Texts) :-
-    load_task(File, lv3d_task, Task, Settings0),
-    append(Overrides, Settings0, Settings),
-    learn(Task, Settings, Prog),
-    program_clauses(Task, Prog, Clauses),
-    maplist(clause_text, Clauses, Texts).
 
 %!  guard(:Goal, -Kind, -Where, -Message) is nondet.
 %   Kind = ok, or when Goal throws (atoms): Kind is time_limit, input (a bad task or program
@@ -48,6 +37,8 @@ message_text(E, Msg) :-
 load_scene(M, FactPreds, Facts) :-
     drop_scene(M),
     forall(member(P/A, FactPreds), ( A1 is A + 1, dynamic(M:P/A1) )),
+    dynamic(M:'$mil_fact'/3),
+    forall(member(P/A, FactPreds), assertz(M:'$mil_fact'(P, A, P))),
     ( import_module(M, shape_bk) -> true ; add_import_module(M, shape_bk, end) ),
     maplist(assert_fact(M), Facts).
 

@@ -13,6 +13,8 @@ bk:square(f1, 0.9).       bk:square(f2, 0.6).       bk:square(f3, 0.3).       bk
 bk:triangle(f4, 1.0).     bk:triangle(f3, 0.7).
 bk:adjacent(f1, f2, 1.0). bk:adjacent(f2, f1, 1.0).
 bk:perpendicular(f1, f2, 0.8). bk:perpendicular(f2, f1, 0.8).
+% they are facts with a confidence, stored under their own name (lv3d_bridge:load_scene/3 declares them so)
+bk:'$mil_fact'(P, A, P) :- member(P/A, [face_of/2, square/1, triangle/1, adjacent/2, perpendicular/2]).
 
 shape_task(Pos, Neg, task(bk, [cube/1], [face_of/2, square/1, triangle/1, adjacent/2, perpendicular/2],
                           [part, part2], Pos, Neg)).

@@ -51,7 +51,7 @@ def main(argv=None) -> int:
 
     install()
     try:
-        cli.main(args=argv, prog_name="lv3d", standalone_mode=False)
+        rv = cli.main(args=argv, prog_name="lv3d", standalone_mode=False)
     except InputError as e:
         click.echo(f"lv3d: error: {_one_line(e)}", err=True)
         return 2
@@ -70,4 +70,4 @@ def main(argv=None) -> int:
         return e.exit_code
     except click.exceptions.Exit as e:
         return e.exit_code
-    return 0
+    return rv if isinstance(rv, int) and not isinstance(rv, bool) else 0  # a command's exit status

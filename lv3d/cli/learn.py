@@ -12,20 +12,65 @@ from ..errors import InputError, read_json
 from ..facts import MODALITIES
 
 
+def _setting(text: str) -> tuple[str, object]:
+    """NAME=VALUE of --set: the value read as JSON (numbers, true/false, lists), else as a name."""
+    name, sep, raw = text.partition("=")
+    if not sep or not name.strip():
+        raise InputError("--set", f"expected NAME=VALUE, got {text!r}")
+    try:
+        value = json.loads(raw)
+    except json.JSONDecodeError:
+        value = raw.strip()
+    return name.strip(), value
+
+
 @click.command()
 @click.argument("task", type=click.Path(path_type=Path))
+@click.option("--goal", default=None, help="learn this goal only (a goal clause's name, e.g. a; default: the goals "
+                                           "the file's directives run, else every learning goal clause)")
+@click.option("--noisy", is_flag=True, help="the noise-tolerant search: programs from samples of the examples, "
+                                            "scored on all of them (wrong labels, facts with confidences)")
+@click.option("--set", "sets", multiple=True, metavar="NAME=VALUE",
+              help="a learner setting, e.g. --set max_clauses=4 (repeatable; docs/learner.md lists them)")
 @click.option("--time-limit", type=click.FloatRange(0, 86400, min_open=True), default=None,
-              help="seconds for the search (default: the task's, else 10)")
-def mil(task: Path, time_limit: float | None):
-    """Learn the Metagol-style TASK file and print the program."""
+              help="seconds for each goal's search (default: the task's, else 10)")
+@click.option("--memory-limit", type=click.IntRange(64, 1 << 20), default=None,
+              help="MB for the learner's process (default 2048)")
+@click.option("--timing", is_flag=True, help="print each goal's learning time on stderr")
+def mil(task: Path, goal: str | None, noisy: bool, sets: tuple[str, ...], time_limit: float | None,
+        memory_limit: int | None, timing: bool):
+    """Learn the task file TASK (Metagol's example files unchanged, or lv3d's form) and print each goal's
+    program as Metagol prints it. Exit status 1 when a goal has no program within its bounds, 2 when a
+    goal or the file cannot be learned (one line on stderr)."""
     from ..learn.engine import LearnError
-    from ..learn.task import learn_task
+    from ..learn.settings import check_settings
+    from ..learn.task import MEMORY_MB, run_task
 
+    settings = check_settings(dict(_setting(t) for t in sets), "--set")
     try:
-        clauses = learn_task(task, time_limit=time_limit)
+        run = run_task(task, time_limit=time_limit, settings=settings, goal=goal,
+                       mode="noisy" if noisy else "exact", memory_mb=memory_limit or MEMORY_MB)
     except LearnError as e:
         raise InputError(task, str(e).split(": ", 1)[-1]) from None
-    click.echo("\n".join(clauses))
+    for w in run.warnings:
+        click.echo(f"lv3d: warning: {task}: {w}", err=True)
+    several = len(run.goals) > 1
+    code = 0
+    for g in run.goals:
+        if several:
+            click.echo(f"% {g.name}")
+        if g.error is not None:
+            click.echo(f"lv3d: error: {task}: {f'{g.name}: ' if several else ''}{g.error}", err=True)
+            code = 2
+        elif g.clauses is None:
+            click.echo("% unable to learn a solution")
+            code = max(code, 1)
+        else:
+            click.echo("\n".join(g.clauses))
+        if timing:
+            click.echo(f"% {g.name}: {g.cpu_s:.3f} s cpu, {g.wall_s:.3f} s wall", err=True)
+    if code:
+        raise click.exceptions.Exit(code)
 
 
 @click.group()

@@ -23,12 +23,12 @@ class LearnError(RuntimeError):
 
 @lru_cache(maxsize=1)
 def prolog():
-    """The process's Prolog, with mil, mil_task, shape_bk and lv3d_bridge consulted once."""
+    """The process's Prolog, with mil, shape_bk and lv3d_bridge consulted once."""
     from pyswip import Prolog
 
     import prolog as sources
 
-    for name in ("mil.pl", "mil_task.pl", "shape_bk.pl", "lv3d_bridge.pl"):
+    for name in ("mil.pl", "shape_bk.pl", "lv3d_bridge.pl"):
         path = str(sources.source(name)).replace("\\", "/")
         list(Prolog.query(f"use_module('{quote(path)[1:-1]}')"))
     return Prolog

@@ -26,7 +26,8 @@ NEAR_MISS = 0.1
 # In few-shot tasks a `regular` literal costs 0.5 nats of prior (docs/learner.md, Settings): every class
 # shows a regular face in most views, so among the clauses one positive cannot tell apart, those
 # resting on it generalise worst.
-SHAPE_SETTINGS = {"max_clauses": 1, "max_inventions": 0, "time_limit": 20, "disjunctions": 20, "extra_literals": 1,
+SHAPE_SETTINGS = {"max_clauses": 1, "max_literals": 6, "max_inventions": 0, "time_limit": 20, "disjunctions": 20,
+                  "extra_literals": 1,
                   "samples": 16, "sample_neg": 6, "predicate_prior": [["regular", 0.5]]}
 FIT_MODULE, SCENE_MODULE = "lv3d_fit", "lv3d_scene"
 

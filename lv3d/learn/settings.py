@@ -18,9 +18,11 @@ BIG = 10 ** 6
 # name -> (kind, low, high, what it is); kinds: int, number, bool, choice, numbers, atoms, priors, metarules
 SETTINGS: dict[str, tuple] = {
     "max_clauses": ("int", 1, 20, "bound on the number of clauses"),
+    "min_clauses": ("int", 1, 20, "where the iterative deepening on clauses starts"),
     "max_literals": ("int", 1, 50, "bound on the body literals of all clauses together"),
     "max_inventions": ("int", 0, 5, "invented predicate symbols allowed"),
     "max_depth": ("int", 1, 1000, "bound on nested clause applications in one proof"),
+    "functional": ("bool", None, None, "Metagol's functional check with the task's func_test/3"),
     "time_limit": ("number", 0, 86400, "seconds for a search (above 0)"),
     "threshold": ("number", 0, 1, "confidence at which an example is covered"),
     "combine": ("choice", COMBINE, None, "how a proof combines its facts' confidences"),

@@ -1,30 +1,201 @@
-"""Metagol-style task files (format: prolog/mil_task.pl, docs/learner.md): learn one and get the
-program's clauses back. The file is read as data by Prolog, never consulted as code."""
+"""Task files (Metagol's example files unchanged, and lv3d's own form; prolog/mil_task.pl and
+docs/learner.md): learn them and get the programs back.
+
+A task file is read as data by ``prolog/mil_main.pl`` in a SWI-Prolog process of its own, under a
+time and a memory limit that this module enforces from outside: whatever the file's own Prolog
+does (mil_safe checks it before it runs), the process ends, and its end is reported in one line.
+"""
 
 from __future__ import annotations
 
+import os
+import selectors
+import shutil
+import signal
+import subprocess
+import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import InputError
 from . import engine
 from .engine import LearnError
 
+MODES = ("exact", "noisy")
+# Memory for one task's process, in MB: the Prolog stacks get this much (--stack-limit), the whole
+# process this and 512 MB more (its address space, RLIMIT_AS).
+MEMORY_MB = 2048
+# Seconds the process may run past a goal's limits (reading the file, starting up) before it is
+# stopped from outside.
+GRACE_S = 10.0
 
-def learn_task(path: str | Path, *, time_limit: float | None = None, settings: dict | None = None) -> list[str]:
-    """The clauses (portray_clause text) of the smallest program that proves every pos/1 example of
-    the task file and no neg/1 one. InputError for a missing or malformed file; LearnError when the
-    search reaches its time limit or finds no program within the file's size bounds."""
+
+@dataclass(frozen=True)
+class GoalResult:
+    """One learning goal of a task file: its program (clauses as Metagol prints them), or None when
+    no program is within the bounds, or the reason it could not be learned (``error``, with
+    ``kind``: time_limit, memory, input, error)."""
+
+    name: str
+    clauses: tuple[str, ...] | None = None
+    error: str | None = None
+    kind: str | None = None
+    cpu_s: float = 0.0
+    wall_s: float = 0.0
+
+
+@dataclass(frozen=True)
+class TaskRun:
+    path: Path
+    goals: tuple[GoalResult, ...] = ()
+    warnings: tuple[str, ...] = field(default_factory=tuple)
+
+
+def swipl() -> str:
+    """The SWI-Prolog executable: $LV3D_SWIPL, else ``swipl`` on PATH."""
+    exe = os.environ.get("LV3D_SWIPL") or shutil.which("swipl")
+    if not exe:
+        raise LearnError("SWI-Prolog's swipl is not on PATH (or set LV3D_SWIPL)")
+    return exe
+
+
+def run_task(path: str | Path, *, time_limit: float | None = None, settings: dict | None = None,
+             goal: str | None = None, mode: str = "exact", memory_mb: int = MEMORY_MB) -> TaskRun:
+    """Learn every goal of the task file (or ``goal``) with the exact search (Metagol's) or the
+    noise-tolerant one (``mode="noisy"``). InputError for a missing or unusable file; a goal that
+    runs out of time or memory is a GoalResult with its error."""
+    import prolog as sources
+
     path = Path(path)
     if not path.is_file():
         raise InputError(path, "no such task file")
+    if mode not in MODES:
+        raise InputError("mode", f"must be one of {', '.join(MODES)}, got {mode!r}")
     opts = dict(settings or {})
     if time_limit is not None:
         if not time_limit > 0:
             raise InputError("--time-limit", f"must be positive, got {time_limit}")
         opts["time_limit"] = float(time_limit)
-    ans = engine.query(f"lv3d_bridge:learn_task({engine.quote(str(path))}, {engine.settings_term(opts)}, Texts)",
-                       where=str(path))
-    if not ans:
-        raise LearnError(f"{path}: no program within the task's max_clauses / max_literals proves every "
-                         "positive and no negative")
-    return [str(t) for t in ans[0]["Texts"]]
+    if not (isinstance(memory_mb, int) and 64 <= memory_mb <= 1 << 20):
+        raise InputError("--memory-limit", f"must be a whole number of MB from 64, got {memory_mb!r}")
+    main = str(sources.source("mil_main.pl"))
+    # the address space is bounded by the shell that execs swipl (no preexec_fn: this process may have
+    # threads); its own session, so that stopping it stops everything it started
+    cmd = ["/bin/sh", "-c", f'ulimit -v {(memory_mb + 512) * 1024} && exec "$0" "$@"', swipl(),
+           f"--stack-limit={memory_mb}m", "-q", main, "--", str(path), engine.settings_term(opts), mode, goal or ""]
+    limit = float(opts.get("time_limit", 10.0))
+    per_goal = 2 * limit + GRACE_S  # running the goal up to its learning call, then the search
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
+                            start_new_session=True)
+    goals: list[GoalResult] = []
+    warnings: list[str] = []
+    current: dict | None = None
+    fatal = None
+    deadline = time.monotonic() + limit + GRACE_S
+    buf = b""
+    sel = selectors.DefaultSelector()
+    sel.register(proc.stdout, selectors.EVENT_READ)
+    stopped = False
+    try:
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                _stop(proc)
+                stopped = True
+                break
+            if not sel.select(timeout=min(left, 1.0)):
+                if proc.poll() is not None:
+                    rest = proc.stdout.read()
+                    buf += rest or b""
+                    break
+                continue
+            chunk = os.read(proc.stdout.fileno(), 65536)
+            if not chunk:
+                break
+            buf += chunk
+            while b"\n" in buf:
+                raw, buf = buf.split(b"\n", 1)
+                rec = raw.decode("utf-8", "replace").split("\t")
+                tag = rec[0]
+                if tag == "warning":
+                    warnings.append(rec[1] if len(rec) > 1 else "")
+                elif tag == "goal":
+                    current = {"name": rec[1], "clauses": [], "none": False, "error": None, "kind": None}
+                    deadline = time.monotonic() + per_goal
+                elif tag == "clause" and current is not None:
+                    current["clauses"].append(rec[1])
+                elif tag == "none" and current is not None:
+                    current["none"] = True
+                elif tag == "failed" and current is not None:
+                    current["kind"], current["error"] = rec[1], rec[2]
+                elif tag == "time" and current is not None:
+                    goals.append(_result(current, float(rec[1]), float(rec[2])))
+                    current = None
+                elif tag == "fatal":
+                    fatal = rec[1:]
+    finally:
+        sel.close()
+        err = b""
+        try:
+            _, err = proc.communicate(timeout=5)
+        except subprocess.TimeoutExpired:
+            _stop(proc)
+    if fatal:
+        kind, where, msg = (fatal + ["", "", ""])[:3]
+        if kind == "input":
+            raise InputError(where or path, msg)
+        raise LearnError(f"{path}: {msg}")
+    if current is not None:  # the process ended, or was stopped, inside a goal
+        why = _ended(proc, stopped, limit, err)
+        goals.append(GoalResult(current["name"], None, why[1], why[0]))
+    elif stopped or (proc.returncode not in (0, None) and not goals):
+        kind, msg = _ended(proc, stopped, limit, err)
+        raise LearnError(f"{path}: {msg}")
+    return TaskRun(path, tuple(goals), tuple(warnings))
+
+
+def _result(cur: dict, cpu: float, wall: float) -> GoalResult:
+    if cur["error"] is not None:
+        return GoalResult(cur["name"], None, cur["error"], cur["kind"], cpu, wall)
+    if cur["none"]:
+        return GoalResult(cur["name"], None, None, None, cpu, wall)
+    return GoalResult(cur["name"], tuple(cur["clauses"]), None, None, cpu, wall)
+
+
+def _stop(proc: subprocess.Popen) -> None:
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    proc.wait()
+
+
+def _ended(proc: subprocess.Popen, stopped: bool, limit: float, err: bytes) -> tuple[str, str]:
+    text = (err or b"").decode("utf-8", "replace")
+    if stopped:
+        return "time_limit", f"the learner did not stop at its time limit of {limit:g} s and was stopped"
+    if "memory" in text.lower() or "resource" in text.lower():
+        return "memory", "the learner ran out of memory"
+    rc = proc.returncode
+    if rc is not None and rc < 0:
+        return "error", f"the learner process ended with signal {-rc}"
+    return "error", f"the learner process ended (exit code {rc})" + (f": {' '.join(text.split())[:200]}" if text else "")
+
+
+def learn_task(path: str | Path, *, time_limit: float | None = None, settings: dict | None = None,
+               goal: str | None = None, mode: str = "exact") -> list[str]:
+    """The clauses (as Metagol prints them) of the program of the task file's one goal (or
+    ``goal``): the smallest that proves every positive and no negative (mode exact), or the best
+    scored (mode noisy). InputError for a missing or malformed file; LearnError when the search
+    reaches its time limit or finds no program within the bounds, or the file has several goals
+    and none is named."""
+    run = run_task(path, time_limit=time_limit, settings=settings, goal=goal, mode=mode)
+    if len(run.goals) != 1:
+        names = ", ".join(g.name for g in run.goals)
+        raise LearnError(f"{path}: the file learns {len(run.goals)} goals ({names}); name one")
+    g = run.goals[0]
+    if g.error is not None:
+        raise LearnError(f"{path}: {g.error}")
+    if g.clauses is None:
+        raise LearnError(f"{path}: no program within the task's bounds proves every positive and no negative")
+    return list(g.clauses)

@@ -1,7 +1,7 @@
 % ancestor, learned as a recursive program.
 % Expected: ancestor(A,B) :- parent(A,B).   ancestor(A,B) :- parent(A,C), ancestor(C,B).
 body_pred(parent/2).
-metarules([ident, chain]).
+metarules([ident, tailrec]).
 setting(max_clauses(2)).
 setting(max_inventions(0)).
 

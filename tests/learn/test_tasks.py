@@ -17,23 +17,17 @@ def task(name):
 
 def test_grandparent_invents_parent():
     clauses = learn_task(task("grandparent"))
-    print("\n" + "\n".join(clauses))
-    text = " ".join(" ".join(c.split()) for c in clauses)
-    assert len(clauses) == 3, clauses
-    assert "grandparent(A, B) :- grandparent_1(A, C), grandparent_1(C, B)." in text
-    assert "grandparent_1(A, B) :- mother(A, B)." in text and "grandparent_1(A, B) :- father(A, B)." in text
+    assert clauses == ["grandparent(A,B):-grandparent_1(A,C),grandparent_1(C,B).",
+                       "grandparent_1(A,B):-mother(A,B).", "grandparent_1(A,B):-father(A,B)."]
 
 
 def test_ancestor_is_recursive():
-    clauses = [" ".join(c.split()) for c in learn_task(task("ancestor"))]
-    print("\n" + "\n".join(clauses))
-    assert clauses == ["ancestor(A, B) :- parent(A, B).", "ancestor(A, B) :- parent(A, C), ancestor(C, B)."]
+    assert learn_task(task("ancestor")) == ["ancestor(A,B):-parent(A,B).", "ancestor(A,B):-parent(A,C),ancestor(C,B)."]
 
 
 def test_even_and_odd_learned_together_by_mutual_recursion():
-    clauses = [" ".join(c.split()) for c in learn_task(task("even_odd"))]
-    print("\n" + "\n".join(clauses))
-    assert set(clauses) == {"even(A) :- zero(A).", "even(A) :- prev(A, B), odd(B).", "odd(A) :- prev(A, B), even(B)."}
+    clauses = learn_task(task("even_odd"))
+    assert set(clauses) == {"even(A):-zero(A).", "even(A):-prev(A,B),odd(B).", "odd(A):-prev(A,B),even(B)."}
 
 
 def test_plunit_suite_passes():
@@ -48,7 +42,6 @@ def test_plunit_suite_passes():
 @pytest.mark.parametrize("text, problem", [
     ("body_pred(mother/2).\npos(gp(a, b)", "syntax error at line"),
     (":- shell('ls').\n", "a task file is data"),
-    ("body_pred(nope/2).\nmetarules([chain]).\npos(gp(a, b)).\n", "body predicate nope/2 is not defined"),
     ("p(a).\nbody_pred(p/1).\nmetarules([base]).\n", "no positive examples"),
     ("p(a).\nbody_pred(p/1).\nmetarules([sideways]).\npos(q(a)).\n", "unknown metarule"),
     ("p(a).\nbody_pred(p/1).\nmetarules([base]).\nsetting(speed(9)).\npos(q(a)).\n", "unknown setting"),
