@@ -18,6 +18,8 @@ guard(Goal, Kind, Where, Msg) :-
 
 error_status(mil_error(time_limit(T)), error(time_limit, '', Msg)) :- !,
     format(atom(Msg), 'the search reached its time limit of ~w s without an answer', [T]).
+error_status(mil_error(classify_time_limit(Label, T)), error(time_limit, '', Msg)) :- !,
+    format(atom(Msg), 'the best proof with the program of ~w was not found within the time limit of ~w s', [Label, T]).
 error_status(mil_error(task(F, M)), error(input, F, M)) :- !.
 error_status(mil_error(program(F, M)), error(input, F, M)) :- !.
 error_status(mil_error(X), error(learn, '', Msg)) :- !, format(atom(Msg), '~q', [X]).
@@ -80,7 +82,8 @@ classify(M, Programs, BodyPreds, Obj, Settings, Results) :-
               maplist(text_clause, Texts, Clauses),
               program_heads(Clauses, Heads),
               example(Label, Obj, E),
-              prove_best(task(M, Heads, BodyPreds, [], [], []), Settings, Clauses, E, best(C, T0)),
+              catch(prove_best(task(M, Heads, BodyPreds, [], [], []), Settings, Clauses, E, best(C, T0)),
+                    mil_error(time_limit(T)), throw(mil_error(classify_time_limit(Label, T)))),
               maplist(trace_item, T0, Trace) ),
             Results).
 

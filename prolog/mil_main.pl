@@ -37,6 +37,9 @@ main :-
     catch(run(File, Overrides, Mode, GoalName), E, ( fatal_error(File, E), halt(2) )),
     halt(0).
 
+run(File, _, validate, _) :- !,
+    validate(File),
+    record([ok]).
 run(File, Overrides, Mode, GoalName) :-
     atom_concat('check:', ClausesFile, Mode), !,
     read_task_file(File, mil_task_bk, TF),
@@ -57,9 +60,46 @@ run(File, Overrides, Mode, GoalName) :-
     goals_named(TF, File, GoalName, Goals),
     append(Overrides, FileSettings, Settings0),
     forall(member(O, Settings0), read_here(File, Mode, O)),
-    mil:settings(Settings0, Settings),
+    mil:settings(Settings0, Settings1),
+    (   Mode == noisy, \+ memberchk(sample_pos(_), Settings0)
+    ->  select_option(sample_pos(_), Settings1, Settings)        % mil_task: two thirds of the positives
+    ;   Settings = Settings1
+    ),
     option(time_limit(T), Settings),
     forall(member(Name-G, Goals), learn_goal(TF, Name, G, T, Settings, Mode)).
+
+%   A file another process will read (a program file): it reads as Prolog terms nested at most
+%   max_depth/1 deep, which an embedded Prolog reads without running out of C stack.
+max_depth(100).
+
+validate(File) :-
+    catch(setup_call_cleanup(open(File, read, S), validate_terms(S, File), close(S)), E,
+          validate_error(File, E)).
+
+validate_terms(S, File) :-
+    read_term(S, T, [syntax_errors(error), term_position(P)]),
+    (   T == end_of_file -> true
+    ;   max_depth(Max), stream_position_data(line_count, P, Line),
+        (   deeper(T, Max) -> format(atom(Msg), 'line ~w: a term is nested more than ~w deep', [Line, Max]),
+            throw(mil_error(task(File, Msg)))
+        ;   true
+        ),
+        validate_terms(S, File)
+    ).
+
+deeper(T, Max) :- Max < 0, !, nonvar(T).
+deeper(T, Max) :- compound(T), M1 is Max - 1, arg(_, T, A), deeper(A, M1), !.
+
+validate_error(File, E) :-
+    (   E = error(syntax_error(Msg), stream(_, L, C, _)) -> format(atom(M), 'syntax error at line ~w column ~w: ~w', [L, C, Msg])
+    ;   E = error(syntax_error(Msg), file(_, L, C, _)) -> format(atom(M), 'syntax error at line ~w column ~w: ~w', [L, C, Msg])
+    ;   E = error(syntax_error(Msg), _) -> format(atom(M), 'syntax error: ~w', [Msg])
+    ;   E = error(existence_error(source_sink, _), _) -> M = 'no such file'
+    ;   E = error(resource_error(_), _) -> M = 'a term is nested too deeply to read'
+    ;   E = mil_error(_) -> throw(E)
+    ;   format(atom(M), 'cannot be read: ~q', [E])
+    ),
+    throw(mil_error(task(File, M))).
 
 %   A setting the chosen search does not read is an error, not ignored.
 read_here(File, Mode, O) :-
@@ -123,13 +163,17 @@ learn_goal(TF, Name, G, T, Settings, Mode) :-
 failure(mil_error(time_limit(T)), time_limit, Msg) :- !,
     format(atom(Msg), 'the search reached its time limit of ~w s without an answer', [T]).
 failure(mil_error(task(_, M)), input, M) :- !.
+failure(error(resource_error(c_stack), _), memory, 'a term is nested too deeply (the C stack ran out)') :- !.
 failure(error(resource_error(R), _), memory, Msg) :- !,
     format(atom(Msg), 'the search ran out of memory (~w)', [R]).
+failure(mil_error(unsafe_call(M)), input, M) :- !.
 failure(E, error, Msg) :- message(E, Msg).
 
 fatal_error(_, mil_error(task(F, M))) :- !, fatal(input, F, M).
 fatal_error(File, mil_error(time_limit(T))) :- !,
     format(atom(Msg), 'reached its time limit of ~w s', [T]), fatal(time_limit, File, Msg).
+fatal_error(File, error(resource_error(c_stack), _)) :- !,
+    fatal(input, File, 'a term is nested too deeply (the C stack ran out)').
 fatal_error(File, error(resource_error(R), _)) :- !,
     format(atom(Msg), 'ran out of memory (~w)', [R]), fatal(memory, File, Msg).
 fatal_error(File, E) :- message(E, Msg), fatal(error, File, Msg).

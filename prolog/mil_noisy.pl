@@ -247,7 +247,7 @@ sample_hypothesis(Ctx0, Settings, Pos, Neg, Prog) :-
 
 sized_hypotheses(Ctx, J, Pos, Neg, Progs) :-
     findall(P, all_examples(Pos, Ctx, [], P), Ps0), list_to_set(Ps0, Ps),
-    findall(P, limit(J, (member(P, Ps), consistent(Ctx, Neg, P))), Progs).
+    findall(P, limit(J, (member(P, Ps), consistent(Ctx, Pos, Neg, P))), Progs).
 
 %   Each example's proof may extend the program; other proofs that give the same program are
 %   pruned (distinct/2), else every proof of every later example would repeat a hypothesis.
@@ -267,13 +267,14 @@ sample(SP, SN, Pos, Neg, P1-N1) :- pick(SP, Pos, P1), pick(SN, Neg, N1).
 pick(K, Xs, Ys) :- random_permutation(Xs, Zs), length(Xs, L), M is min(K, L), length(Ys, M), append(Ys, _, Zs).
 
 %   A program that proves every positive has the round's size, no clause twice, no clause with a
-%   literal twice, and proves no negative.  A clause whose body holds one literal twice (part2
+%   literal twice, proves no negative and passes the functional check (setting functional(true)).  A clause whose body holds one literal twice (part2
 %   with R = S) says no more than a shorter one found before it, but under combine(product) its
 %   proofs are less confident, which can game the coverage threshold.
-consistent(Ctx, Neg, Prog) :-
+consistent(Ctx, Pos, Neg, Prog) :-
     ground(Prog),
     ctx_maxn(Ctx, N), length(Prog, N),
     exact_size(Ctx, Prog),
     sort(Prog, Sorted), length(Sorted, N),
     \+ ( member(Item, Prog), repeated_literal(Ctx, Item) ),
-    \+ ( member(E, Neg), covers(Ctx, Prog, E, _, _) ).
+    \+ ( member(E, Neg), covers(Ctx, Prog, E, _, _) ),
+    functional_ok(Ctx, Prog, Pos).

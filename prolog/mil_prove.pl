@@ -394,19 +394,35 @@ add_lits(cl(_, B), L0, L) :- length(B, K), L is L0 + K.
 %!  deduce(+Ctx, +Prog, +Atom, -Conf) is semidet.
 %   The first proof of Atom (an l/3) with Prog and no new clause (Metagol's deduce_atom).
 deduce(X0, Prog, L, C) :-
-    length(Prog, N), set_maxn_of_ctx(N, X0, X), ctx_depth(X, D),
+    fixed_ctx(X0, Prog, N, X), ctx_depth(X, D),
     once(prove([L], X, [], [], D, Prog, _, N, _, 1.0, C, _, [])).
 
 %   Every proof (nondet) of L with Prog and no new clause.
 proves(X0, Prog, L) :-
-    length(Prog, N), set_maxn_of_ctx(N, X0, X), ctx_depth(X, D),
+    fixed_ctx(X0, Prog, N, X), ctx_depth(X, D),
     prove([L], X, [], [], D, Prog, _, N, _, 1.0, _, _, []).
+
+%   The context for proving with Prog as it is: no new clause, and without a signature of the
+%   search, the program's own (its targets, then the other symbols its clauses define).
+fixed_ctx(X0, Prog, N, X) :-
+    length(Prog, N), set_maxn_of_ctx(N, X0, X1),
+    (   ctx_sig(X1, none)
+    ->  ctx_targets(X1, Ts),
+        findall(sym(P, A, target), member(P/A, Ts), TSyms),
+        findall(sym(P, A, 1), ( member(I, Prog), item_head(I, P, A), \+ memberchk(P/A, Ts) ), Syms0),
+        list_to_set(Syms0, Syms), append(TSyms, Syms, Sig),
+        set_sig_of_ctx(Sig, X1, X)
+    ;   X = X1
+    ).
+
+item_head(sub(_, P, A, _, _), P, A).
+item_head(cl(l(P, A, _), _), P, A).
 
 %!  covers(+Ctx, +Prog, +Atom, -Conf, -Trace) is nondet.  Every proof of Atom (an l/3 or an atom)
 %   with the fixed program Prog.
 covers(X0, Prog, E, C, Trace) :-
     ( E = l(_, _, _) -> L = E ; atom_lit(E, L) ),
-    length(Prog, N), set_maxn_of_ctx(N, X0, X), ctx_depth(X, D),
+    fixed_ctx(X0, Prog, N, X), ctx_depth(X, D),
     prove([L], X, [], [], D, Prog, _, N, _, 1.0, C, Trace, []).
 
 %!  functional_ok(+Ctx, +Prog, +Atoms) is semidet.

@@ -50,11 +50,12 @@ check_head(H, W) :-
     ;   H = M:_ -> refuse(W, 'the clause is module-qualified (~q): a task defines its own predicates only', [M])
     ;   \+ callable(H) -> refuse(W, 'the clause head ~q is not an atom', [H])
     ;   functor(H, P, A), builtin(P, A) -> refuse(W, 'defines ~q/~q, a built-in', [P, A])
+    ;   functor(H, P, A), sub_atom(P, 0, _, _, '$') -> refuse(W, 'defines ~q/~q: names starting with $ are reserved', [P, A])
     ;   true
     ).
 
 %   body(+Goal, +Where, -Checked, -Warnings0, -Warnings)
-body(G, W, checked_call(M, G), Ws, Ws) :- var(G), !, where_module(W, M).
+body(G, W, mil_safe:checked_call(M, G), Ws, Ws) :- var(G), !, where_module(W, M).
 body(M:G, W, _, _, _) :- !,
     refuse(W, 'calls ~q, a module-qualified goal: a task calls its own predicates and safe built-ins only', [M:G]).
 body(G, W, _, _, _) :- \+ callable(G), !, refuse(W, 'calls ~q, which is not a goal', [G]).
@@ -66,7 +67,7 @@ body(\+ A, W, \+ A1, Ws0, Ws) :- !, body(A, W, A1, Ws0, Ws).
 body(G, W, G1, Ws0, Ws) :-
     functor(G, call, N), N >= 1, !,
     G =.. [call, C|Extra],
-    (   var(C) -> where_module(W, M), G1 =.. [checked, M, C|Extra], Ws0 = Ws
+    (   var(C) -> where_module(W, M), checked_goal(M, C, Extra, G1), Ws0 = Ws
     ;   callable(C), C \= _:_ -> extend(C, Extra, G2), body(G2, W, G3, Ws0, Ws), G1 = call(G3)
     ;   refuse(W, 'calls ~q, which is not a goal', [C])
     ).
@@ -102,7 +103,9 @@ check_pred(P/A, W, Kind) :-
     ;   Kind = unknown
     ).
 
-own(M, P, A) :- catch(M:'$mil_own'(P, A), error(existence_error(_, _), _), fail), !.
+own(M, P, A) :-
+    catch(M:'$mil_own'(P, A), error(existence_error(_, _), _), fail), !,
+    \+ builtin(P, A), \+ sub_atom(P, 0, _, _, '$').
 
 known_elsewhere(P, A) :- builtin(P, A), !.
 known_elsewhere(P, A) :- '$in_library'(P, A, _), !.
@@ -132,6 +135,9 @@ closure(C, N, W, C1, Ws) :-
 closure(C, _, W, _, _) :- refuse(W, 'calls ~q, which is not a goal', [C]).
 
 meta_goal(G) :- functor(G, P, A), ( meta(P/A, _, _) ; P == call ), !.
+
+checked_goal(M, C, [], mil_safe:checked_call(M, C)) :- !.
+checked_goal(M, C, Extra, mil_safe:G) :- G =.. [checked, M, C|Extra].
 
 extend(C, Extra, G) :- C =.. L0, append(L0, Extra, L), G =.. L.
 
@@ -168,7 +174,7 @@ checked_call(M, G) :-
     (   own(M, P, A) -> call(M:G)
     ;   safe(P/A), \+ meta(P/A, _, _), special_ok(G) -> call(M:G)
     ;   catch(check_goal(G, where(runtime, 0, 'a goal built at run time', M, bk), G1, _), mil_error(task(_, Msg)),
-              throw(mil_error(unsafe_call(G, Msg)))),
+              throw(mil_error(unsafe_call(Msg)))),
         call(M:G1)
     ).
 

@@ -75,7 +75,8 @@ read_task_file(File, M, TF) :-
     foldl(classify(File, Format), Terms, s([], [], [], [], [], [], [], []), S0),
     S0 = s(BK0, BPs0, MRs0, Decls0, Sets0, Dirs0, Exs0, Ws0),
     maplist(reverse, [BK0, BPs0, MRs0, Decls0, Sets0, Dirs0, Exs0, Ws0],
-                     [BK, BPs1, MRs1, Decls1, Sets, Dirs, Exs, Ws1]),
+                     [BK0r, BPs1, MRs1, Decls1, Sets, Dirs, Exs, Ws1]),
+    confident(File, BK0r, BK),
     declare_own(File, M, BK, Dirs),
     findall(P/A, ( member(c(Cl, _, _), BK), clause_pi(Cl, P/A) ), Own0),
     foldl(assert_clause(File, M), BK, Ws1, Ws2),
@@ -190,7 +191,11 @@ add(metarules(Ns), File, L, s(B, P, M, D0, Se, Di, E, W), s(B, P, M1, D0, Se, Di
     foldl(named_metarule(File, L), Ns, M, M1).
 add(clause(T), File, L, s(B, P, M, D0, Se, Di, E, W), s([c(T, L, plain)|B], P, M, D0, Se, Di, E, W)) :-
     (   T = (H :- _) -> true ; H = T ),
-    (   H = Mod:_ -> problem(File, format('line ~w: the clause is module-qualified (~q): a task defines its own predicates only', [L, Mod]))
+    (   var(H) -> problem(File, format('line ~w: a clause head is a variable', [L]))
+    ;   H = Mod:_ -> problem(File, format('line ~w: the clause is module-qualified (~q): a task defines its own predicates only', [L, Mod]))
+    ;   \+ callable(H) -> problem(File, format('line ~w: the clause head ~q is not an atom', [L, H]))
+    ;   functor(H, Nm, Ar), sub_atom(Nm, 0, _, _, '$')
+    ->  problem(File, format('line ~w: clause ~q/~q: names starting with $ are reserved', [L, Nm, Ar]))
     ;   true
     ).
 
@@ -227,6 +232,23 @@ clause_pi(T, P/A) :-
     (   T = (H :- _) -> true ; H = T ),
     functor(H, P, A).
 
+%   A predicate with a fact that has a confidence is a fact with a confidence throughout: its facts
+%   without one hold with confidence 1; a rule for it has no confidence to give and is refused.
+confident(File, BK0, BK) :-
+    findall(P/A, ( member(c(F, _, conf(_)), BK0), functor(F, P, A) ), Ps0), sort(Ps0, Ps),
+    maplist(confident_clause(File, Ps), BK0, BK).
+
+confident_clause(File, Ps, c(T, L, plain), C) :- !,
+    (   T = (H :- B), B \== true -> true ; H = T, B = true ),
+    functor(H, P, A),
+    (   memberchk(P/A, Ps)
+    ->  (   B == true -> C = c(H, L, conf(1.0))
+        ;   problem(File, format('line ~w: ~q/~q has facts with confidences; a rule for it has none to give', [L, P, A]))
+        )
+    ;   C = c(T, L, plain)
+    ).
+confident_clause(_, _, C, C).
+
 %   The task's own predicates (its clauses' and those declared dynamic), before any clause is
 %   checked: a clause may call one defined later.
 declare_own(File, M, BK, Dirs) :-
@@ -243,16 +265,12 @@ assert_clause(File, M, c(T, L, plain), W0, W) :-
     check_clause(T, where(File, L, What, M, Role), T1, Ws),
     assertz(M:T1),
     append(W0, Ws, W).
-assert_clause(File, M, c(F, L, conf(C)), W, W) :-
+assert_clause(_, M, c(F, _, conf(C)), W, W) :-
     functor(F, P, A),
     (   M:'$mil_fact'(P, A, Store) -> true
     ;   atom_concat('$mil_cf_', P, Store),
         assertz(M:'$mil_fact'(P, A, Store)),
         functor(H, P, A), H =.. [P|Args], append(Args, [_], Args1), B =.. [Store|Args1],
-        (   predicate_property(M:H, number_of_clauses(K)), K > 0
-        ->  problem(File, format('line ~w: ~q/~q has facts with confidences and clauses without; give every fact a confidence', [L, P, A]))
-        ;   true
-        ),
         assertz(M:(H :- B))
     ),
     F =.. [_|Args2], append(Args2, [C], Args3), G =.. [Store|Args3],
@@ -488,8 +506,16 @@ seq_task(TF, Settings, Mode, Pos-Neg, Ps0-Extra0, [Cs|Ps0]-Extra) :-
 
 learn_task(Task, Settings, exact, Prog) :-
     (   learn(Task, Settings, P) -> Prog = P ; Prog = none ).
-learn_task(Task, Settings, noisy, Prog) :-
+learn_task(Task, Settings0, noisy, Prog) :-
+    sample_size(Task, Settings0, Settings),
     (   learn_noisy(Task, Settings, P, _) -> Prog = P ; Prog = none ).
+
+%   For a task file, a sample holds two thirds of the positives (at least two) unless a setting
+%   says otherwise: with one wrong label in nine, a third of such samples leave it out, and a
+%   sample still needs as many clauses as the whole concept.
+sample_size(Task, Settings, Settings) :- memberchk(sample_pos(_), Settings), !, arg(1, Task, _).
+sample_size(Task, Settings, [sample_pos(K)|Settings]) :-
+    arg(5, Task, Pos), length(Pos, NP), K is max(2, ceiling(2 * NP / 3)).
 
 %   The task of a learning call: the targets are the examples' predicates (Metagol: the first
 %   positive's; lv3d: each, in order).

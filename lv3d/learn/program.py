@@ -70,6 +70,9 @@ class Program:
         target = target or (m.group(1) if m else path.stem)
         if not _TARGET.match(target):
             raise InputError(path, f"target {target!r} is not a predicate name")
+        from .task import validate_file
+
+        validate_file(path)  # read first in a process of its own: no file can crash this one's Prolog
         known = engine.plist(f"{p}/{a}" for p, a in known_predicates())
         ans = engine.query(f"lv3d_bridge:check_program({engine.quote(str(path))}, {known}, {target}, Texts)",
                            where=str(path))

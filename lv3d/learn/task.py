@@ -21,7 +21,9 @@ from ..errors import InputError
 from . import engine
 from .engine import LearnError
 
-MODES = ("exact", "noisy")
+MODES = ("exact", "noisy", "validate")
+# A file another part of lv3d reads in its own (embedded) Prolog is first read here: at most this size.
+MAX_VALIDATE_BYTES = 1 << 20
 # Memory for one task's process, in MB: the Prolog stacks get this much (--stack-limit), the whole
 # process this and 512 MB more (its address space, RLIMIT_AS).
 MEMORY_MB = 2048
@@ -199,3 +201,14 @@ def learn_task(path: str | Path, *, time_limit: float | None = None, settings: d
     if g.clauses is None:
         raise LearnError(f"{path}: no program within the task's bounds proves every positive and no negative")
     return list(g.clauses)
+
+
+def validate_file(path: str | Path) -> None:
+    """InputError unless the file reads as Prolog terms nested at most 100 deep (read in a process of
+    its own, so that no file can crash this one's embedded Prolog). For program files."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(path, "no such file")
+    if path.stat().st_size > MAX_VALIDATE_BYTES:
+        raise InputError(path, f"larger than {MAX_VALIDATE_BYTES} bytes; not a program lv3d wrote")
+    run_task(path, mode="validate", time_limit=10, memory_mb=256)

@@ -40,3 +40,16 @@ def test_learn_fit_then_predict_on_a_rendered_data_set(tmp_path, capsys):
     assert (tmp_path / "m" / "cube.pl").is_file()
     assert main(["learn", "predict", "--data", str(data), "--model", str(tmp_path / "m")]) == 0
     assert "accuracy 6/6" in capsys.readouterr().out
+
+
+def test_mil_noisy_and_a_goal_without_program(capsys):
+    assert main(["mil", str(prolog.source("tasks/noisy_grandparent.pl"))]) == 1
+    assert capsys.readouterr().out.strip() == "% unable to learn a solution"
+    assert main(["mil", "--noisy", "--set", "max_clauses=3", str(prolog.source("tasks/noisy_grandparent.pl"))]) == 0
+    assert capsys.readouterr().out.splitlines()[0] == "grandparent(A,B):-grandparent_1(A,C),grandparent_1(C,B)."
+
+
+def test_mil_bad_set_is_one_line(capsys):
+    assert main(["mil", "--set", "max_clauses=0", str(prolog.source("tasks/ancestor.pl"))]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("lv3d: error: --set: max_clauses") and "\n" not in err

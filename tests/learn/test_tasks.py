@@ -70,3 +70,40 @@ def test_search_that_reaches_its_time_limit_is_an_error(tmp_path):
     with pytest.raises(LearnError, match="time limit of 0.5 s"):
         learn_task(f, time_limit=0.5)
     assert time.monotonic() - t0 < 10
+
+
+GRANDPARENT = ["grandparent(A,B):-grandparent_1(A,C),grandparent_1(C,B).",
+               "grandparent_1(A,B):-mother(A,B).", "grandparent_1(A,B):-father(A,B)."]
+
+
+def test_noisy_search_learns_through_a_wrong_label_and_a_doubtful_fact():
+    with pytest.raises(LearnError, match="no program"):
+        learn_task(task("noisy_grandparent"))
+    assert learn_task(task("noisy_grandparent"), mode="noisy") == GRANDPARENT
+
+
+@pytest.mark.parametrize("settings, mode, problem", [
+    ({"samples": 4}, "exact", "setting samples is read only by the noise-tolerant search"),
+    ({"miss": 0.1}, "noisy", "setting miss is not read when learning"),
+])
+def test_a_setting_the_search_does_not_read_is_refused(settings, mode, problem):
+    with pytest.raises(InputError, match=problem):
+        learn_task(task("grandparent"), settings=settings, mode=mode)
+
+
+def test_a_fact_with_a_confidence_below_the_threshold_is_not_used(tmp_path):
+    f = tmp_path / "t.pl"
+    f.write_text("body_pred(p/1).\nmetarules([base]).\n0.4::p(a).\np(b).\npos(t(b)).\n")
+    assert learn_task(f) == ["t(A):-p(A)."]
+    f.write_text("body_pred(p/1).\nmetarules([base]).\n0.4::p(a).\np(b).\npos(t(a)).\n")
+    with pytest.raises(LearnError, match="no program"):
+        learn_task(f)
+    assert learn_task(f, settings={"threshold": 0.3}) == ["t(A):-p(A)."]
+
+
+def test_p_and_p_with_one_more_argument_do_not_collide(tmp_path):
+    # trains: load/3 is a body predicate and load/2 a plain one; neither is a fact with a confidence
+    f = tmp_path / "t.pl"
+    f.write_text("body_pred(load/2).\nmetarules([base, part]).\nload(c1, tri).\nload(c1, tri, 2).\n"
+                 "tri(tri).\nbody_pred(tri/1).\npos(t(c1)).\nneg(t(c2)).\n")
+    assert learn_task(f) == ["t(A):-load(A,B),tri(B)."]
