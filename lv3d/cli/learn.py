@@ -147,6 +147,8 @@ def fit(data: Path, modality: str, facts: str, classes: str | None, out: Path, s
     with replacing(out, (data,)) as tmp:  # written beside OUT, then moved into its place
         model.save(tmp)
     for c, p in model.programs.items():
+        if p.target != c:
+            click.echo(f"% {c}: learned as {p.target}, since {c} names a body predicate")
         click.echo(f"% {c}: covers {p.score['tp']}/{p.score['n_pos']} positives, "
                    f"{p.score['fp']}/{p.score['n_neg']} negatives\n{p}\n")
     for c, why in model.failures.items():

@@ -80,11 +80,20 @@ def _check_scenes(scenes: list[SceneFacts]) -> str:
     return modalities.pop()
 
 
+def predicate_name(label: str) -> str:
+    """The predicate a class's program defines: the label itself, or is_<label> when the label names a
+    body predicate (a fact of the contract or a derived one), which a learned clause could not
+    otherwise tell from it (Program.label keeps the class)."""
+    taken = set(PREDICATES) | {p for p, _ in engine.derived_preds()}
+    return f"is_{label}" if label in taken else label
+
+
 def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: dict | None = None,
         seed: int = 0) -> Program:
     """Learn ``target(O)`` from the scenes' target objects: positives where label == target,
     negatives the rest. ``settings`` override SHAPE_SETTINGS and mil's defaults (docs/learner.md).
-    LearnError when no hypothesis covers any sample or the search runs out of time."""
+    A target named like a body predicate (``triangle``) is learned as ``is_triangle``, its program's
+    label saying so. LearnError when no hypothesis covers any sample or the search runs out of time."""
     if len(scenes) != len(labels):
         raise InputError("labels", f"{len(labels)} labels for {len(scenes)} scenes")
     modality = _check_scenes(scenes)
@@ -93,6 +102,7 @@ def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: d
     if not pos:
         raise InputError("labels", f"no scene is labelled {target!r}")
     opts = {**SHAPE_SETTINGS, **check_settings(settings), "seed": int(seed)}
+    label, target = target, predicate_name(target)
     preds = engine.plist(f"{p}/{a}" for p, a in body_preds(modality))
     mrs = engine.plist(opts.pop("metarules", SHAPE_METARULES))
     goal = (f"{_load(FIT_MODULE, scenes)}, "
@@ -108,7 +118,8 @@ def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: d
     a = ans[0]
     score = {"j": float(a["J"]), "soft": float(a["Soft"]), "tp": int(a["TP"]), "n_pos": int(a["NP"]),
              "fp": int(a["FP"]), "n_neg": int(a["NN"]), "threshold": float(a["Thr"])}
-    return Program(target, tuple(str(t) for t in a["Texts"]), score, modality, opts)
+    return Program(target, tuple(str(t) for t in a["Texts"]), score, modality, opts,
+                   label=label if label != target else None)
 
 
 @dataclass
@@ -188,9 +199,11 @@ class Model:
         goal = (f"{_load(SCENE_MODULE, [scene])}, lv3d_bridge:classify({SCENE_MODULE}, {progs}, {preds}, "
                 f"{scene.target}, {engine.settings_term(opts)}, Rs), lv3d_bridge:drop_scene({SCENE_MODULE})")
         ans = engine.query(goal, where=f"classifying {scene.scene}")
+        classes = {p.target: c for c, p in self.programs.items()}
         out = []
         for r in ans[0]["Rs"] if ans else []:
-            label, conf, trace = _result_parts(r)
+            pred, conf, trace = _result_parts(r)
+            label = classes.get(pred, pred)
             if near or conf >= thr[label]:
                 # a near proof ranks by its per-fact (geometric mean) confidence: a program of two
                 # facts missing one is half matched, one of four missing one three-quarters, where
@@ -238,7 +251,8 @@ class Model:
             p.save(out_dir / f"{p.target}.pl")
         (out_dir / "model.json").write_text(json.dumps(
             {"classes": sorted(self.programs), "settings": self.settings,
-             "scores": {k: p.score for k, p in self.programs.items()}}, indent=1))
+             "scores": {k: p.score for k, p in self.programs.items()},
+             "predicates": {k: p.target for k, p in self.programs.items() if p.target != k}}, indent=1))
         return out_dir
 
     @classmethod
@@ -253,9 +267,12 @@ class Model:
         except (KeyError, TypeError) as e:
             raise InputError(index, f"malformed: {e}") from None
         programs = {}
+        preds = meta.get("predicates", {}) if isinstance(meta.get("predicates"), dict) else {}
         for c in classes:
-            p = Program.load(in_dir / f"{c}.pl", target=c)
-            programs[c] = Program(p.target, p.clauses, meta.get("scores", {}).get(c, {}), p.modality)
+            pred = preds.get(c, c)
+            p = Program.load(in_dir / f"{pred}.pl", target=pred)
+            programs[c] = Program(p.target, p.clauses, meta.get("scores", {}).get(c, {}), p.modality,
+                                  label=c if pred != c else None)
         return cls(programs, meta.get("settings", {}))
 
 

@@ -30,13 +30,21 @@ class Program:
     score: dict = field(default_factory=dict)
     modality: str | None = None
     settings: dict = field(default_factory=dict)
+    label: str | None = None  # the class it answers when that is not ``target`` (a fact predicate's name)
 
     def __str__(self) -> str:
         return "\n".join(self.clauses)
 
+    @property
+    def answers(self) -> str:
+        """The class this program answers: its label, else its target."""
+        return self.label or self.target
+
     def to_pl(self) -> str:
         head = [f"% lv3d program: target {self.target}/1, facts {SCHEMA}, modality {self.modality}",
                 f"% target: {self.target}"]
+        if self.label and self.label != self.target:
+            head.append(f"% label: {self.label} (learned as {self.target}: {self.label} names a body predicate)")
         if self.score:
             s = self.score
             head.append(f"% training: covers {s.get('tp')}/{s.get('n_pos')} positives, "
@@ -66,6 +74,7 @@ class Program:
         except (OSError, UnicodeDecodeError) as e:
             raise InputError(path, f"cannot be read: {e}") from None
         m = re.search(r"^%\s*target:\s*(\S+)", text, re.M)
+        lab = re.search(r"^%\s*label:\s*([a-z][a-zA-Z0-9_]*)", text, re.M)
         modality = re.search(r"modality (\w+)", text)
         target = target or (m.group(1) if m else path.stem)
         if not _TARGET.match(target):
@@ -79,4 +88,5 @@ class Program:
         if not ans:
             raise InputError(path, "could not be read as a program")
         return cls(target, tuple(str(t) for t in ans[0]["Texts"]),
-                   modality=modality.group(1) if modality and modality.group(1) != "None" else None)
+                   modality=modality.group(1) if modality and modality.group(1) != "None" else None,
+                   label=lab.group(1) if lab else None)

@@ -42,3 +42,21 @@ def test_bad_program_file_is_an_input_error(tmp_path, text, problem):
 def test_missing_model_dir(tmp_path):
     with pytest.raises(InputError, match="no model.json"):
         Model.load(tmp_path)
+
+
+def test_a_class_named_like_a_fact_predicate_is_learned_under_another_name(tmp_path):
+    from lv3d.facts import Fact, SceneFacts
+
+    def scene(i, shape):
+        o, f = f"o{i}", f"f{i}"
+        return SceneFacts(f"s{i}", "rgb", [Fact("object", (o,), 1.0), Fact("face_of", (o, f), 1.0),
+                                           Fact(shape, (f,), 0.9)], o)
+
+    xs = [scene(0, "triangle"), scene(1, "triangle"), scene(2, "pentagon"), scene(3, "hexagon")]
+    model = Model.fit(xs, ["triangle", "triangle", "other", "other"], classes=["triangle"])
+    p = model.programs["triangle"]
+    assert p.target == "is_triangle" and p.label == "triangle" and p.clauses[0].startswith("is_triangle(A) :-")
+    assert model.predict(xs[0]) == ("triangle", 0.9) and model.predict(xs[2])[0] == "unknown"
+    model.save(tmp_path / "m")
+    assert "% label: triangle" in (tmp_path / "m" / "is_triangle.pl").read_text()
+    assert Model.load(tmp_path / "m").predict(xs[1]) == ("triangle", 0.9)
