@@ -5,10 +5,16 @@
     rests on, exactly as a learned clause's does, and an explanation lists those facts.
     A scene module imports this one (lv3d_bridge:load_scene/3) to see these rules.
 */
-:- module(shape_bk, [derived/1, near_miss/2]).
+:- module(shape_bk, [derived/1, derived_uses/2, near_miss/2]).
 
 %!  derived(?Name/Arity) is nondet.  The derived body predicates.
 derived(P/A) :- clause(bk_rule(H, _), true), functor(H, P, A).
+
+%!  derived_uses(?Name/Arity, -Facts) is nondet.  The fact predicates (Name/Arity) a derived
+%   predicate's rule rests on: a modality that lacks one of them can never prove it.
+derived_uses(P/A, Uses) :-
+    clause(bk_rule(H, Body), true), functor(H, P, A),
+    findall(Q/B, ( member(G, Body), functor(G, Q, B) ), Uses0), sort(Uses0, Uses).
 
 %!  near_miss(+M, ?Fact) is nondet.  Fact, absent from scene module M, may be taken for a fact
 %   perception missed (mil's option miss/1): never the structure (object/1, face_of/2), so that a

@@ -64,6 +64,13 @@ def fact_pred_specs() -> str:
 
 
 @lru_cache(maxsize=1)
+def derived_uses() -> dict[str, frozenset[str]]:
+    """Each derived predicate of prolog/shape_bk.pl: the fact predicates its rule rests on."""
+    return {str(r["P"]): frozenset(str(u).split("/")[0] for u in r["U"])
+            for r in query("shape_bk:derived_uses(P/_, U0), findall(X, (member(Q/B, U0), format(atom(X), '~w/~w', [Q, B])), U)")}
+
+
+@lru_cache(maxsize=1)
 def derived_preds() -> tuple[tuple[str, int], ...]:
     """The derived body predicates of prolog/shape_bk.pl, (name, arity)."""
     return tuple((r["P"], int(r["A"])) for r in query("shape_bk:derived(P/A)"))

@@ -49,9 +49,13 @@ EXCLUDED = ("object", "horizontal", "vertical")
 
 def body_preds(modality: str) -> list[tuple[str, int]]:
     """The body predicates a system seeing ``modality`` learns with, in search order: the contract's
-    (but object/1, true of every target) and the derived ones of prolog/shape_bk.pl."""
+    (but object/1, true of every target) and the derived ones of prolog/shape_bk.pl whose facts the
+    modality emits."""
     own = [(p, a) for p, (a, mods) in PREDICATES.items() if modality in mods and p not in EXCLUDED]
-    preds = own + list(engine.derived_preds())
+    seen = {p for p, (_, mods) in PREDICATES.items() if modality in mods}
+    uses = engine.derived_uses()
+    # a derived predicate whose rule rests on a fact the modality never emits can never be proved
+    preds = own + [(p, a) for p, a in engine.derived_preds() if uses.get(p, frozenset()) <= seen]
     rank = {p: i for i, p in enumerate(BODY_ORDER)}
     return sorted(preds, key=lambda pa: rank.get(pa[0], len(rank)))
 
