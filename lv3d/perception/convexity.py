@@ -102,8 +102,23 @@ def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, offsets:
             ca, cb = xyz[near_b].mean(axis=0), xyz[near_a].mean(axis=0)
             angle = float(np.degrees(np.arccos(np.clip(na @ nb, -1.0, 1.0))))
             convex = float((na - nb) @ (ca - cb)) > 0
+            if convex and not _sane(na, nb, ca - cb, angle):
+                continue  # not a junction of one surface: a step seen across an occluding edge
             out.append((a + 1, b + 1, angle if convex else -angle))
     return out
+
+
+def _sane(na: np.ndarray, nb: np.ndarray, d: np.ndarray, angle_deg: float) -> bool:
+    """LCCP's sanity criterion for a convex junction: two planes that meet along an edge have their centroids'
+    offset ``d`` well across the line where they intersect (n_a x n_b); an offset nearly along that line is a
+    step between surfaces one above or behind the other, seen touching in the image. The least angle allowed grows
+    with the angle between the normals, as 60 deg / (1 + exp(-0.25 (angle - 25 deg))) (Stein et al. 2014)."""
+    s = np.cross(na, nb)
+    ls, ld = np.linalg.norm(s), np.linalg.norm(d)
+    if ls < 1e-9 or ld < 1e-12:
+        return True
+    theta = float(np.degrees(np.arccos(min(1.0, abs(float(s @ d)) / (ls * ld)))))  # 0 when along the line
+    return theta >= 60.0 / (1.0 + np.exp(-0.25 * (angle_deg - 25.0)))
 
 
 def _meet(xyz: np.ndarray, along: np.ndarray, n: np.ndarray, d: float, settings: ConvexitySettings) -> bool:
