@@ -110,9 +110,8 @@ def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: floa
     control (step_edge.side_cut: a cube's top and front whose left and right sides run on in one line each): most
     colour-only misses on noisy renders are corners the segments stop short of and two faces of one colour traced as
     one. The parts of the silhouettes left outside every face, each of a colour of its own or a whole solid none of
-    whose faces was traced, are then faces too (untraced.untraced_faces: slivers whose corners the graph collapsed;
-    clean rgb recall rose on 4 of 6 dev seeds and fell on none; docs/perception.md), each cut from side to side as
-    above. Faces of the colour of the image's border (floor texture, shadows, painted lines) are then dropped
+    whose faces was traced, are then faces too (untraced.untraced_faces: slivers whose corners the graph
+    collapsed), each cut from side to side as above. Faces of the colour of the image's border (floor texture, shadows, painted lines) are then dropped
     (background.background_faces): most false colour-only faces on noisy renders are such; those much smoother than
     the floor of their hue are kept (background.smooth_faces: an object of the table's hue). (rgbd does not trace
     colour faces: fuse.py.)"""
@@ -251,8 +250,7 @@ def _faint_cut(poly: np.ndarray, sgrads: np.ndarray, min_area_px: float, lines) 
     parts = step_cut(poly, sgrads, min_area_px, lines=lines) if lines is not None else None
     if parts is None and lines is not None:
         # a short faint edge keeps few clear samples; it is taken with 10 when it steps 10 times its control
-        # (a small face of one colour with its neighbour: triangular prism 1002's 509 px face, 10 samples,
-        # a step 89 times its control; docs/perception.md, session 26)
+        # (a small face of one colour beside its neighbour, whose shared edge is short)
         parts = step_cut(poly, sgrads, min_area_px, rel_step=10.0, min_samples=10, lines=lines)
     if parts is None:
         parts = fork_cut(poly, sgrads, min_area_px)
