@@ -190,6 +190,8 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     import grounding
     import jax.numpy as jnp
 
+    from .image_shape import image_shape
+
     grounding.enable_cache()
     k = scene.intrinsics
     intr = (k.fx, k.fy, k.cx, k.cy)
@@ -240,6 +242,8 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
             tilt_l = g["quantities"]["tilt_deg"].tolist()
             dih_l = g["quantities"]["dihedral_deg"].tolist()
             par_l = g["quantities"]["parallel_deg"].tolist()
+            corner_l, corner_sd = g["quantities"]["corner_deg"].tolist(), g["std"]["corner_deg"].tolist()
+            side_l, side_sd = g["quantities"]["side_px"].tolist(), g["std"]["side_px"].tolist()
             # float32 arithmetic, as on the scalars before
             support_l = np.clip(g["conf"]["edge_support"] / grounding.SUPPORT_FULL, 0.0, 1.0).tolist()
             vstd_all = _largest_std(g["vertex_cov"])
@@ -259,6 +263,8 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                     cands.append((SIDE_NAMES[n - 1], (f.id,), c["p_fewer"][i], float(n - 1)))
                 if n == 4:
                     cands.append(("parallelogram", (f.id,), c["p_parallelogram"][i], c["para_dev_deg"][i]))
+                if not has_plane[i] and scene.modality == "rgb":  # colour alone: image-plane shape
+                    cands += image_shape(f.id, corner_l[i][:n], corner_sd[i][:n], side_l[i][:n], side_sd[i][:n])
                 if has_plane[i]:
                     if n == 4:
                         cands.append(("square", (f.id,), c["p_square"][i], c["side_ratio"][i]))

@@ -30,10 +30,15 @@ PREDICATES: dict[str, tuple[int, frozenset[str]]] = {
     "hexagon": (1, frozenset({"rgb", "depth", "rgbd"})),
     # 2D shape of the image polygon
     "parallelogram": (1, frozenset({"rgb", "rgbd"})),
-    # metric shape of the face on its plane (needs depth)
-    "square": (1, frozenset({"depth", "rgbd"})),
-    "rectangle": (1, frozenset({"depth", "rgbd"})),
-    "regular": (1, frozenset({"depth", "rgbd"})),
+    # metric shape of the face on its plane (depth, rgbd); for colour alone, the same tests on the image
+    # polygon: image-plane shape (lv3d.image_shape)
+    "square": (1, frozenset({"rgb", "depth", "rgbd"})),
+    "rectangle": (1, frozenset({"rgb", "depth", "rgbd"})),
+    "regular": (1, frozenset({"rgb", "depth", "rgbd"})),
+    # the kinds of corner of the image polygon (colour alone: lv3d.image_shape)
+    "has_right_angle": (1, frozenset({"rgb"})),
+    "has_acute_angle": (1, frozenset({"rgb"})),
+    "has_obtuse_angle": (1, frozenset({"rgb"})),
     # orientation relative to the support plane (needs depth)
     "horizontal": (1, frozenset({"depth", "rgbd"})),
     "vertical": (1, frozenset({"depth", "rgbd"})),

@@ -17,6 +17,7 @@ from grounding import (ACUTE_BELOW_DEG, EQUAL_CORNERS_DEG, OBTUSE_ABOVE_DEG, PAR
 
 from .errors import InputError
 from .facts import PREDICATES, Fact, SceneFacts, face_id, object_id
+from .image_shape import exact_image_shape
 
 SIDES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
 EQUAL_SIDES_TOL = 0.12     # relative spread of side lengths for square and regular
@@ -66,8 +67,9 @@ def _face_shape(poly_px: np.ndarray, poly_3d: np.ndarray) -> list[str]:
     return out
 
 
-def _exact_facts(truth: dict, k: dict, scene_id: str) -> list[Fact]:
-    """Every fact of the contract that the ground truth supports, confidence 1."""
+def _exact_facts(truth: dict, k: dict, scene_id: str, modality: str = "rgbd") -> list[Fact]:
+    """Every fact of the contract that the ground truth supports, confidence 1; for colour alone the shape
+    facts of the image polygon (lv3d.image_shape) in place of the metric ones."""
     o = object_id(scene_id, 1)
     facts = [Fact("object", (o,), 1.0)]
     up = np.asarray(truth["support_plane"]["normal"], float)
@@ -84,7 +86,10 @@ def _exact_facts(truth: dict, k: dict, scene_id: str) -> list[Fact]:
             facts.append(Fact(SIDES[int(f["sides"])], (fid,), 1.0, float(f["sides"])))
         poly = np.asarray(f["polygon"], float)
         poly3 = _on_plane(poly, n, float(f["plane"]["offset"]), k)
-        facts += [Fact(p, (fid,), 1.0) for p in _face_shape(poly, poly3)]
+        shape = _face_shape(poly, poly3)
+        if modality == "rgb":
+            shape = [p for p in shape if p not in ("square", "rectangle", "regular")] + exact_image_shape(poly)
+        facts += [Fact(p, (fid,), 1.0) for p in shape]
         tilt = _angle_deg(n, up)
         if tilt <= PLANE_ANGLE_DEG:
             facts.append(Fact("horizontal", (fid,), 1.0, tilt))
@@ -144,7 +149,7 @@ def truth_facts(meta: dict, scene_id: str, modality: str, *, perturb: float = 0.
         raise InputError("perturb", f"perturb must lie in [0, 1], got {perturb}")
     try:
         truth, k = meta["truth"], meta["intrinsics"]
-        facts = _exact_facts(truth, k, scene_id)
+        facts = _exact_facts(truth, k, scene_id, modality)
     except (KeyError, TypeError, ValueError, IndexError) as e:
         raise InputError(where, f"ground truth is malformed: {type(e).__name__}: {e}") from None
     scene = SceneFacts(scene_id, modality, facts, object_id(scene_id, 1)).for_modality(modality)

@@ -20,7 +20,7 @@ def test_fact_rejects_unknown_predicates_bad_arity_atoms_and_confidences(bad):
 
 
 def test_modality_filter_hides_depth_facts_from_rgb():
-    sf = SceneFacts("s1", "rgbd", [Fact("square", ("f",), 0.9), Fact("triangle", ("f",), 0.9)])
+    sf = SceneFacts("s1", "rgbd", [Fact("perpendicular", ("f", "g"), 0.9), Fact("triangle", ("f",), 0.9)])
     assert [f.pred for f in sf.for_modality("rgb").facts] == ["triangle"]
     with pytest.raises(InputError):
         sf.for_modality("infrared")

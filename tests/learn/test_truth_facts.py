@@ -42,7 +42,11 @@ def test_cube_faces_are_squares_meeting_at_right_angles():
 def test_modality_keeps_only_its_predicates():
     rgb = atoms(truth_facts(cube_meta(), "s1", "rgb"))
     assert "quadrilateral(s1_o1_f1)" in rgb and "adjacent(s1_o1_f1,s1_o1_f2)" in rgb
-    assert not any(x.startswith(("square", "perpendicular", "horizontal")) for x in rgb)
+    assert not any(x.startswith(("perpendicular", "horizontal")) for x in rgb)
+    # colour alone: the image polygon's shape, a front face a square, a foreshortened top face not
+    assert {"square(s1_o1_f2)", "has_right_angle(s1_o1_f2)", "has_acute_angle(s1_o1_f1)"} <= rgb
+    assert "square(s1_o1_f1)" not in rgb and "has_right_angle(s1_o1_f1)" not in rgb
+    assert not any(x.startswith("has_") for x in atoms(truth_facts(cube_meta(), "s1", "rgbd")))
 
 
 def test_perturb_is_seeded_and_spoils_confidences():
