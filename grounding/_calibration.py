@@ -87,8 +87,9 @@ def calibration_key(pred: str, fewer: bool = False, shared_side_px: float | None
       point on a straight side): ``pred + "_fewer"``. The two kinds of one predicate have different probabilities
       behind them (a pentagon face's own count and a hexagon's count without its weakest corner) and came out
       calibrated in opposite directions on one map.
-    - A fact about two faces (``SHARED_SIDE_PREDS``) that share no side (``shared_side_px`` 0,
-      ``lv3d.describe.shared_side_px``: they touch at a point, or a gap or a spurious corner parts their outlines):
+    - A fact about two faces (``SHARED_SIDE_PREDS``) that share no side (``shared_side_px`` 0, the length in pixels
+      of the longest side their refined polygons have in common: they touch at a point, or a gap or a spurious
+      corner parts their outlines):
       ``pred + "_touch"``. Their errors are of another kind (opposite laterals of a pyramid meeting at its apex are
       no neighbours; a tetrahedron's faces traced apart are), and one map over both kinds would read its
       measurements alike for both."""
@@ -143,7 +144,7 @@ class Calibration:
 
     def calibrate(self, modality: str, pred: str, p: float, x: dict | None = None) -> float:
         """Calibrated probability of one candidate fact with raw probability ``p`` and face measurements ``x``
-        (keys as ``lv3d.describe.calibration_features`` gives them); ``pred``: its calibration key
+        (a dict by measurement name; a name the map reads and ``x`` lacks reads 0); ``pred``: its calibration key
         (:func:`calibration_key`). ``p`` itself where nothing was fitted; 0 stays 0 (a predicate the geometry
         rules out is not revived). Equal to :func:`calibrate_with` on the same maps."""
         key = (modality, pred)
