@@ -62,3 +62,36 @@ def test_malformed_truth_is_an_input_error():
     del meta["truth"]["faces"][0]["plane"]
     with pytest.raises(InputError, match="ground truth is malformed"):
         truth_facts(meta, "s1", "rgbd")
+
+
+def test_logical_vision_concepts_are_learnable_from_colour_alone():
+    # 2D polygons facing the camera, as Logical Vision's scenes: a right-angled triangle and a regular
+    # polygon, each told from the others by image-plane facts alone
+    import numpy as np
+
+    from lv3d.facts import Fact, SceneFacts
+    from lv3d.image_shape import exact_image_shape
+    from lv3d.learn import fit
+
+    def scene(i, poly):
+        o, f = f"p{i}_o1", f"p{i}_o1_f1"
+        sides = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}[len(poly)]
+        facts = [Fact("object", (o,), 1.0), Fact("face_of", (o, f), 1.0), Fact(sides, (f,), 1.0)]
+        facts += [Fact(p, (f,), 1.0) for p in exact_image_shape(np.array(poly, float))]
+        return SceneFacts(f"p{i}", "rgb", facts, o)
+
+    def ngon(n, r=1.0):
+        return [(r * np.cos(2 * np.pi * k / n), r * np.sin(2 * np.pi * k / n)) for k in range(n)]
+
+    polys = {"right": [[(0, 0), (3, 0), (0, 2)], [(0, 0), (2, 0), (0, 2)], [(0, 0), (4, 0), (0, 1)]],
+             "regular": [ngon(3), ngon(5), ngon(6)],
+             "other": [[(0, 0), (4, 0), (1, 3)], [(0, 0), (3, 0), (4, 2), (0, 1)], [(0, 0), (5, 0), (1, 1)]]}
+    scenes, labels = [], []
+    for label, ps in polys.items():
+        for p in ps:
+            scenes.append(scene(len(scenes), p))
+            labels.append(label)
+    right = fit(scenes, labels, "right", settings={"disjunctions": 0})
+    assert "has_right_angle(B)" in right.clauses[0] and right.score["tp"] == 3 and right.score["fp"] == 0
+    regular = fit(scenes, labels, "regular", settings={"disjunctions": 0})
+    assert "regular(B)" in regular.clauses[0] and regular.score["tp"] == 3 and regular.score["fp"] == 0
