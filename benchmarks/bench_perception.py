@@ -35,7 +35,7 @@ from tqdm import tqdm
 
 from lv3d.errors import InputError
 from lv3d.perception import perceive
-from lv3d.perception.cloud import slope_noise
+from lv3d.perception.depth.cloud import slope_noise
 from lv3d.perception.polygons import rasterize
 from lv3d.plane import dihedral_deg
 from lv3d.render import render_scene
@@ -274,7 +274,7 @@ def main(argv=None) -> int:
               f"{' each' if sets else ''} ({time.perf_counter() - t0:.0f} s)")
         noise = [r["depth_noise"] for r in rows[modalities[0]]]
         if noise:
-            print(f"depth noise sigma, in pixel footprints (lv3d.perception.cloud.slope_noise): {min(noise):.2f} to "
+            print(f"depth noise sigma, in pixel footprints (lv3d.perception.depth.cloud.slope_noise): {min(noise):.2f} to "
                   f"{max(noise):.2f}, median {np.median(noise):.2f}")
         print(f"{'modality':8} {'recall':>7} {'prec':>6} {'sides':>6} {'vert_px':>8} {'normal':>7} {'dihedral':>8}"
               f" {'n_dih':>5} {'target':>6}")

@@ -29,7 +29,7 @@ import numpy as np
 from ..rgbd import RGBD
 from ..scene import Face
 from .edges import channel_edges, channels, edge_distance, edge_support
-from .holes import UnreadFace, add_hole_faces
+from .depth.holes import UnreadFace, add_hole_faces
 from .polygons import area, rasterize
 
 # a depth outline lying on colour edges (within edges.edge_support's 2 px) for at least this fraction of its

@@ -13,7 +13,7 @@ from ..scene import Face, Scene, SceneObject
 from .depth import MAX_OBJECTS, DepthObjectResult, DepthResult, depth_scene
 from .boundary import grid_to_pixels
 from .fuse import fused_faces, largest_first
-from .holes import UnreadFace, unread_faces
+from .depth.holes import UnreadFace, unread_faces
 from .polygons import area
 from .rgb import RGBFace, rgb_faces
 

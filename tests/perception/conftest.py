@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from lv3d.camera import Intrinsics
-from lv3d.perception.cloud import PointGrid
+from lv3d.perception.depth.cloud import PointGrid
 from lv3d.render.sampler import look_at
 from lv3d.rgbd import RGBD
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lv3d.perception import perceive
-from lv3d.perception.curved import fan_cylinder
+from lv3d.perception.depth.curved import fan_cylinder
 from tests.conftest import REAL_DIR
 
 

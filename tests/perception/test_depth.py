@@ -1,10 +1,10 @@
 import numpy as np
 
-from lv3d.perception.cloud import crop_normals, point_grid, remove_flying, slope_noise
+from lv3d.perception.depth.cloud import crop_normals, point_grid, remove_flying, slope_noise
 from lv3d.perception.depth import depth_scene
-from lv3d.perception.objects import heavy_noise, segment_objects, support_band
-from lv3d.perception.planes import outward_normal
-from lv3d.perception.support import support_plane
+from lv3d.perception.depth.objects import heavy_noise, segment_objects, support_band
+from lv3d.perception.depth.planes import outward_normal
+from lv3d.perception.depth.support import support_plane
 from lv3d.plane import dihedral_deg
 
 from .conftest import box_on_table, cell_grid

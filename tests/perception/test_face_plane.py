@@ -1,10 +1,10 @@
 import numpy as np
 
 from lv3d.perception.boundary import grow_convex
-from lv3d.perception.cloud import point_grid
-from lv3d.perception.depth import _support
-from lv3d.perception.face_plane import angle_deg, fit_face_plane, polygon_cells
-from lv3d.perception.objects import support_band
+from lv3d.perception.depth.cloud import point_grid
+from lv3d.perception.depth.stage import _support
+from lv3d.perception.depth.face_plane import angle_deg, fit_face_plane, polygon_cells
+from lv3d.perception.depth.objects import support_band
 from lv3d.perception.polygons import area
 from lv3d.plane import Plane
 
@@ -77,7 +77,7 @@ def test_grow_convex_moves_every_side_outward():
 
 def test_a_face_seen_edge_on_stays_with_its_object():
     from lv3d.camera import Intrinsics
-    from lv3d.perception.objects import segment_objects
+    from lv3d.perception.depth.objects import segment_objects
 
     k = Intrinsics(200, 200, 79.5, 59.5, 160, 120)
     depth = np.zeros((120, 160), np.float32)

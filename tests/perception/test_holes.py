@@ -2,7 +2,7 @@ import cv2
 import numpy as np
 
 from lv3d.perception.edges import channel_edges, channels, edge_distance
-from lv3d.perception.holes import hole_faces, hole_sizes
+from lv3d.perception.depth.holes import hole_faces, hole_sizes
 from lv3d.perception.polygons import rasterize
 
 from .conftest import mask_iou as _iou
@@ -69,7 +69,7 @@ def _frame_and_object():
 
 
 def test_hole_face_is_added_as_a_colour_face_and_neighbour_of_the_face_it_touches():
-    from lv3d.perception.holes import add_hole_faces
+    from lv3d.perception.depth.holes import add_hole_faces
     from lv3d.scene import Face
 
     frame, obj = _frame_and_object()
@@ -83,7 +83,7 @@ def test_hole_face_is_added_as_a_colour_face_and_neighbour_of_the_face_it_touche
 
 
 def test_a_hole_a_face_covers_already_adds_nothing():
-    from lv3d.perception.holes import add_hole_faces
+    from lv3d.perception.depth.holes import add_hole_faces
     from lv3d.scene import Face
 
     frame, obj = _frame_and_object()
@@ -94,7 +94,7 @@ def test_a_hole_a_face_covers_already_adds_nothing():
 
 
 def test_unread_face_in_rgbd_needs_colour_edges_beyond_the_object_side_and_comes_before_colour():
-    from lv3d.perception.holes import UnreadFace, add_hole_faces
+    from lv3d.perception.depth.holes import UnreadFace, add_hole_faces
     from lv3d.plane import Plane
     from lv3d.scene import Face
 
@@ -112,7 +112,7 @@ def test_unread_face_in_rgbd_needs_colour_edges_beyond_the_object_side_and_comes
 
 
 def test_a_hole_that_is_the_unread_rest_of_a_grazing_face_extends_it():
-    from lv3d.perception.holes import add_hole_faces
+    from lv3d.perception.depth.holes import add_hole_faces
     from lv3d.plane import Plane
     from lv3d.scene import Face
 
@@ -163,7 +163,7 @@ def _unread(frame, **checks) -> list:
     """holes.unread_faces beside the largest depth object of ``frame``."""
     from lv3d.perception.boundary import grid_to_pixels
     from lv3d.perception.depth import depth_scene
-    from lv3d.perception.holes import unread_faces
+    from lv3d.perception.depth.holes import unread_faces
 
     dres = depth_scene(frame)
     o = dres.objects[0]

@@ -2,10 +2,10 @@
 
 import numpy as np
 
-from lv3d.perception.objects import DepthObject
-from lv3d.perception.occlusion import join_occluded
-from lv3d.perception.planes import DepthPlane
-from lv3d.perception.support import refine
+from lv3d.perception.depth.objects import DepthObject
+from lv3d.perception.depth.occlusion import join_occluded
+from lv3d.perception.depth.planes import DepthPlane
+from lv3d.perception.depth.support import refine
 
 
 def _grid(z_between: float):

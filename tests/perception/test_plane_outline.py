@@ -1,8 +1,8 @@
 import numpy as np
 
 from lv3d.camera import Intrinsics
-from lv3d.perception.plane_outline import lift, simplify_on_plane
-from lv3d.perception.snap import add_triple_corners
+from lv3d.perception.depth.plane_outline import lift, simplify_on_plane
+from lv3d.perception.depth.snap import add_triple_corners
 from lv3d.plane import Plane
 
 K = Intrinsics(fx=500.0, fy=500.0, cx=320.0, cy=240.0, width=640, height=480)

@@ -1,7 +1,7 @@
 import numpy as np
 
-from lv3d.perception.planes import DepthPlane, merge_strips, object_planes
-from lv3d.perception.support import refine
+from lv3d.perception.depth.planes import DepthPlane, merge_strips, object_planes
+from lv3d.perception.depth.support import refine
 from lv3d.plane import Plane
 
 from .conftest import cell_grid

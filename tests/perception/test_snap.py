@@ -1,7 +1,7 @@
 import numpy as np
 
 from lv3d.camera import Intrinsics
-from lv3d.perception.snap import snap_polygon
+from lv3d.perception.depth.snap import snap_polygon
 from lv3d.plane import Plane
 from lv3d.scene import Face, Scene, SceneObject
 

@@ -6,7 +6,7 @@ import pytest
 
 from lv3d.errors import InputError
 from lv3d.perception import perceive
-from lv3d.perception.objects import _split_by_height
+from lv3d.perception.depth.objects import _split_by_height
 from lv3d.render import CLASSES, noise_config, render_scene
 
 

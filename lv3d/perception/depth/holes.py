@@ -27,14 +27,14 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from ..plane import Plane
-from ..rgbd import RGBD
-from ..scene import Face
-from .boundary import grow_convex
+from ...plane import Plane
+from ...rgbd import RGBD
+from ...scene import Face
+from ..boundary import grow_convex
 from .cloud import PointGrid
-from .edges import edge_support
+from ..edges import edge_support
 from .face_plane import angle_deg
-from .polygons import area, clockwise, drop_short_sides, rasterize
+from ..polygons import area, clockwise, drop_short_sides, rasterize
 from .support import noise_threshold, ransac_plane
 
 

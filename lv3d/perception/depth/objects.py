@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from ..plane import Plane
+from ...plane import Plane
 from .cloud import PointGrid
 from .support import noise_threshold
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..camera import Intrinsics
-from ..plane import Plane
-from .polygons import clockwise, drop_short_sides, simplify
+from ...camera import Intrinsics
+from ...plane import Plane
+from ..polygons import clockwise, drop_short_sides, simplify
 from .snap import cross3
 
 # a ray this close to lying in the plane (|cos| of its angle to the normal) lifts to a point whose place is

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..plane import Plane
+from ...plane import Plane
 from .cloud import PointGrid, crop_normals
 from .support import noise_threshold, ransac_plane, refine
 

@@ -12,7 +12,7 @@ import cv2
 import numpy as np
 from matplotlib.path import Path
 
-from ..plane import Plane
+from ...plane import Plane
 
 
 def refine(points: np.ndarray) -> Plane:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..cylinder import Cylinder
+from ...cylinder import Cylinder
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from ..plane import Plane
+from ...plane import Plane
 from .cloud import PointGrid
 from .support import noise_threshold, ransac_plane, refine
 

@@ -13,9 +13,9 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from ..camera import Intrinsics
-from ..plane import Plane
-from .polygons import area, clockwise
+from ...camera import Intrinsics
+from ...plane import Plane
+from ..polygons import area, clockwise
 
 _Line = tuple[np.ndarray, np.ndarray]  # (point, unit direction) in pixels
 

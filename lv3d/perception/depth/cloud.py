@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..camera import Intrinsics
+from ...camera import Intrinsics
 
 
 @dataclass(frozen=True)
