@@ -101,6 +101,8 @@ metarule(part,      [P,Q,R],   [P,A],   [[Q,A,B],[R,B]]).                 % P(A)
 metarule(part2,     [P,Q,R,S], [P,A],   [[Q,A,B],[R,B],[S,B]]).           % P(A) :- Q(A,B), R(B), S(B)
 metarule(part_and,  [P,Q,R,S], [P,A],   [[Q,A,B],[R,B],[S,A]]).           % P(A) :- Q(A,B), R(B), S(A)
 metarule(part_pair, [P,Q,R,S,T], [P,A], [[Q,A,B],[R,B],[S,B,C],[T,C]]).   % P(A) :- Q(A,B), R(B), S(B,C), T(C)
+metarule(has,       [P,Q],     [P,A],   [[Q,A,_]]).                       % P(A) :- Q(A,_)  a relation to something
+metarule(part_rel,  [P,Q,R],   [P,A],   [[Q,A,B],[R,A,B]]).               % P(A) :- Q(A,B), R(A,B)  two relations to one part
 
 %!  settings(+Given, -Settings) is det.
 %   Given first, then the defaults of the options it does not set; max_inventions(auto) becomes

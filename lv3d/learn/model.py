@@ -47,15 +47,15 @@ BODY_ORDER = ("face_of", "triangle", "quadrilateral", "pentagon", "hexagon", "sq
 EXCLUDED = ("object", "horizontal", "vertical")
 
 
-def body_preds(modality: str) -> list[tuple[str, int]]:
+def body_preds(modality: str, derived: bool = True) -> list[tuple[str, int]]:
     """The body predicates a system seeing ``modality`` learns with, in search order: the contract's
-    (but object/1, true of every target) and the derived ones of prolog/shape_bk.pl whose facts the
-    modality emits."""
+    (but object/1, true of every target) and, with ``derived``, the derived ones of prolog/shape_bk.pl
+    whose facts the modality emits."""
     own = [(p, a) for p, (a, mods) in PREDICATES.items() if modality in mods and p not in EXCLUDED]
     seen = {p for p, (_, mods) in PREDICATES.items() if modality in mods}
     uses = engine.derived_uses()
     # a derived predicate whose rule rests on a fact the modality never emits can never be proved
-    preds = own + [(p, a) for p, a in engine.derived_preds() if uses.get(p, frozenset()) <= seen]
+    preds = own + [(p, a) for p, a in engine.derived_preds() if derived and uses.get(p, frozenset()) <= seen]
     rank = {p: i for i, p in enumerate(BODY_ORDER)}
     return sorted(preds, key=lambda pa: rank.get(pa[0], len(rank)))
 
@@ -107,7 +107,7 @@ def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: d
         raise InputError("labels", f"no scene is labelled {target!r}")
     opts = {**SHAPE_SETTINGS, **check_settings(settings), "seed": int(seed)}
     label, target = target, predicate_name(target)
-    preds = engine.plist(f"{p}/{a}" for p, a in body_preds(modality))
+    preds = engine.plist(f"{p}/{a}" for p, a in body_preds(modality, opts.pop("derived", True)))
     mrs = engine.plist(opts.pop("metarules", SHAPE_METARULES))
     goal = (f"{_load(FIT_MODULE, scenes)}, "
             f"lv3d_bridge:fit({FIT_MODULE}, {target}, {preds}, {mrs}, {engine.plist(pos)}, {engine.plist(neg)}, "
@@ -194,7 +194,7 @@ class Model:
         progs = engine.plist(f"{p.target}-{engine.plist(engine.quote(c) for c in p.clauses)}"
                              for p in self.programs.values())
         preds = engine.plist(f"{p}/{a}" for p, a in body_preds(scene.modality))
-        opts = {k: v for k, v in {**SHAPE_SETTINGS, **self.settings}.items() if k != "metarules"}
+        opts = {k: v for k, v in {**SHAPE_SETTINGS, **self.settings}.items() if k not in ("metarules", "derived")}
         thr = self._thresholds(opts)
         # every program proves it when near, missing facts at NEAR_MISS each
         opts["threshold"] = 0.0 if near else min(thr.values(), default=0.5)

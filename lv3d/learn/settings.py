@@ -11,7 +11,7 @@ from ..errors import InputError
 
 # the metarules of prolog/mil.pl (metarule/4) a shape learner may name
 METARULES = ("ident", "inverse", "precon", "postcon", "chain", "tailrec", "base", "conj", "part", "part2",
-             "part_and", "part_pair")
+             "part_and", "part_pair", "has", "part_rel")
 COMBINE = ("product", "min")
 BIG = 10 ** 6
 
@@ -43,6 +43,7 @@ SETTINGS: dict[str, tuple] = {
     "predicate_prior": ("priors", 0, 100, "[[predicate, nats], ...]"),
     "seed": ("int", 0, 2 ** 32 - 1, "random seed (a study sets it per task)"),
     "metarules": ("metarules", None, None, "metarules, in search order"),
+    "derived": ("bool", None, None, "shape learning: offer prolog/shape_bk.pl's derived predicates"),
 }
 
 
