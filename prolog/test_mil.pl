@@ -4,6 +4,7 @@
 :- use_module(library(plunit)).
 :- use_module(mil).
 :- use_module(mil_task).
+:- use_module(mil_safe).
 :- use_module(shape_bk).
 
 % two objects with faces; confidences as a last argument, as lv3d_bridge:load_scene/3 stores them
@@ -90,6 +91,66 @@ test(task_file_learned, [nondet]) :-
     length(Cs, 3), memberchk((odd(X) :- prev(X, Y), even(Y)), Cs).
 
 :- end_tests(mil).
+
+:- begin_tests(mil_task).
+
+% a Metagol example file, unchanged in form: the directive loads Metagol, metarule/3, a goal clause
+metagol_file(File) :-
+    tmp_file_stream(text, File, S),
+    format(S, ":- use_module('../metagol').~n", []),
+    format(S, "body_pred(mother/2).~nbody_pred(father/2).~n", []),
+    format(S, "metarule([P,Q], [P,A,B], [[Q,A,B]]).~nmetarule([P,Q,R], [P,A,B], [[Q,A,C],[R,C,B]]).~n", []),
+    format(S, "mother(ann,amy). mother(amy,amelia). father(steve,amy). father(gavin,amelia).~n", []),
+    format(S, "a :- Pos = [gp(ann,amelia), gp(steve,amelia)], learn(Pos, [gp(amy,amelia)]).~n", []),
+    close(S).
+
+test(metagol_file_read_as_data) :-
+    metagol_file(File),
+    read_task_file(File, task_test, TF),
+    task_goals(TF, [a-a]),
+    goal_call(TF, a, 5, Call),
+    Call == learn([gp(ann,amelia), gp(steve,amelia)], [gp(amy,amelia)]),
+    learn_call(TF, Call, [], exact, program(Cs)),
+    program_text(Cs, ['gp(A,B):-mother(A,C),mother(C,B).', 'gp(A,B):-father(A,C),mother(C,B).']).
+
+test(unsafe_clause_refused, [throws(mil_error(task(_, Msg)))]) :-
+    tmp_file_stream(text, File, S),
+    format(S, "body_pred(p/1).~nmetarules([base]).~np(X) :- shell(X).~npos(t(a)).~n", []), close(S),
+    catch(read_task_file(File, task_test, _), mil_error(task(F, Msg)), true),
+    sub_atom(Msg, _, _, _, 'line 3: clause p/1 calls shell/1'),
+    throw(mil_error(task(F, Msg))).
+
+test(confidence_facts_declared) :-
+    tmp_file_stream(text, File, S),
+    format(S, "body_pred(p/1).~nmetarules([base]).~n0.4::p(a).~np(b).~npos(t(b)).~n", []), close(S),
+    read_task_file(File, task_test, _),
+    task_test:'$mil_fact'(p, 1, Store),
+    G1 =.. [Store, a, C1], call(task_test:G1), C1 =:= 0.4,
+    G2 =.. [Store, b, C2], call(task_test:G2), C2 =:= 1.0.
+
+:- end_tests(mil_task).
+
+:- begin_tests(mil_safe).
+
+where(M, where(test, 1, 'clause p/1', M, bk)).
+
+test(variable_goal_checked_when_called) :-
+    where(safe_test, W),
+    check_clause((p(G) :- call(G)), W, (p(_) :- C), []),
+    C = mil_safe:checked_call(safe_test, _).
+
+test(safe_closure_kept) :-
+    where(safe_test, W),
+    check_clause((p(L) :- maplist(succ, L, _)), W, (p(_) :- maplist(succ, _, _)), []).
+
+test(runtime_goal_refused, [throws(mil_error(unsafe_call(_)))]) :-
+    checked_call(safe_test, halt).
+
+test(catch_refused, [throws(mil_error(task(test, _)))]) :-
+    where(safe_test, W),
+    check_clause((p(X) :- catch(q(X), _, true)), W, _, _).
+
+:- end_tests(mil_safe).
 
 % the shape background's derived rules, seen from bk as a scene module sees them
 bk_module(task(_, Ts, BPs, MRs, P, N), task(bk, Ts, BPs, MRs, P, N)) :-
