@@ -1,6 +1,6 @@
 import numpy as np
 
-from lv3d.perception.background import (background_faces, border_chromaticity, chromaticity, face_chromaticity,
+from lv3d.perception.rgb.background import (background_faces, border_chromaticity, chromaticity, face_chromaticity,
                                         log_gradient, smooth_faces)
 from lv3d.perception.polygons import rasterize
 from lv3d.perception.rgb import rgb_faces

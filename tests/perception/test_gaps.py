@@ -1,9 +1,9 @@
 import cv2
 import numpy as np
 
-from lv3d.perception.gaps import close_gaps
+from lv3d.perception.rgb.gaps import close_gaps
 from lv3d.perception.rgb import rgb_faces
-from lv3d.perception.step_edge import smoothed_gradients
+from lv3d.perception.rgb.step_edge import smoothed_gradients
 
 
 def _grads(img: np.ndarray) -> np.ndarray:

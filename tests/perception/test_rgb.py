@@ -1,7 +1,7 @@
 import cv2
 import numpy as np
 
-from lv3d.perception import rgb
+from lv3d.perception.rgb import stage as rgb
 from lv3d.perception.polygons import rasterize
 from lv3d.perception.rgb import rgb_faces
 
@@ -51,7 +51,7 @@ def test_plain_image_has_no_face():
 
 def test_traced_part_keeps_the_traced_bends_between_outline_corners():
     from lv3d.perception.polygons import clockwise
-    from lv3d.perception.rgb import _traced_part
+    from lv3d.perception.rgb.stage import _traced_part
 
     # a wide face and a thin one merged: the bend at (104, 50) was simplified away from the merged outline,
     # which is cut along its diagonal a-c as the split functions cut (runs of the outline's corners)

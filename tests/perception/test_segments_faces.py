@@ -1,8 +1,8 @@
 import numpy as np
 
-from lv3d.perception.faces import PlanarGraph, bounded_faces, build_graph, planarize, prune
+from lv3d.perception.rgb.faces import PlanarGraph, bounded_faces, build_graph, planarize, prune
 from lv3d.perception.polygons import signed_area
-from lv3d.perception.segments import merge_collinear, union_find_labels
+from lv3d.perception.rgb.segments import merge_collinear, union_find_labels
 
 
 def test_merge_collinear_joins_pieces_of_one_edge():

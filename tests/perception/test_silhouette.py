@@ -2,7 +2,7 @@ import cv2
 import numpy as np
 
 from lv3d.perception.rgb import rgb_faces
-from lv3d.perception.silhouette import foreground, regions_of, silhouette_segments, snap_to_edges
+from lv3d.perception.rgb.silhouette import foreground, regions_of, silhouette_segments, snap_to_edges
 
 TAN = (170, 135, 90)
 PURPLE = (120, 70, 140)

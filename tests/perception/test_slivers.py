@@ -3,10 +3,11 @@ cut along an image edge kept apart."""
 import cv2
 import numpy as np
 
-from lv3d.perception.faces import bounded_faces, build_graph
+from lv3d.perception.rgb.faces import bounded_faces, build_graph
 from lv3d.perception.polygons import area, clockwise, simplify
-from lv3d.perception.rgb import _join_on_graph_edges, _join_thin_to_traced, rgb_faces
-from lv3d.perception.split import split_by_diagonal
+from lv3d.perception.rgb import rgb_faces
+from lv3d.perception.rgb.stage import _join_on_graph_edges, _join_thin_to_traced
+from lv3d.perception.rgb.split import split_by_diagonal
 
 # a face seen edge-on: a quadrilateral 10 px wide whose corners turn by a few degrees, traced with a vertex more
 SLIVER = np.array([[0.0, 0.0], [50.0, 4.1], [100.0, 8.0], [200.0, 0.0], [100.0, -2.0]])

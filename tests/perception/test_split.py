@@ -3,7 +3,7 @@ import numpy as np
 
 from lv3d.perception.polygons import area, drop_short_sides
 from lv3d.perception.edges import channel_edges
-from lv3d.perception.split import (_diagonal_samples, _mean_clear_of_outline, reflex_corners, split_by_diagonal,
+from lv3d.perception.rgb.split import (_diagonal_samples, _mean_clear_of_outline, reflex_corners, split_by_diagonal,
                                    split_concave)
 
 

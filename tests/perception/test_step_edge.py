@@ -2,7 +2,7 @@ import cv2
 import numpy as np
 
 from lv3d.perception.polygons import area
-from lv3d.perception.step_edge import fork_cut, side_cut, smoothed_gradients, step_cut, step_lines
+from lv3d.perception.rgb.step_edge import fork_cut, side_cut, smoothed_gradients, step_cut, step_lines
 
 # a cube's top and front faces traced as one outline: their shared edge runs from the outline's corner (40, 80)
 # to a point in the middle of its right side, (160, 80), not to a corner

@@ -3,7 +3,7 @@ import numpy as np
 
 from lv3d.perception.edges import channel_edges, channels, edge_distance
 from lv3d.perception.polygons import rasterize
-from lv3d.perception.thin import thin_faces
+from lv3d.perception.rgb.thin import thin_faces
 
 from .conftest import B, C, F, F2, FRONT, SLIVER, TOP, mask_iou
 from .conftest import sliver_box as _image

@@ -3,8 +3,8 @@ import numpy as np
 
 from lv3d.perception.edges import channel_edges, channels, edge_distance
 from lv3d.perception.polygons import rasterize
-from lv3d.perception.silhouette import foreground
-from lv3d.perception.untraced import untraced_faces
+from lv3d.perception.rgb.silhouette import foreground
+from lv3d.perception.rgb.untraced import untraced_faces
 
 from .conftest import A, B, C, D, E, F, F2, FRONT, SLIVER, TOP
 from .conftest import mask_iou

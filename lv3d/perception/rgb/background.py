@@ -16,7 +16,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .polygons import rasterize
+from ..polygons import rasterize
 
 
 def chromaticity(color: np.ndarray) -> np.ndarray:

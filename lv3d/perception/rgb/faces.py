@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .polygons import signed_area
+from ..polygons import signed_area
 from .segments import union_find_labels
 
 

@@ -13,7 +13,7 @@ import functools
 import cv2
 import numpy as np
 
-from .polygons import area, outline_distance, pixel_values, signed_area
+from ..polygons import area, outline_distance, pixel_values, signed_area
 
 
 def reflex_corners(poly: np.ndarray, tol_deg: float = 4.0) -> list[int]:

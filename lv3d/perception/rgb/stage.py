@@ -11,10 +11,10 @@ import cv2
 import numpy as np
 
 from .background import background_faces, chromaticity, face_chromaticity, log_gradient, smooth_faces
-from .edges import channel_edges, channels, edge_distance, edge_support
+from ..edges import channel_edges, channels, edge_distance, edge_support
 from .faces import bounded_faces, build_graph
 from .gaps import close_gaps
-from .polygons import (KEEP_AREA, area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
+from ..polygons import (KEEP_AREA, area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
                        sample_boundary, simplify)
 from .segments import detect_color_segments, union_find_labels
 from .silhouette import foreground, regions_of, silhouette_segments

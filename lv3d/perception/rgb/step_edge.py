@@ -12,7 +12,7 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from .polygons import area
+from ..polygons import area
 from .split import reflex_corners
 
 

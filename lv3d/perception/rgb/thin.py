@@ -14,8 +14,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .edges import edge_distance, edge_support
-from .polygons import (area, clockwise, distance_to_segments, is_simple, mean_width, pixel_values, rasterize,
+from ..edges import edge_distance, edge_support
+from ..polygons import (area, clockwise, distance_to_segments, is_simple, mean_width, pixel_values, rasterize,
                        sample_boundary)
 
 

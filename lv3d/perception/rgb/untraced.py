@@ -14,9 +14,9 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .boundary import grow_convex
-from .edges import edge_support
-from .polygons import area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, rasterize, simplify
+from ..boundary import grow_convex
+from ..edges import edge_support
+from ..polygons import area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, rasterize, simplify
 from .split import reflex_corners
 from .thin import outline_distance_map
 
