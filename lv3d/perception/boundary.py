@@ -32,8 +32,7 @@ def mask_polygon(grid_mask: np.ndarray, stride: int, image_shape: tuple[int, int
     if len(approx) < 3:
         return None
     # a face seen edge-on is a lens whose corners lie a few px off their neighbours' chord and turn by little, yet
-    # hold much of its area: pentagonal prism 1007's end (clean dev seed 1000) lost two of five and half its area
-    # (docs/perception.md, session 27)
+    # hold much of its area: simplifying on the chord alone drops corners that carry half a face
     poly = simplify(approx.astype(np.float64), keep_area_frac=KEEP_AREA)
     if convex and len(poly) >= 3:
         # the contour runs through the outermost samples' pixels; each sample stands for a stride x stride

@@ -96,8 +96,8 @@ def _object_pixels(o: DepthObjectResult, stride: int) -> tuple[int, tuple[float,
 
 
 def _depth_object(scene_id: str, k: int, o: DepthObjectResult, dres: DepthResult, frame: RGBD) -> SceneObject:
-    """The object's planes as faces, and the faces beside it that depth did not read (holes.unread_faces: on
-    realsense renders most faces depth alone missed had no reading at all, docs/perception.md)."""
+    """The object's planes and cylindrical faces as faces, and the faces beside it that depth did not read
+    (holes.unread_faces: a face seen beyond the sensor's grazing angle has no reading at all)."""
     stride = dres.grid.stride
     faces, index = [], {}
     for i, (p, poly) in enumerate(zip(o.planes, o.polygons)):

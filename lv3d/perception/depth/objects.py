@@ -63,9 +63,8 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     over the focal length). Where noise alone makes jumps over ``rel_jump`` (``jump_sigmas`` standard deviations
     of the difference of two readings), jumps are measured on a 3x3 median of the depth instead, which keeps
     steps and has 0.41 of the noise, against the larger of ``rel_jump`` and ``jump_sigmas`` of that (0.45 taken,
-    on the safe side). Why: under heavy noise (sigma = 0.008 z^2) noise cut the full grid into pieces and objects
-    fell apart (docs/perception.md, sessions 25 and 26); at the noise of the presets up to ``realsense`` nothing
-    changes."""
+    on the safe side). Why: under heavy noise (sigma = 0.008 z^2) noise alone cuts the full grid into pieces and
+    objects fall apart; at the noise of consumer sensors nothing changes."""
     valid = grid.valid
     if support is not None:
         h_above = np.where(valid, grid.xyz @ support.n.astype(np.float32) + np.float32(support.offset), 0)

@@ -40,7 +40,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     """Planes of the object whose grid cells are ``obj_mask`` (h, w) bool, largest first. A plane needs at least
     ``max(min_points, min(min_frac * object size, max_need))`` points in one connected piece: a share of the object
     keeps strips and noise out (depth.py asks more under heavy depth noise), and ``max_need`` lets a large object's
-    small face in (hexagonal prism 2003's 2179 px side is 4.4% of its 47690 cells; docs/perception.md, session 27).
+    small face in (the side of a large prism can be under 5 % of its cells).
     A sample whose plane is too small a piece sets its points aside and the search goes on, ``max_misses`` times
     at most: a curved surface beside the object's planes (a can, a drill, in clutter) must not end the search
     before the planes behind it are found. ``normals``: the object's normals on its bounding box of the grid, as
@@ -56,9 +56,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     nrm_grid = grid.normals[i0:i1, j0:j1] if normals is None else normals
     if not nrm_grid.any():
         # from the object's points alone: along its silhouette, normals mixed with the table's points agree with
-        # none of its faces, and the score below gave a face's silhouette strip to its neighbour (tetrahedron 1005,
-        # clean dev seed 1000: the side's outline took in a wedge of the next face, IoU 0.43; docs/perception.md,
-        # session 27)
+        # none of its faces, and the score below would give a face's silhouette strip to its neighbour
         nrm_grid = crop_normals(grid, i0, j0, i1, j1, within=obj_mask)
     nrm = nrm_grid[box].astype(np.float64)
     if len(pts) < min_points:
@@ -127,9 +125,8 @@ def merge_strips(planes: list[DepthPlane], dist_m: float, max_median: float = 0.
     Why: along a silhouette the grid normals mix in the background, so a strip of a face two or three cells
     wide fails the normal test of its face's plane and is peeled off as a plane of its own. Across so narrow a
     strip the depth noise barely constrains a tilt, and the flying pixels on its outer side tilt the fit by
-    17-58 deg on dev scenes: a false edge with a false dihedral (docs/grounding.md, session 9). A true
-    neighbouring face leaves its points far from the other plane (median >= 1.2 ``dist_m`` on dev scenes), a
-    strip of the same face within 0.4. Pieces are taken smallest first, each once, into the largest plane that
+    tens of degrees: a false edge with a false dihedral. A true neighbouring face leaves its points far from the
+    other plane (median above the inlier distance), a strip of the same face within half of it. Pieces are taken smallest first, each once, into the largest plane that
     takes it."""
     planes = list(planes)
     for small in sorted(planes, key=lambda p: len(p.points)):
@@ -199,8 +196,8 @@ def _holds_face(far: np.ndarray, n: int, dist_m: float, others: list[Plane], min
 
     Why: a thin triangle seen edge-on (2.5-3 px wide) is too narrow for a plane of its own; depth peels it off
     together with the silhouette strip of its neighbour, and most of that piece lies on the neighbour's plane.
-    On clean dev renders its off-plane points fit a plane within 0.00 inlier distances, a silhouette strip's
-    flying pixels 0.11-0.38 on noisy ones; so noisy depth merges both, as before (docs/perception.md, session 10)."""
+    On clean depth its off-plane points fit a plane almost exactly, a silhouette strip's flying pixels to a tenth
+    of an inlier distance or more; so under noise both are merged."""
     if len(far) < max(min_far, min_share * n):
         return False
     p = refine(far.astype(np.float64))
