@@ -520,11 +520,19 @@ def _one_core() -> None:
 
 
 def write_overlay(path: Path, frame, scene, labels: list, label_img: np.ndarray | None) -> None:
-    """What perception found (lv3d's overlay: each object's faces) with the truth over it: ground-truth mask
-    outlines in white where the frame has masks, and each labelled pixel as a white ring."""
+    """What perception found (lv3d's overlay: each object's faces; each object's segment outlined in a colour of
+    its own) with the truth over it: ground-truth mask outlines in white where the frame has masks, and each
+    labelled pixel as a white ring."""
     from lv3d.perception.overlay import draw_overlay
 
     img = draw_overlay(frame.color, scene)
+    for k, o in enumerate(scene.objects):  # each object's segment outlined in a colour of its own
+        if o.mask is None:
+            continue
+        hue = int(179 * ((k * 0.618034) % 1.0))
+        colour = cv2.cvtColor(np.uint8([[[hue, 255, 255]]]), cv2.COLOR_HSV2RGB)[0, 0].tolist()
+        cnts, _ = cv2.findContours(o.mask.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+        cv2.drawContours(img, cnts, -1, colour, 3)
     if label_img is not None:
         for gid in np.unique(label_img):
             if gid == 0:
