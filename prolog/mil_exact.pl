@@ -40,7 +40,7 @@ size(Settings, X0, X) :-
     ;   between(1, ML, L), between(Min, MC, N), N =< L
     ),
     signature(X0, N, Sig),
-    set_maxn_of_ctx(N, X0, X1), set_maxl_of_ctx(L, X1, X2), set_sig_of_ctx(Sig, X2, X).
+    set_maxn_of_ctx(N, X0, X1), set_maxl_of_ctx(L, X1, X2), with_sig(Sig, X2, X).
 
 %!  exact_size(+Ctx, +Prog) is semidet.
 %   With a literal bound, Prog has exactly the round's clauses and literals; else any size.

@@ -45,7 +45,7 @@
                        ctx_bk/2, ctx_mm/2, ctx_targets/2, ctx_bps/2, ctx_threshold/2, ctx_combine/2,
                        ctx_inventions/2, ctx_maxn/2, ctx_maxl/2, ctx_miss/2, ctx_trace/2, ctx_sig/2,
                        ctx_depth/2, ctx_functional/2,
-                       set_maxn_of_ctx/3, set_maxl_of_ctx/3, set_sig_of_ctx/3, set_threshold_of_ctx/3,
+                       set_maxn_of_ctx/3, set_maxl_of_ctx/3, with_sig/3, set_threshold_of_ctx/3,
                        set_miss_of_ctx/3, set_trace_of_ctx/3
                      ]).
 :- use_module(library(lists)).
@@ -62,7 +62,7 @@
 %   check; trace: record proofs.
 :- record ctx(bk=user, mm=user, targets=[], bps=[], heads=[], depth=inf,
               threshold=0.0, combine=product, inventions=0, maxn=1, maxl=inf, miss=0, sig=none,
-              functional=false, trace=false).
+              after=[], functional=false, trace=false).
 
 %   The tables, in module BK$mil (filled by task_ctx/3, so that the interpreter looks things up by
 %   first-argument indexing):
@@ -274,6 +274,8 @@ program_lit(L, X, Sig1, Path, D, P0, P, N0, N, C0, C, T0, T) :-
         select_lower(Q, A, X, Sig1, Sig2),
         (   ctx_trace(X, true)
         ->  nth1(I, P0, Item), length(P0, NP), IC is NP - I + 1, T0 = [clause(IC)|T1]
+        ;   P0 = [sub(_, _, _, _, _)|_]
+        ->  Item = sub(_, Q, A, _, _), member(Item, P0), T1 = T0       % only the symbol's own items
         ;   member(Item, P0), T1 = T0
         ),
         item_instance(Item, X, L, Body, Rec),
@@ -320,20 +322,33 @@ new_metasub(Name, Q, A, Subs, Prog) :-
 select_lower(Q, A, X, Sig1, Sig2) :-
     ctx_sig(X, Full),
     (   Full == none -> Sig2 = none
-    ;   nonvar(Q) -> after(Full, Q, A, Sig2)
-    ;   lower_used(Sig1, Q, A, Rest, U), lower_rest(U, Full, Q, A, Rest, Sig2)
+    ;   nonvar(Q) -> after(X, Full, Q, A, Sig2)
+    ;   lower_used(Sig1, Q, A, Rest, U), lower_rest(U, X, Full, Q, A, Rest, Sig2)
     ).
 
 %   After a target taken for an open symbol, the same symbols as for its own clauses.
-lower_rest(U, Full, Q, A, Rest, Sig2) :-
-    (   U == target -> after(Full, Q, A, Sig2) ; Sig2 = Rest ).
+lower_rest(U, X, Full, Q, A, Rest, Sig2) :-
+    (   U == target -> after(X, Full, Q, A, Sig2) ; Sig2 = Rest ).
 
-after(Full, Q, A, Sig2) :-
-    append(Before, [sym(Q, A, U)|After], Full), !,
-    (   U == target, include(target_sym, Full, [_, _|_])
-    ->  include(target_sym, Before, Ts), append(Ts, After, Sig2)
+after(X, _, Q, A, Sig2) :-
+    ctx_after(X, Table),
+    memberchk(a(Q, A, Sig2), Table).
+
+%!  with_sig(+Sig, +Ctx0, -Ctx) is det.  Ctx with the signature Sig and its table of what follows each
+%   symbol: a(Symbol, Arity, Symbols a clause of it may name), the variables shared with Sig.
+with_sig(Sig, X0, X) :-
+    ctx_targets(X0, Ts),
+    (   Ts = [_, _|_] -> Multi = true ; Multi = false ),
+    sig_table(Sig, [], Multi, Table),
+    set_sig_of_ctx(Sig, X0, X1), set_after_of_ctx(Table, X1, X).
+
+sig_table([], _, _, []).
+sig_table([sym(Q, A, U)|After], Before, Multi, [a(Q, A, Sig2)|Table]) :-
+    (   U == target, Multi == true
+    ->  include(target_sym, Before, Ts0), reverse(Ts0, Ts), append(Ts, After, Sig2)
     ;   Sig2 = After
-    ).
+    ),
+    sig_table(After, [sym(Q, A, U)|Before], Multi, Table).
 
 target_sym(sym(_, _, U)) :- U == target.
 
@@ -348,8 +363,8 @@ lower_used([sym(S, B, U0)|Rest], Q, A, Sig2, U) :-
 bind_lower(Q, A, X, Sig1, Sig2) :-
     ctx_sig(X, Full),
     (   Full == none -> fail                         % a fixed program takes no new clause
-    ;   nonvar(Q) -> after(Full, Q, A, Sig2)
-    ;   lower_bind(Sig1, Q, A, Rest, U), lower_rest(U, Full, Q, A, Rest, Sig2)
+    ;   nonvar(Q) -> after(X, Full, Q, A, Sig2)
+    ;   lower_bind(Sig1, Q, A, Rest, U), lower_rest(U, X, Full, Q, A, Rest, Sig2)
     ).
 
 lower_bind([sym(S, B, U0)|Rest], Q, A, Sig2, U) :-
@@ -411,7 +426,7 @@ fixed_ctx(X0, Prog, N, X) :-
         findall(sym(P, A, target), member(P/A, Ts), TSyms),
         findall(sym(P, A, 1), ( member(I, Prog), item_head(I, P, A), \+ memberchk(P/A, Ts) ), Syms0),
         list_to_set(Syms0, Syms), append(TSyms, Syms, Sig),
-        set_sig_of_ctx(Sig, X1, X)
+        with_sig(Sig, X1, X)
     ;   X = X1
     ).
 
