@@ -315,12 +315,9 @@ compile_decl(File, M, ibk(H, B, C, L), ibk(l(P, A, Args), Body, Cond), Ws) :- !,
     ),
     W = where(File, L, 'ibk', M, bk),
     maplist(body_element(File, L, W), B, B1, Wss), append(Wss, Ws0),
-    condition(C, W, C1, Ws1), append(Ws0, Ws1, Ws),
-    compile_metarule(metarule(ibk, [], H, B1, true), mr(_, _, _, Body, _, _, _)),
-    cond_term(C1, Cond).
+    condition(C, W, Cond, Ws1), append(Ws0, Ws1, Ws),
+    compile_metarule(metarule(ibk, [], H, B1, true), mr(_, _, _, Body, _, _, _)).
 compile_decl(_, _, D, D, []).
-
-cond_term(C, C).
 
 %   body_pred(P/A): own, or a safe built-in (succ/2); one the file does not define is dropped with
 %   a warning (Metagol's); P/A's kind is its own (a fact with confidences only when declared so).
@@ -483,11 +480,9 @@ learn_call(TF, learn(Pos, Neg), Settings, Mode, Result) :- !,
         )
     ).
 learn_call(TF, learn_seq(Tasks), Settings, Mode, program(Clauses)) :-
-    TF = taskfile(_, M, _, _, _, _, _, _, _),
     foldl(seq_task(TF, Settings, Mode), Tasks, []-[], Progs-_),
     reverse(Progs, InOrder), append(InOrder, All),
-    reverse(All, Clauses),
-    M = M.
+    reverse(All, Clauses).
 
 %   A task of a sequence: learned with the predicates learned before it as body predicates (their
 %   clauses join the background), Metagol's learn_seq.
