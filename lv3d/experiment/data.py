@@ -126,11 +126,16 @@ def ensure_facts(cfg: StudyConfig, out: Path, data: Path, items: list[Item], mod
     todo = [it for it in items if have[it.id] is None]
     if todo:
         jobs = [(str(Path(data) / it.dir), it.id, modality, refine) for it in todo]
-        executor = executor or LocalExecutor(workers)
-        for i, record in tqdm(executor.map(facts_job, jobs, workers=workers), total=len(jobs),
-                              desc=f"facts {modality} refine={refine}"):
-            write_atomic(dest / f"{todo[i].id}.json", json.dumps(record))
-            have[todo[i].id] = (SceneFacts.from_json(record["facts"], todo[i].id), record["error"])
+        own = executor is None
+        executor = LocalExecutor(workers) if own else executor
+        try:
+            for i, record in tqdm(executor.map(facts_job, jobs, workers=None if own else workers), total=len(jobs),
+                                  desc=f"facts {modality} refine={refine}"):
+                write_atomic(dest / f"{todo[i].id}.json", json.dumps(record))
+                have[todo[i].id] = (SceneFacts.from_json(record["facts"], todo[i].id), record["error"])
+        finally:
+            if own:
+                executor.close()
     facts, errors = {}, {}
     for it in items:
         sf, error = have[it.id]

@@ -30,32 +30,57 @@ class LocalExecutor:
         self.workers = max(1, int(workers))
         self._pool = None
 
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
     def map(self, fn: Callable, jobs: list, shared: Any = None, workers: int | None = None
             ) -> Iterator[tuple[int, Any]]:
         """(index of the job, its result), as jobs finish. ``workers``: at most this many processes for this
-        map (default: the executor's)."""
+        map (default: the executor's, whose processes are kept for its next map until :meth:`close`)."""
         n = min(self.workers if workers is None else max(1, workers), len(jobs))
         if n <= 1:
             for i, job in enumerate(jobs):
                 yield i, fn(job, shared)
             return
-        from concurrent.futures import ProcessPoolExecutor, as_completed
+        from concurrent.futures import as_completed
+
+        own = workers is not None and workers != self.workers
+        pool = self._new_pool(n) if own else self._shared_pool()
+        futures = {pool.submit(fn, job, shared): i for i, job in enumerate(jobs)}
+        try:
+            for f in as_completed(futures):
+                yield futures[f], _result(f)
+        except BaseException:
+            for f in futures:
+                f.cancel()
+            if not own:
+                self.close()
+            raise
+        finally:
+            if own:
+                pool.shutdown(cancel_futures=True)
+
+    def _new_pool(self, n: int):
+        from concurrent.futures import ProcessPoolExecutor
         from multiprocessing import get_context
 
         from ..workers import die_with_parent
 
-        with ProcessPoolExecutor(n, mp_context=get_context("spawn"), initializer=die_with_parent) as pool:
-            futures = {pool.submit(fn, job, shared): i for i, job in enumerate(jobs)}
-            try:
-                for f in as_completed(futures):
-                    yield futures[f], _result(f)
-            except BaseException:
-                for f in futures:
-                    f.cancel()
-                raise
+        return ProcessPoolExecutor(n, mp_context=get_context("spawn"), initializer=die_with_parent)
+
+    def _shared_pool(self):
+        if self._pool is None:
+            self._pool = self._new_pool(self.workers)
+        return self._pool
 
     def close(self) -> None:
-        pass
+        pool, self._pool = self._pool, None
+        if pool is not None:
+            pool.shutdown(cancel_futures=True)
 
 
 def _result(future):
@@ -73,7 +98,7 @@ class DaskExecutor:
 
     name = "dask"
 
-    def __init__(self, address: str | None = None, workers: int = 1, processes: bool = True):
+    def __init__(self, address: str | None = None, workers: int = 1, processes: bool = True, timeout: str = "20s"):
         try:
             from distributed import Client, LocalCluster
         except ImportError:
@@ -81,10 +106,11 @@ class DaskExecutor:
         self._cluster = None
         try:
             if address:
-                self.client = Client(address, timeout="20s")
+                self.client = Client(address, timeout=timeout)
             else:
                 self._cluster = LocalCluster(n_workers=max(1, int(workers)), threads_per_worker=1,
-                                             processes=processes, dashboard_address=None)
+                                             processes=processes, dashboard_address=":0",
+                                             worker_dashboard_address=":0")  # any free port
                 self.client = Client(self._cluster)
         except (OSError, TimeoutError) as e:
             self.close()
@@ -96,8 +122,10 @@ class DaskExecutor:
 
         if not jobs:
             return
-        handle = self.client.scatter(shared, broadcast=True) if shared is not None else None
-        futures = [self.client.submit(fn, job, handle, pure=False) for job in jobs]
+        # one object under one key of its own (a dict would be scattered item by item; hash=False: two maps of
+        # the same data must not share, and release, one key)
+        handle = self.client.scatter(_Shared(shared), broadcast=True, hash=False)
+        futures = [self.client.submit(_call, fn, job, handle, pure=False) for job in jobs]
         index = {f.key: i for i, f in enumerate(futures)}
         try:
             for f in as_completed(futures):
@@ -115,6 +143,17 @@ class DaskExecutor:
         if self._cluster is not None:
             self._cluster.close()
             self._cluster = None
+
+
+class _Shared:
+    """What every job of a map reads, sent to the workers as one object."""
+
+    def __init__(self, value):
+        self.value = value
+
+
+def _call(fn: Callable, job, shared: _Shared):
+    return fn(job, shared.value)
 
 
 def make_executor(kind: str = "local", workers: int = 1, address: str | None = None):
