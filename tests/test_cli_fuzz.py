@@ -119,6 +119,8 @@ CASES = [
     "dataset show {box}/file.txt",
     # mil and learn
     "mil {box}/nope.pl",
+    "mil {box}/task.pl",
+    "mil {box}/file.txt",
     "mil {box}/task.pl --time-limit -1",
     "learn fit --data {box}/data --out {out} --time-limit -1",
     "learn fit --data {box}/data --out {out} --time-limit 0",
