@@ -1,8 +1,8 @@
 """Perception + grounding on real RGB-D frames, each figure beside its target.
 
-    .venv/bin/python benchmarks/bench_real.py                          # every folder under ../shared/data/real with objects.csv
-    .venv/bin/python benchmarks/bench_real.py ../shared/data/real/osd-learn --limit 5 --modalities depth,rgbd
-    .venv/bin/python benchmarks/bench_real.py --json out/bench_real.json
+    .venv/bin/python -m benchmarks.bench_real                          # every folder under ../shared/data/real with objects.csv
+    .venv/bin/python -m benchmarks.bench_real ../shared/data/real/osd-learn --limit 5 --modalities depth,rgbd
+    .venv/bin/python -m benchmarks.bench_real --json out/bench_real.json
 
 A folder is in the real layout of ../shared/data/real/README.md: ``<frame>_rgb.*`` and ``<frame>_depth*`` images,
 ``intrinsics.json``, ``objects.csv`` (one row per labelled object: frame, object, a pixel u,v inside it, shape,
@@ -111,12 +111,11 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+from benchmarks.calibration_error import ece
+from lv3d.errors import InputError
+from lv3d.facts import MODALITIES, PREDICATES
 
-from benchmarks.calibration_error import ece  # noqa: E402
-from lv3d.errors import InputError  # noqa: E402
-from lv3d.facts import MODALITIES, PREDICATES  # noqa: E402
+ROOT = Path(__file__).resolve().parent.parent
 
 REAL = ROOT.parent / "shared" / "data" / "real"
 
