@@ -494,8 +494,9 @@ def _sha256(path: Path) -> str:
 
 
 def _git(*args: str) -> str | None:
+    """The output of a git command in the repository (trailing newline off), None where git cannot answer."""
     try:
-        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
+        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True, check=True).stdout.rstrip("\n")
     except (OSError, subprocess.CalledProcessError):
         return None
 
@@ -608,8 +609,6 @@ def main(argv=None) -> int:
         in_fit = real_sets(real, maps=maps)
         print_real("real sets in the fit" + ("; shipped -> calibrated" if before else ""), in_fit, before)
         out_checks["real_in_fit"] = in_fit
-        if before:
-            out_checks["real_shipped_before"] = before
     report_rendered(render_rows, maps, f"fit rows ({', '.join(p.name for p in a.data)})")
     if check_rows:
         report_rendered(check_rows, maps, f"check rows ({', '.join(p.name for p in a.check)})", shipped)
