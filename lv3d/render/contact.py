@@ -3,6 +3,7 @@ class under every noise preset (docs/contact_sheet.png: ``python -m lv3d.render.
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -46,11 +47,39 @@ def grid(tiles: list[np.ndarray], cols: int, gap: int = 4) -> np.ndarray:
     return out
 
 
+# the PNG text key that marks a contact sheet as lv3d's own: only such a file is ever written over
+SHEET_KEY = "lv3d-contact-sheet"
+
+
+def is_own_sheet(path: Path) -> bool:
+    """True when ``path`` is a PNG that lv3d wrote as a contact sheet (its text chunk ``SHEET_KEY``)."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as im:
+            return SHEET_KEY in getattr(im, "text", {})
+    except OSError:
+        return False
+
+
 def write_png(path: Path, rgb: np.ndarray) -> Path:
+    """Write ``rgb`` (H, W, 3) uint8 to ``path`` as a PNG marked as lv3d's (``SHEET_KEY``), through a temporary
+    file beside it; an existing file at ``path`` that lv3d did not write is refused."""
+    from PIL import Image, PngImagePlugin
+
     path = Path(path)
+    if path.exists() and not is_own_sheet(path):
+        raise InputError(path, "exists and is not a contact sheet lv3d wrote; choose another --out or remove it")
     path.parent.mkdir(parents=True, exist_ok=True)
-    if not cv2.imwrite(str(path), np.ascontiguousarray(rgb[:, :, ::-1]), [cv2.IMWRITE_PNG_COMPRESSION, 9]):
-        raise InputError(path, "cannot write the PNG here")
+    info = PngImagePlugin.PngInfo()
+    info.add_text(SHEET_KEY, "1")
+    tmp = path.with_name(f".{path.name}.partial-{os.getpid()}")
+    try:
+        Image.fromarray(np.ascontiguousarray(rgb)).save(tmp, format="PNG", pnginfo=info, compress_level=9)
+        os.replace(tmp, path)
+    except OSError as e:
+        tmp.unlink(missing_ok=True)
+        raise InputError(path, f"cannot write the PNG here ({e.strerror or e})") from None
     return path
 
 

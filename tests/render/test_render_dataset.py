@@ -116,3 +116,19 @@ def test_cli_make_show_and_errors(tmp_path, capsys):
     assert main(["dataset", "show", str(tmp_path / "nope")]) == 2
     err = capsys.readouterr().err
     assert "unknown class 'blob'" in err and "unknown noise preset 'fog'" in err and "not a data set" in err
+
+
+def test_dataset_show_writes_over_its_own_sheet_and_nothing_else(tmp_path):
+    from lv3d.cli import main
+    from lv3d.render import make_dataset
+
+    data = tmp_path / "data"
+    make_dataset(data, classes=["cube"], per_class=1, noise="clean", seed=0, width=160, height=120, progress=False)
+    sheet = tmp_path / "sheet.png"
+    assert main(["dataset", "show", str(data), "--out", str(sheet)]) == 0
+    assert main(["dataset", "show", str(data), "--out", str(sheet)]) == 0  # its own sheet: replaced
+    mine = tmp_path / "photo.png"
+    mine.write_bytes(b"not lv3d's")
+    assert main(["dataset", "show", str(data), "--out", str(mine)]) == 2
+    assert mine.read_bytes() == b"not lv3d's"
+    assert not [p for p in tmp_path.iterdir() if ".partial-" in p.name]
