@@ -26,8 +26,14 @@ def dataset():
 @click.option("--width", type=click.IntRange(8, 16384), default=640, show_default=True,
               help="pixels; width x height at most 2048x2048 (lv3d.limits)")
 @click.option("--height", type=click.IntRange(8, 16384), default=480, show_default=True)
-def make(classes, per_class, noise, seed, out, workers, width, height):
-    """Render PER_CLASS images of each class into OUT (resumes: an identical finished set is kept)."""
+@click.option("--executor", type=click.Choice(["local", "dask"]), default="local", show_default=True,
+              help="where the images are rendered: this machine's processes, or a Dask cluster")
+@click.option("--address", default=None, metavar="tcp://HOST:PORT",
+              help="the Dask scheduler (with --executor dask; without it, a local cluster of --workers processes); "
+                   "its workers must see OUT's folder at the same path")
+def make(classes, per_class, noise, seed, out, workers, width, height, executor, address):
+    """Render PER_CLASS images of each class into OUT (resumes: an identical finished set is kept). The files
+    are the same, byte for byte, whatever --workers and --executor."""
     from ..errors import InputError
     from ..limits import check_pixels
     from ..output import clean_stale, lock_beside
@@ -52,7 +58,16 @@ def make(classes, per_class, noise, seed, out, workers, width, height):
     lock = lock_beside(out, f"--out {out}")  # a second make into this folder stops here
     try:
         clean_stale(out.parent, out.name)  # what a killed make left beside it
-        path = make_dataset(out, names, per_class, noise, seed, workers=workers, width=width, height=height)
+        if executor == "dask" or address:
+            from ..experiment.executor import make_executor
+
+            ex = make_executor(executor, workers or 1, address)
+            try:
+                path = make_dataset(out, names, per_class, noise, seed, width=width, height=height, executor=ex)
+            finally:
+                ex.close()
+        else:
+            path = make_dataset(out, names, per_class, noise, seed, workers=workers, width=width, height=height)
     finally:
         lock.release()
     click.echo(str(path))

@@ -58,6 +58,11 @@ def _render_job(job: tuple) -> str:
     return item["id"]
 
 
+def render_job(job: tuple, shared=None) -> str:
+    """:func:`_render_job` in the form an executor maps (``fn(job, shared)``; lv3d.experiment.executor)."""
+    return _render_job(job)
+
+
 def _check_args(classes, per_class, seed, workers) -> list[str]:
     if isinstance(classes, str):
         classes = [c for c in classes.split(",") if c]
@@ -90,14 +95,17 @@ def _is_finished(out: Path, manifest: dict) -> bool:
 
 
 def make_dataset(out: Path, classes, per_class: int, noise: str | NoiseConfig, seed: int,
-                 workers: int | None = None, width: int = 640, height: int = 480, progress: bool = True) -> Path:
+                 workers: int | None = None, width: int = 640, height: int = 480, progress: bool = True,
+                 executor=None) -> Path:
     """Render ``per_class`` images of each of ``classes`` into ``out`` and return ``out``.
 
     Items are interleaved by class (s000000 = classes[0], s000001 = classes[1], ...); item i is rendered
     from :func:`item_seed` (seed, i), so the files are byte-identical for any ``workers``. Rendering
     goes into a hidden folder beside ``out`` that is renamed to ``out`` only when all items are written;
     on failure it is removed. An existing non-empty ``out`` is returned as it is when it is a finished
-    data set with the same parameters, and is an InputError otherwise.
+    data set with the same parameters, and is an InputError otherwise. ``executor``: where the items are
+    rendered (an object with ``map(fn, jobs)``, as lv3d.experiment.executor makes them: a Dask cluster whose
+    workers see ``out``'s folder); by default ``workers`` processes of this machine.
     """
     classes = _check_args(classes, per_class, seed, workers)
     cfg = as_config(noise)
@@ -132,7 +140,10 @@ def make_dataset(out: Path, classes, per_class: int, noise: str | NoiseConfig, s
         jobs = [(str(tmp), it, cfg, width, height) for it in items]
         n_workers = min(workers or os.cpu_count() or 1, len(jobs))
         bar = tqdm(total=len(jobs), desc=f"dataset {out.name}", unit="img", disable=not progress)
-        if n_workers == 1:
+        if executor is not None:
+            for _ in executor.map(render_job, jobs):
+                bar.update()
+        elif n_workers == 1:
             for job in jobs:
                 _render_job(job)
                 bar.update()

@@ -132,3 +132,24 @@ def test_dataset_show_writes_over_its_own_sheet_and_nothing_else(tmp_path):
     assert main(["dataset", "show", str(data), "--out", str(mine)]) == 2
     assert mine.read_bytes() == b"not lv3d's"
     assert not [p for p in tmp_path.iterdir() if ".partial-" in p.name]
+
+
+def test_a_data_set_made_on_a_dask_cluster_is_the_same_byte_for_byte(tmp_path):
+    import hashlib
+
+    from lv3d.experiment.executor import DaskExecutor
+    from lv3d.render import make_dataset
+
+    def digest(folder):
+        return {p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+                for p in sorted(folder.rglob("*")) if p.is_file()}
+
+    kw = dict(classes=["cube", "tetrahedron"], per_class=2, noise="realsense", seed=3, width=160, height=120,
+              progress=False)
+    make_dataset(tmp_path / "local", workers=1, **kw)
+    ex = DaskExecutor(workers=2, processes=False)
+    try:
+        make_dataset(tmp_path / "dask", executor=ex, **kw)
+    finally:
+        ex.close()
+    assert digest(tmp_path / "local") == digest(tmp_path / "dask")
