@@ -267,10 +267,9 @@ def side_cut(poly: np.ndarray, grads: np.ndarray, min_area_px: float, shift_px: 
     ``coarse`` lines whose step exceeds their control by most are then moved every pixel up to ``step_px`` along
     their sides, and the best that passes the test is taken (``min_samples`` clear samples, a step of
     ``min_step`` and ``rel_step`` times its control); the parts must be at least ``min_area_px``.
-    ``rel_step`` is far above step_cut's: thousands of lines are tried, and noise steps on some. On realsense
-    dev seed 2000 (10 a class), none of the 32 cuts that passed at 3 times gave two true faces, the strongest
-    stepping 14.9 times its control; on clean renders, whose faces are flat, the true cuts stepped over 10000
-    times (docs/perception.md, session 30)."""
+    ``rel_step`` is far above step_cut's: thousands of lines are tried, and noise steps on some. On noisy
+    renders, lines that step 3 times their control are mostly noise, stepping up to about 15 times; on clean
+    renders, whose faces are flat, true cuts step thousands of times their control."""
     p = np.asarray(poly, np.float64)
     n = len(p)
     q, side = _outline_points(p, step_px)
