@@ -74,10 +74,12 @@ def test_a_faint_edge_inside_a_concave_outline_is_cut_before_the_outline_is_spli
     # front as one concave outline, and their faint edge runs from its reflex corner (80, 80) to a point of its right
     # side, not to a corner, where no corner-to-corner cut can follow it (split_concave cut the diagonal (80, 80) to
     # (160, 30) before)
+    # (drawn in perspective: where front and left meet, their outline turns; it would run straight on only for a
+    # line drawn across one face, solids.one_face_parts)
     img = np.full((240, 320, 3), (120, 80, 50), np.uint8)
-    top = np.array([(40, 30), (160, 30), (160, 80), (80, 80), (40, 80)])
+    top = np.array([(40, 30), (160, 30), (160, 80), (80, 80), (40, 60)])
     front = np.array([(80, 80), (160, 80), (160, 170), (80, 170)])
-    left = np.array([(40, 80), (80, 80), (80, 170), (40, 170)])
+    left = np.array([(40, 60), (80, 80), (80, 170), (40, 150)])
     for poly, colour in ((top, (192, 202, 142)), (front, (188, 198, 138)), (left, (93, 99, 69))):
         cv2.fillPoly(img, [poly.astype(np.int32)], colour)
 

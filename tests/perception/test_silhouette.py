@@ -74,29 +74,42 @@ def test_regions_of_names_the_region_holding_most_of_each_polygon():
     assert c == 0 and d == a
 
 
+def _box(img: np.ndarray, x0: int, x1: int, top: int, mid: int, bottom: int, lean: int, colour=PURPLE) -> None:
+    """A box drawn in perspective, each face a shade of one colour: its top (lightest), front and right side, the
+    top and side leaning ``lean`` px to the right as they recede."""
+    rise = mid - top
+    for poly, shade in ((((x0 + lean, top), (x1 + lean, top), (x1, mid), (x0, mid)), 1.2),
+                        (((x0, mid), (x1, mid), (x1, bottom), (x0, bottom)), 0.8),
+                        (((x1, mid), (x1 + lean, top), (x1 + lean, bottom - rise), (x1, bottom)), 0.5)):
+        cv2.fillPoly(img, [np.array(poly, np.int32)], tuple(int(c) for c in np.clip(np.array(colour) * shade, 0, 255)))
+
+
+def _apart(res, u: float) -> bool:
+    """Each object of ``res`` (two) lies on one side of the column ``u``."""
+    sides = [{float(res.faces[i].polygon[:, 0].mean()) < u for i in group} for group in res.groups]
+    return len(res.groups) == 2 and all(len(s) == 1 for s in sides) and sides[0] != sides[1]
+
+
 def test_faces_of_two_solids_that_nearly_touch_are_two_objects():
     img = _floor(seed=2)
-    # two boxes of two faces each (top lighter than front), 8 px of floor between them: the graph joins the two
-    _square(img, 40, 50, 110, 90, shade=1.2)
-    _square(img, 40, 90, 110, 150, shade=0.7)
-    _square(img, 118, 60, 190, 100, shade=1.2)  # of one colour: their hue does not part them
-    _square(img, 118, 100, 190, 150, shade=0.7)
+    # two boxes of one colour, 8 px of floor between them: the graph joins the two, the silhouettes part them
+    _box(img, 30, 90, 50, 80, 150, 14)
+    _box(img, 112, 172, 60, 90, 150, 14)
     res = rgb_faces(img)
-    assert len(res.faces) == 4 and len(res.groups) == 2
-    for group in res.groups:
-        xs = [float(res.faces[i].polygon[:, 0].mean()) for i in group]
-        assert all(x < 114 for x in xs) or all(x > 114 for x in xs)
+    assert len(res.faces) == 6 and _apart(res, 108)
 
 
-def test_solids_of_two_colours_that_touch_are_two_objects():
+def test_solids_that_touch_are_two_objects_whatever_their_colours():
+    # two boxes of one colour side by side, touching: one silhouette. The smaller one's top and front end on the
+    # larger one's side, which runs on straight past them (T junctions): two objects, though of one colour
     img = _floor(seed=3)
-    # a purple box and a teal box side by side, touching: one region, but two colours
-    _square(img, 40, 50, 110, 90, shade=1.2)
-    _square(img, 40, 90, 110, 150, shade=0.7)
-    _square(img, 110, 60, 190, 100, colour=(60, 130, 150), shade=1.2)
-    _square(img, 110, 100, 190, 150, colour=(60, 130, 150), shade=0.7)
+    _box(img, 30, 100, 40, 70, 150, 14)
+    _box(img, 114, 180, 80, 105, 160, 14)
     res = rgb_faces(img)
-    assert len(res.faces) == 4 and len(res.groups) == 2
-    for group in res.groups:
-        xs = [float(res.faces[i].polygon[:, 0].mean()) for i in group]
-        assert all(x < 110 for x in xs) or all(x > 110 for x in xs)
+    assert len(res.faces) == 6 and _apart(res, 110)
+    # the three faces of one box, each of its own colour, are one object
+    img = _floor(seed=3)
+    _box(img, 60, 140, 50, 85, 170, 16)
+    cv2.fillPoly(img, [np.array([(60, 85), (140, 85), (140, 170), (60, 170)], np.int32)], (60, 130, 150))
+    res = rgb_faces(img)
+    assert len(res.faces) == 3 and res.groups == [[0, 1, 2]]

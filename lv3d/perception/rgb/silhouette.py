@@ -5,12 +5,13 @@ Without depth, a solid's outline against the floor reaches the graph only where 
 where the floor's texture is as dark as the face, where a shadow meets a dark face, or where blur spreads a
 corner. Its chromaticity (background.py) still tells the solid from the floor there, whatever the shading: the
 floor, the wall, their texture and the shadows on them keep the chromaticity of the image's border. The regions
-of other chromaticities, cleaned of specks, are the solids (and painted lines wider than a few pixels); each
-region's outline, simplified to a polygon and moved onto the image's edge, gives its sides as segments. The
-regions also tell which faces can belong to one solid (rgb._same_solid).
+of other chromaticities, cleaned of specks, are the solids (and painted lines wider than a few pixels), whatever
+the hues of their faces; each region's outline, simplified to a polygon and moved onto the image's edge, gives its
+sides as segments. The regions also tell which faces can belong to one solid: faces on two regions never do
+(solids.group_solids).
 
-Before it is moved onto the edge, the outline lies outside the edges LSD finds: by a median 1.2 px on realsense
-renders (blur mixes the colours across it) and 0.4 px on clean ones (320 / 166 sides, dev seeds 3000-3004).
+Before it is moved onto the edge, the outline lies outside the edges LSD finds by about a pixel where blur mixes
+the colours across it, and by less on sharp images.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Faces from colour alone: edges -> segments -> planar graph -> bounded minimal cycles -> validated polygons,
 plus the thin faces beside them that the graph cannot trace (thin.py) and, colour alone, the parts of the solids'
-silhouettes that no face covers (untraced.py), grouped into objects by shared edges."""
+silhouettes that no face covers (untraced.py), grouped into objects by shared edges and silhouettes (solids.py)."""
 
 from __future__ import annotations
 
@@ -16,8 +16,9 @@ from .faces import bounded_faces, build_graph
 from .gaps import close_gaps
 from ..polygons import (KEEP_AREA, area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
                        sample_boundary, simplify)
-from .segments import detect_color_segments, union_find_labels
+from .segments import detect_color_segments
 from .silhouette import foreground, regions_of, silhouette_segments
+from .solids import SETTINGS as SOLIDS, group_solids, one_face_parts, union_outline
 from .split import reflex_corners, split_by_diagonal, split_concave
 from .step_edge import fork_cut, side_cut, smoothed_gradients, step_cut, step_lines
 from .thin import thin_faces
@@ -100,21 +101,23 @@ def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: floa
     background region around an object) are dropped.
 
     The sides of the solids' silhouettes, told from the floor by chromaticity, join the segments (silhouette.py),
-    segments are carried on across gaps in their edges where the colour still steps (gaps.close_gaps), faces on two
-    separate silhouettes or of two chromaticities are never neighbours (the graph joins solids that nearly touch or
-    overlap; a solid is taken to be of one colour, so a printed carton comes out as one object per colour:
-    _same_solid), and a kept face whose outline the graph traced whole, or a concave traced outline before it is
-    split, is cut along a faint straight edge from one of its corners (step_edge.step_cut), and a convex one that no
-    such line cuts is cut at a fork of three faint edges from three of its corners (step_edge.fork_cut: a solid
-    showing three faces of one colour), or else along a faint edge from side to side that steps far above its
-    control (step_edge.side_cut: a cube's top and front whose left and right sides run on in one line each): most
-    colour-only misses on noisy renders are corners the segments stop short of and two faces of one colour traced as
-    one. The parts of the silhouettes left outside every face, each of a colour of its own or a whole solid none of
-    whose faces was traced, are then faces too (untraced.untraced_faces: slivers whose corners the graph
-    collapsed), each cut from side to side as above. Faces of the colour of the image's border (floor texture, shadows, painted lines) are then dropped
-    (background.background_faces): most false colour-only faces on noisy renders are such; those much smoother than
-    the floor of their hue are kept (background.smooth_faces: an object of the table's hue). (rgbd does not trace
-    colour faces: fuse.py.)"""
+    segments are carried on across gaps in their edges where the colour still steps (gaps.close_gaps), and a kept
+    face whose outline the graph traced whole, or a concave traced outline before it is split, is cut along a faint
+    straight edge from one of its corners (step_edge.step_cut), and a convex one that no such line cuts is cut at a
+    fork of three faint edges from three of its corners (step_edge.fork_cut: a solid showing three faces of one
+    colour), or else along a faint edge from side to side that steps far above its control (step_edge.side_cut: a
+    cube's top and front whose left and right sides run on in one line each): most colour-only misses on noisy
+    renders are corners the segments stop short of and two faces of one colour traced as one. The parts of the
+    silhouettes left outside every face, each of a colour of its own or a whole solid none of whose faces was
+    traced, are then faces too (untraced.untraced_faces: slivers whose corners the graph collapsed), each cut from
+    side to side as above. Faces of the colour of the image's border (floor texture, shadows, painted lines) are
+    then dropped (background.background_faces): most false colour-only faces on noisy renders are such; those much
+    smoother than the floor of their hue are kept (background.smooth_faces: an object of the table's hue).
+
+    Faces are grouped into solids by the edges they share and the silhouettes they lie in, never by their hue
+    (solids.group_solids: the graph joins solids that nearly touch or overlap, and a side of one ending on the
+    other's outline parts them), and the parts of one face cut apart by a line drawn across it are made one face
+    again (solids.one_face_parts: a print's edge, a label). (rgbd does not trace colour faces: fuse.py.)"""
     import time
 
     t0 = time.perf_counter()
@@ -129,7 +132,7 @@ def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: floa
     segs = detect_color_segments(chans)
     sgrads = smoothed_gradients(chans)  # for close_gaps and step_cut
     solids = foreground(crop)  # regions not of the border's chromaticity
-    chroma = chromaticity(crop)  # for background_faces and _same_solid
+    chroma = chromaticity(crop)  # for background_faces and smooth_faces
     segs = close_gaps(np.concatenate([segs, silhouette_segments(solids, grad)]), sgrads)
     t2 = time.perf_counter()
     g = build_graph(segs, edge_dist=dist)
@@ -158,7 +161,7 @@ def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: floa
         # traced with a third as one outline): split_concave cuts only from corner to corner and reads Canny's
         # gradient, which the faint edge is under. Stricter than step_cut on whole faces (a step 10 times its
         # control, 12 clear samples: a short edge ending on a side keeps few); the parts, their corners found again,
-        # are then split as before (docs/perception.md)
+        # are then split as a traced outline is (docs/perception.md)
         concave = bool(reflex_corners(poly))
         lines = step_lines(poly, sgrads) if concave else None
         stepped = step_cut(poly, sgrads, min_area_px, rel_step=10.0, min_samples=12, lines=lines) \
@@ -218,7 +221,7 @@ def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: floa
             group = [(p, es | {cut}, sup, a) for p, es, sup, a in group]
         new += group
     cands += new
-    hues = []  # each face's chromaticity, for background_faces and _same_solid
+    hues = []  # each face's chromaticity, for background_faces and smooth_faces
     if cands:
         hues = [face_chromaticity(np.asarray(c[0], np.float64), chroma) for c in cands]
         bg = background_faces(hues, chroma)
@@ -231,15 +234,43 @@ def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: floa
     faces, hues = [f for f, _ in faces], [h for _, h in faces]
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
                  if faces[i].edges & faces[j].edges]
-    adjacency = _same_solid(adjacency, [f.polygon for f in faces], hues, solids)
-    lab = union_find_labels(len(faces), np.array(adjacency, int).reshape(-1, 2))
-    groups: dict[int, list[int]] = {}
-    for i, l in enumerate(lab):
-        groups.setdefault(int(l), []).append(i)
-    ordered = sorted(groups.values(), key=lambda idx: (-sum(faces[i].area_px for i in idx), idx[0]))
+    polys = [f.polygon for f in faces]
+    # the silhouette each face lies in: a region of the foreground, -1 outside every one (floor, shadow); a face
+    # outside the foreground much smoother than the floor of its hue is of an object of the floor's hue, and may lie
+    # in any silhouette (0)
+    region = regions_of(polys, solids)
+    outside = [r == 0 for r in region]
+    if any(outside):
+        smooth = smooth_faces(polys, hues, outside, chroma, log_gradient(crop))
+        region = [0 if sm else (r or -1) for r, sm in zip(region, smooth)]
+    groups = group_solids(polys, adjacency, (h, w), region)
+    # parts cut apart where the image steps (split_by_diagonal, step_cut, fork_cut, side_cut) stay two faces
+    apart = {(i, j) for i, j in adjacency if faces[i].edges & faces[j].edges & image_cuts}
+    faces, groups = _one_face(faces, groups, one_face_parts(polys, groups, adjacency, (h, w), apart), dist,
+                             SOLIDS.contact_frac * np.hypot(h, w))
+    adjacency = [(i, j) for g in groups for i in g for j in g if i < j and faces[i].edges & faces[j].edges]
+    ordered = sorted(groups, key=lambda idx: (-sum(faces[i].area_px for i in idx), idx[0]))
     t3 = time.perf_counter()
     timings = {"edges": (t1 - t0) * 1e3, "segments": (t2 - t1) * 1e3, "faces": (t3 - t2) * 1e3}
     return RGBResult(faces, ordered, adjacency, timings)
+
+
+def _one_face(faces: list[RGBFace], groups: list[list[int]], parts: list[list[int]], dist: np.ndarray,
+              touch: float) -> tuple[list[RGBFace], list[list[int]]]:
+    """The faces with each of ``parts`` (indices into ``faces``: the parts of one face, solids.one_face_parts)
+    made one face (the outline of the parts together, their seams of up to ``touch`` px closed), largest first as
+    ``faces`` are, and ``groups`` (indices into ``faces``) as indices into the faces returned."""
+    made = []  # (face, the indices of its parts)
+    for part in parts:
+        if len(part) == 1:
+            made.append((faces[part[0]], part))
+            continue
+        poly = _outline(union_outline([faces[i].polygon for i in part], touch))
+        edges = frozenset().union(*(faces[i].edges for i in part))
+        made.append((RGBFace(poly, edges, edge_support(poly, dist), area(poly)), part))
+    made.sort(key=lambda fp: (-fp[0].area_px, float(fp[0].polygon[0, 0]), float(fp[0].polygon[0, 1])))
+    new_index = {i: k for k, (_, part) in enumerate(made) for i in part}
+    return [f for f, _ in made], [sorted({new_index[i] for i in g}) for g in groups]
 
 
 def _faint_cut(poly: np.ndarray, sgrads: np.ndarray, min_area_px: float, lines) -> list[np.ndarray] | None:
@@ -257,17 +288,6 @@ def _faint_cut(poly: np.ndarray, sgrads: np.ndarray, min_area_px: float, lines) 
     if parts is None:
         parts = side_cut(poly, sgrads, min_area_px)
     return parts
-
-
-def _same_solid(pairs: list[tuple[int, int]], polys: list[np.ndarray], hue: list[np.ndarray], solids: np.ndarray,
-                max_chroma: float = 0.1) -> list[tuple[int, int]]:
-    """The pairs of neighbouring faces (polygons ``polys``, pixels; ``hue``: the median chromaticity of each,
-    background.face_chromaticity) that can be faces of one solid:
-    on one region of ``solids`` (silhouette.foreground), and of median chromaticities within ``max_chroma`` (a
-    solid's faces share its colour, whatever their shading). The graph joins solids that nearly touch or overlap
-    in the image; without depth this is what parts them."""
-    region = regions_of(polys, solids)
-    return [(i, j) for i, j in pairs if region[i] == region[j] and np.hypot(*(hue[i] - hue[j])) <= max_chroma]
 
 
 def _part(q: np.ndarray, edges: frozenset, cut: tuple[int, int], vertices: np.ndarray, dist: np.ndarray) -> tuple:
