@@ -67,6 +67,9 @@ class SolidSettings:
     # traces short or blunt beside its neighbour's side, while a side hidden behind another solid leaves its
     # outline at any angle and runs on
     tip_deg: float = 150.0
+    # a line drawn across a face ends where the outline of the parts either side of it, together, turns by less
+    # than this (deg): the face's side runs on straight there, as it does not past a corner of the solid
+    line_deg: float = 15.0
     # parts of one face are convex together: their area at least this share of their convex hull's (the outline
     # of parts traced apart bends by a pixel or two where they meet)
     min_convex: float = 0.95
@@ -287,6 +290,7 @@ def one_face_parts(polys: list[np.ndarray], groups: list[list[int]], pairs: list
                 owner[i] = keep
 
         verdict: dict[tuple[tuple[int, ...], tuple[int, ...]], float | None] = {}
+        outlines: dict[tuple[int, ...], np.ndarray] = {}  # parts' outlines together, by their sorted indices
         while True:
             links = {(min(owner[i], owner[j]), max(owner[i], owner[j])) for i, j in inside
                      if owner[i] != owner[j] and (i, j) not in apart}
@@ -296,7 +300,7 @@ def one_face_parts(polys: list[np.ndarray], groups: list[list[int]], pairs: list
             for a, b in links:
                 key = (parts[a], parts[b])
                 if key not in verdict:
-                    verdict[key] = _marking(list(parts[a]), list(parts[b]), polys, touch, chord, (w, h), settings)
+                    verdict[key] = _marking(parts[a], parts[b], polys, touch, chord, (w, h), settings, outlines)
                 if verdict[key] is not None and (best is None or verdict[key] > best[0]):
                     best = (verdict[key], a, b)
             if best is None:
@@ -323,19 +327,26 @@ def one_face_parts(polys: list[np.ndarray], groups: list[list[int]], pairs: list
     return out
 
 
-def _marking(a: list[int], b: list[int], polys: list[np.ndarray], touch: float, chord: int, size: tuple[int, int],
-             settings: SolidSettings) -> float | None:
-    """The length (px) of the boundary parts ``a`` and ``b`` (lists of indices into ``polys``) share, when it is
-    a line across one face (one_face_parts): the two are convex together and at every end of the boundary off the
-    image's frame their outline together turns by less than ``straight_deg``, read between chords ``part_chord``
-    of the narrower part's width long (at most ``chord``). None otherwise."""
-    ga, gb = (_group(m, union_outline([polys[i] for i in m], touch) if len(m) > 1 else
-                     _clockwise(np.asarray(polys[m[0]], np.float64)), 0.0) for m in (a, b))
+def _marking(a: tuple[int, ...], b: tuple[int, ...], polys: list[np.ndarray], touch: float, chord: int,
+             size: tuple[int, int], settings: SolidSettings, outlines: dict) -> float | None:
+    """The length (px) of the boundary parts ``a`` and ``b`` (indices into ``polys``) share, when it is a line
+    across one face (one_face_parts): the two are convex together and at every end of the boundary off the
+    image's frame their outline together turns by less than ``line_deg``, read between chords ``part_chord`` of
+    the narrower part's width long (at most ``chord``). None otherwise. ``outlines``: the outlines of parts
+    together found so far, by their sorted indices (filled in here)."""
+    def outline(m: tuple[int, ...]) -> np.ndarray:
+        key = tuple(sorted(m))
+        if key not in outlines:
+            outlines[key] = union_outline([polys[i] for i in key], touch) if len(key) > 1 else \
+                _clockwise(np.asarray(polys[key[0]], np.float64))
+        return outlines[key]
+
+    ga, gb = (_group(list(m), outline(m), 0.0) for m in (a, b))
     near = _along(ga, gb, touch, settings.align_deg)
     runs = _runs(near, chord)
     if not runs or (len(runs) == 1 and runs[0] == (0, len(near) - 1)):
         return None
-    both = union_outline([polys[i] for i in a + b], touch)
+    both = outline(a + b)
     hull = cv2.convexHull(both.astype(np.float32)).reshape(-1, 2)
     if abs(_signed_area(both)) < settings.min_convex * abs(_signed_area(hull)):
         return None
@@ -350,7 +361,7 @@ def _marking(a: list[int], b: list[int], polys: list[np.ndarray], touch: float, 
             if min(p[0], p[1], w - 1 - p[0], h - 1 - p[1]) <= touch:
                 continue
             j = int(np.argmin(np.hypot(*(u - p).T)))
-            if _far_turn_deg(u, j, cm) >= settings.straight_deg:
+            if _far_turn_deg(u, j, cm) >= settings.line_deg:
                 return None
             ends += 1
     return float(near.sum()) if ends else None

@@ -234,43 +234,56 @@ def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: floa
     faces, hues = [f for f, _ in faces], [h for _, h in faces]
     adjacency = [(i, j) for i in range(len(faces)) for j in range(i + 1, len(faces))
                  if faces[i].edges & faces[j].edges]
+    touch = SOLIDS.contact_frac * np.hypot(h, w)
     polys = [f.polygon for f in faces]
-    # the silhouette each face lies in: a region of the foreground, -1 outside every one (floor, shadow); a face
-    # outside the foreground much smoother than the floor of its hue is of an object of the floor's hue, and may lie
-    # in any silhouette (0)
-    region = regions_of(polys, solids)
-    outside = [r == 0 for r in region]
-    if any(outside):
-        smooth = smooth_faces(polys, hues, outside, chroma, log_gradient(crop))
-        region = [0 if sm else (r or -1) for r, sm in zip(region, smooth)]
-    groups = group_solids(polys, adjacency, (h, w), region)
+    groups = group_solids(polys, adjacency, (h, w), _silhouettes(polys, hues, solids, chroma, crop))
     # parts cut apart where the image steps (split_by_diagonal, step_cut, fork_cut, side_cut) stay two faces
     apart = {(i, j) for i, j in adjacency if faces[i].edges & faces[j].edges & image_cuts}
-    faces, groups = _one_face(faces, groups, one_face_parts(polys, groups, adjacency, (h, w), apart), dist,
-                             SOLIDS.contact_frac * np.hypot(h, w))
-    adjacency = [(i, j) for g in groups for i in g for j in g if i < j and faces[i].edges & faces[j].edges]
+    parts = one_face_parts(polys, groups, adjacency, (h, w), apart)
+    solid_of = {i: k for k, g in enumerate(groups) for i in g}
+    faces = _one_face(faces, parts, dist, touch)
+    groups = {}
+    for k, part in enumerate(parts):
+        groups.setdefault(solid_of[part[0]], []).append(k)
+    # faces largest first, the objects by their faces' area, largest first
+    order = sorted(range(len(faces)), key=lambda i: (-faces[i].area_px, float(faces[i].polygon[0, 0]),
+                                                     float(faces[i].polygon[0, 1])))
+    rank = {i: k for k, i in enumerate(order)}
+    faces = [faces[i] for i in order]
+    groups = [sorted(rank[i] for i in g) for g in groups.values()]
+    adjacency = sorted((i, j) for g in groups for i in g for j in g if i < j and faces[i].edges & faces[j].edges)
     ordered = sorted(groups, key=lambda idx: (-sum(faces[i].area_px for i in idx), idx[0]))
     t3 = time.perf_counter()
     timings = {"edges": (t1 - t0) * 1e3, "segments": (t2 - t1) * 1e3, "faces": (t3 - t2) * 1e3}
     return RGBResult(faces, ordered, adjacency, timings)
 
 
-def _one_face(faces: list[RGBFace], groups: list[list[int]], parts: list[list[int]], dist: np.ndarray,
-              touch: float) -> tuple[list[RGBFace], list[list[int]]]:
+def _one_face(faces: list[RGBFace], parts: list[list[int]], dist: np.ndarray, touch: float) -> list[RGBFace]:
     """The faces with each of ``parts`` (indices into ``faces``: the parts of one face, solids.one_face_parts)
-    made one face (the outline of the parts together, their seams of up to ``touch`` px closed), largest first as
-    ``faces`` are, and ``groups`` (indices into ``faces``) as indices into the faces returned."""
-    made = []  # (face, the indices of its parts)
+    made one face (the outline of the parts together, their seams of up to ``touch`` px closed), in the order of
+    ``parts``."""
+    out = []
     for part in parts:
         if len(part) == 1:
-            made.append((faces[part[0]], part))
+            out.append(faces[part[0]])
             continue
         poly = _outline(union_outline([faces[i].polygon for i in part], touch))
         edges = frozenset().union(*(faces[i].edges for i in part))
-        made.append((RGBFace(poly, edges, edge_support(poly, dist), area(poly)), part))
-    made.sort(key=lambda fp: (-fp[0].area_px, float(fp[0].polygon[0, 0]), float(fp[0].polygon[0, 1])))
-    new_index = {i: k for k, (_, part) in enumerate(made) for i in part}
-    return [f for f, _ in made], [sorted({new_index[i] for i in g}) for g in groups]
+        out.append(RGBFace(poly, edges, edge_support(poly, dist), area(poly)))
+    return out
+
+
+def _silhouettes(polys: list[np.ndarray], hues: list[np.ndarray], solids: np.ndarray, chroma: np.ndarray,
+                 color: np.ndarray) -> list[int]:
+    """The silhouette each face (``polys``, chromaticities ``hues``) lies in: a region of ``solids``
+    (silhouette.foreground), -1 outside every one (floor, shadow), 0 (any) for a face outside them much smoother
+    than the floor of its hue (background.smooth_faces: an object of the floor's hue)."""
+    region = regions_of(polys, solids)
+    outside = [r == 0 for r in region]
+    if any(outside):
+        smooth = smooth_faces(polys, hues, outside, chroma, log_gradient(color))
+        region = [0 if sm else (r or -1) for r, sm in zip(region, smooth)]
+    return region
 
 
 def _faint_cut(poly: np.ndarray, sgrads: np.ndarray, min_area_px: float, lines) -> list[np.ndarray] | None:
