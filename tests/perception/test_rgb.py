@@ -72,10 +72,9 @@ def test_traced_part_keeps_the_traced_bends_between_outline_corners():
 def test_a_faint_edge_inside_a_concave_outline_is_cut_before_the_outline_is_split():
     # a box's top and front faces of one colour, 4 grey levels apart, and its dark left face: the graph traces top and
     # front as one concave outline, and their faint edge runs from its reflex corner (80, 80) to a point of its right
-    # side, not to a corner, where no corner-to-corner cut can follow it (split_concave cut the diagonal (80, 80) to
-    # (160, 30) before)
-    # (drawn in perspective: where front and left meet, their outline turns; it would run straight on only for a
-    # line drawn across one face, solids.one_face_parts)
+    # side, not to a corner, where no corner-to-corner cut can follow it (split_concave would cut the diagonal
+    # (80, 80) to (160, 30)). Drawn in perspective: where front and left meet, their outline turns; it would run
+    # straight on only for a line drawn across one face (solids.one_face_parts)
     img = np.full((240, 320, 3), (120, 80, 50), np.uint8)
     top = np.array([(40, 30), (160, 30), (160, 80), (80, 80), (40, 60)])
     front = np.array([(80, 80), (160, 80), (160, 170), (80, 170)])
@@ -91,8 +90,8 @@ def test_a_faint_edge_inside_a_concave_outline_is_cut_before_the_outline_is_spli
 
 
 def test_a_short_faint_edge_that_steps_clearly_cuts_a_small_face_off():
-    # triangular prism 1002 of the clean dev renders: its 509 px side and 1316 px end, 5-6 grey levels apart, traced
-    # as one outline; their edge keeps 10 clear samples, under step_cut's 15, but steps 89 times its control
+    # a triangular prism's 509 px side and 1316 px end, 5-6 grey levels apart, traced as one outline; their edge
+    # keeps 10 clear samples, under step_cut's 15, but steps 89 times its control
     off = np.array([40.0, 20.0])
     small = np.array([(12.8, 56.4), (30.1, 37.0), (51.7, 74.0)]) + off
     large = np.array([(30.1, 37.0), (54.1, 10.2), (72.1, 44.7), (51.7, 74.0)]) + off
@@ -107,8 +106,8 @@ def test_a_short_faint_edge_that_steps_clearly_cuts_a_small_face_off():
 
 
 def test_a_faint_edge_from_side_to_side_cuts_two_faces_of_one_colour_apart(monkeypatch):
-    # cube 3003 of the clean dev renders: its top and front faces, 10 grey levels apart, traced as one outline whose
-    # left sides and right sides run on in one line each; their edge ends on those sides, at no corner
+    # a cube's top and front faces, 10 grey levels apart, traced as one outline whose left sides and right sides run
+    # on in one line each (its sides seen edge-on); their edge ends on those sides, at no corner
     top = np.array([(40, 30), (160, 30), (160, 75), (40, 85)])
     front = np.array([(40, 85), (160, 75), (160, 170), (40, 170)])
     img = np.full((240, 320, 3), (120, 80, 50), np.uint8)

@@ -162,6 +162,7 @@ def union_outline(polys: list[np.ndarray], touch: float) -> np.ndarray:
     m = cv2.morphologyEx(m, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1)))
     contours, _ = cv2.findContours(m, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     c = max(contours, key=cv2.contourArea)
+    # simplified within half a pixel: the mask's own resolution, whatever the image's size
     poly = cv2.approxPolyDP(c, 0.5 * sub, True).reshape(-1, 2).astype(np.float64) / sub + lo
     return _clockwise(poly)
 
