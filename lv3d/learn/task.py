@@ -82,7 +82,7 @@ def run_task(path: str | Path, *, time_limit: float | None = None, settings: dic
         raise InputError("--memory-limit", f"must be a whole number of MB from 64, got {memory_mb!r}")
     main = str(sources.source("mil_main.pl"))
     # the address space is bounded by the shell that execs swipl (no preexec_fn: this process may have
-    # threads); its own session, so that stopping it stops everything it started
+    # threads); a process group of its own (start_new_session), so that stopping it stops everything it started
     cmd = ["/bin/sh", "-c", f'ulimit -v {(memory_mb + 512) * 1024} && exec "$0" "$@"', swipl(),
            f"--stack-limit={memory_mb}m", "-q", main, "--", str(path), engine.settings_term(opts), mode, goal or ""]
     limit = float(opts.get("time_limit", 10.0))
