@@ -19,7 +19,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from ...cylinder import Cylinder
@@ -154,11 +153,3 @@ def fan_cylinder(normals: list[np.ndarray], sizes: list[int], adjacency: list[tu
             continue
         return cyl, inl, fan
     return None
-
-
-def largest_piece(mask: np.ndarray) -> np.ndarray:
-    """The largest 8-connected piece of ``mask`` (h, w) bool."""
-    n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
-    if n <= 2:
-        return mask
-    return lab == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))

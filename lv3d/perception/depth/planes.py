@@ -25,7 +25,8 @@ class DepthPlane:
     rms_m: float
 
 
-def _largest_piece(mask: np.ndarray) -> np.ndarray:
+def largest_piece(mask: np.ndarray) -> np.ndarray:
+    """The largest 8-connected piece of ``mask`` (h, w) bool."""
     n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:
         return mask
@@ -76,7 +77,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
         plane, inl = ransac_plane(pts[idx], dist_m, rng, iterations=96, normals=nrm[idx], max_angle_deg=max_angle_deg)
         m = np.zeros((h, w), bool)
         m.flat[flat[idx[inl]]] = True
-        piece = _largest_piece(m)
+        piece = largest_piece(m)
         sel = piece[box] & free & tried
         if np.count_nonzero(sel) < need:
             misses += 1
@@ -100,7 +101,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     for k, plane in enumerate(planes):
         m = np.zeros((h, w), bool)
         m.flat[flat[ok & (best == k)]] = True
-        m = _largest_piece(m)
+        m = largest_piece(m)
         sel = m[box]
         if np.count_nonzero(sel) < need:
             continue

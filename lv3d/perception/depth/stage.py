@@ -21,10 +21,10 @@ from ...rgbd import RGBD
 from ..boundary import mask_polygon
 from .cloud import PointGrid, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
-from .curved import CurvedFace, CurvedSettings, fan_cylinder, largest_piece
+from .curved import CurvedFace, CurvedSettings, fan_cylinder
 from .occlusion import OcclusionSettings, join_occluded
 from .objects import DepthObject, heavy_noise, segment_objects, support_band
-from .planes import DepthPlane, merge_coplanar, object_planes, plane_adjacency
+from .planes import DepthPlane, largest_piece, merge_coplanar, object_planes, plane_adjacency
 from .plane_outline import simplify_on_plane
 from ..polygons import merge_close_corners
 from .snap import add_triple_corners, snap_polygons
