@@ -175,13 +175,15 @@ def _chunks(faces: list[Face], max_faces: int, max_vertices: int, max_sides: int
 
 
 def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray | None = None,
-           refine_all: bool = False, calibrate: bool = True, dense_points: bool = True):
+           refine_all: bool = False, calibrate: bool = True, dense_points: bool = True,
+           refine_ids: frozenset[str] | None = None):
     """Ground every object of ``scene``: (candidate facts with their probabilities, before any is dropped;
     per-object results). Candidates are ``(pred, args, probability, value)``.
 
     With ``refine``, only the scene's target object (:meth:`Scene.target`, the one a label speaks of) is
-    refined unless ``refine_all``: the others keep perception's geometry, and their facts still get
-    confidences from its Laplace covariance (the solver is three quarters of an object's cost).
+    refined unless ``refine_all``, or the objects named by ``refine_ids`` when given (the labelled objects
+    of a real frame): the others keep perception's geometry, and their facts still get confidences from
+    its Laplace covariance (the solver is three quarters of an object's cost).
 
     With ``calibrate``, each probability goes through the per-(modality, predicate) calibration map lv3d ships
     (:mod:`lv3d.calibration`, docs/grounding.md); without it, the raw Gaussian probabilities.
@@ -211,7 +213,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
             pos = {f.id: i for i, f in enumerate(chunk)}
             polys = [_simplify(f.polygon, grounding.MAX_SIDES) for f in chunk]
             has_plane = [f.plane is not None and f.points is not None and len(f.points) >= 3 for f in chunk]
-            refined = refine and (refine_all or obj is target)
+            refined = refine and (refine_all or (obj.id in refine_ids if refine_ids is not None else obj is target))
             pts = [f.points if hp else None for f, hp in zip(chunk, has_plane)]
             if refined and dense_points:  # only a refined plane moves, so only it needs the full-resolution points
                 pts = [p if p is None else _first(dense_face_points(f, frame), p) for f, p in zip(chunk, pts)]
@@ -508,13 +510,15 @@ def _leaf_paths(treedef) -> list[tuple[str, ...]]:
     return [tuple(k.name for k in path) for path, _ in paths]
 
 
-def describe(scene: Scene, frame: RGBD, *, refine: bool = True) -> SceneFacts:
+def describe(scene: Scene, frame: RGBD, *, refine: bool = True, refine_ids: frozenset[str] | None = None
+             ) -> SceneFacts:
     """Facts of ``scene`` (perceived in ``frame``) with confidences, for the scene's modality.
 
     ``refine=False`` keeps perception's polygons and planes but still computes their covariances and
-    the confidences from them. Facts whose probability is below ``MIN_CONF`` are absent.
+    the confidences from them. Facts whose probability is below ``MIN_CONF`` are absent. ``refine_ids``: the
+    objects to refine (default: the scene's target), see :func:`ground`.
     """
-    cands, _ = ground(scene, frame, refine=refine)
+    cands, _ = ground(scene, frame, refine=refine, refine_ids=refine_ids)
     facts = []
     for pred, args, p, value in cands:
         if scene.modality not in PREDICATES[pred][1] or not math.isfinite(p) or p < MIN_CONF:

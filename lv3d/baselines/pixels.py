@@ -1,7 +1,8 @@
 """Frames as small pixel tensors for the statistical baselines.
 
 Every baseline sees the same view of a frame: the central square crop of the image, downsampled
-to ``size`` x ``size`` (no ground truth, no object crop: the baseline gets what the camera gives).
+to ``size`` x ``size`` (no ground truth, no object crop: the baseline gets what the camera gives);
+or, for a labelled object of a real frame, a square crop around it (:func:`crop_tensor`).
 Channel layout (C, size, size), float32:
 
 - ``rgb``: 3 channels, colour scaled to roughly zero mean, unit spread ((x/255 - 0.5) / 0.25);
@@ -55,3 +56,17 @@ def frame_tensor(frame: RGBD, modality: str, size: int = 64) -> np.ndarray:
     if modality in ("depth", "rgbd"):
         parts.append(depth_channel(frame.depth, size))
     return np.concatenate(parts, axis=0)
+
+
+def crop_tensor(frame: RGBD, square: tuple[int, int, int], size: int = 64) -> np.ndarray:
+    """The rgbd tensor (4, size, size) of the square ``(u0, v0, side)`` of ``frame`` (what lies outside the
+    frame: black, no depth reading); depth relative to the crop's median valid depth."""
+    u0, v0, side = square
+    h, w = frame.depth.shape
+    color = np.zeros((side, side, 3), np.uint8)
+    depth = np.zeros((side, side), np.float32)
+    a0, b0, a1, b1 = max(0, u0), max(0, v0), min(w, u0 + side), min(h, v0 + side)
+    if a1 > a0 and b1 > b0:
+        color[b0 - v0:b1 - v0, a0 - u0:a1 - u0] = frame.color[b0:b1, a0:a1]
+        depth[b0 - v0:b1 - v0, a0 - u0:a1 - u0] = frame.depth[b0:b1, a0:a1]
+    return np.concatenate([color_channels(color, size), depth_channel(depth, size)], axis=0)
