@@ -22,14 +22,16 @@ from ..output import check_out, replacing
               help="Metres per 16-bit depth unit (default: from the intrinsics file, else 0.001); float depth is "
               "read as metres.")
 @click.option("--modality", type=click.Choice(["rgb", "depth", "rgbd"]), default="rgbd", show_default=True)
-@click.option("--scene-id", default="s000000", show_default=True, help="Scene id, a Prolog atom like s000123.")
+@click.option("--scene-id", default=None,
+              help="Scene id, a Prolog atom like s000123 (default: the frame's name, made an atom: lv3d.frame_folder."
+                   "scene_atom).")
 @click.option("--out", "out_dir", type=click.Path(path_type=Path), required=True, help="Output folder.")
 @click.option("--facts", is_flag=True, help="Also ground the scene and write facts.json and facts.pl.")
 @click.option("--max-objects", type=click.IntRange(min=1), default=None,
               help="Describe at most this many objects found by depth, the largest (default 24); the output says "
               "how many were left out.")
 def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scale: float | None, modality: str,
-            scene_id: str, out_dir: Path, facts: bool, max_objects: int | None) -> None:
+            scene_id: str | None, out_dir: Path, facts: bool, max_objects: int | None) -> None:
     """Find objects, faces and planes in one frame COLOR; write OUT/scene.json and OUT/overlay.png."""
     from ..rgbd import load_frame, read_intrinsics
     from ..perception.overlay import draw_overlay
@@ -37,7 +39,9 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
 
     import re
 
-    if not re.fullmatch(r"[a-z][a-zA-Z0-9_]*", scene_id):
+    from ..frame_folder import scene_atom
+
+    if scene_id is not None and not re.fullmatch(r"[a-z][a-zA-Z0-9_]*", scene_id):
         raise InputError("--scene-id", f"must be a Prolog atom like s000123 (a lower-case letter, then letters, "
                                        f"digits or _), got {scene_id!r}")
     if modality in ("depth", "rgbd") and depth is None:
@@ -50,6 +54,7 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
     inputs = (color, depth, intrinsics)
     check_out(out_dir, inputs)  # before any work: a file, a folder lv3d did not write or one holding an input
     frame_name = Path(color).stem.removesuffix("_rgb")
+    scene_id = scene_id if scene_id is not None else scene_atom(frame_name)
     # colour alone reads no depth: without a file, load_frame fills in nominal intrinsics
     k, scale = read_intrinsics(intrinsics, frame_name) if intrinsics is not None else (None, 0.001)
     frame = load_frame(color, depth if modality != "rgb" else None, k,

@@ -1,5 +1,6 @@
-"""``lv3d mil TASK.pl`` (classic MIL tasks) and ``lv3d learn fit|predict`` (shape concepts from a
-rendered data set, docs/dataset.md)."""
+"""``lv3d mil TASK.pl`` (classic MIL tasks) and ``lv3d learn fit|predict|explain`` (shape concepts from a
+rendered data set, docs/dataset.md, or from the labelled objects of a folder of real frames,
+docs/real_frames.md)."""
 
 from __future__ import annotations
 
@@ -78,13 +79,21 @@ def learn():
     """Learn shape concepts from a data set and classify with them."""
 
 
-def _dataset_scenes(data: Path, modality: str, facts: str):
-    """(scenes, labels) of a data set directory: facts from the ground truth or through the pipeline."""
-    from ..truth_facts import truth_facts
+def _dataset_scenes(data: Path, modality: str, facts: str | None, cache: Path | None = None):
+    """(scenes, labels) of a data set directory, facts from the ground truth or through the pipeline; or of
+    a folder of real frames (objects.csv), every labelled object one example, facts through the pipeline,
+    cached. Examples whose pixel lies on no perceived object keep no target: one warning line each."""
+    from ..frame_folder import is_frame_folder
 
+    if is_frame_folder(data):
+        if facts == "truth":
+            raise InputError("--facts", f"{data} holds real frames: they have no ground-truth facts (use pipeline)")
+        return _frame_folder_scenes(data, modality, cache)
+    if facts is None:
+        facts = "pipeline"
     manifest = data / "manifest.json"
     if not manifest.is_file():
-        raise InputError(data, "not a data set (no manifest.json)")
+        raise InputError(data, "not a data set (no manifest.json) nor a folder of labelled frames (no objects.csv)")
     try:
         items = json.loads(manifest.read_text())["items"]
     except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError) as e:
@@ -98,6 +107,8 @@ def _dataset_scenes(data: Path, modality: str, facts: str):
     for it in items:
         item_dir = data / it["dir"]
         if facts == "truth":
+            from ..truth_facts import truth_facts
+
             meta_path = item_dir / "meta.json"
             meta = read_json(meta_path, "meta.json")
             scenes.append(truth_facts(meta, it["id"], modality))
@@ -105,29 +116,73 @@ def _dataset_scenes(data: Path, modality: str, facts: str):
             from ..pipeline import scene_facts
             from ..rgbd import load_item
 
-            scenes.append(scene_facts(load_item(item_dir), it["id"], modality))
+            try:
+                scenes.append(scene_facts(load_item(item_dir), it["id"], modality))
+            except InputError as e:  # no object found: the image is left out of learning and counted
+                from ..facts import SceneFacts
+
+                click.echo(f"lv3d: warning: {item_dir}: {e.problem} (no example)", err=True)
+                scenes.append(SceneFacts(it["id"], modality, [], None))
         labels.append(it["class"])
     if not scenes:
         raise InputError(data, "the data set lists no items")
     return scenes, labels
 
 
-_data = click.option("--data", type=click.Path(path_type=Path), required=True, help="data set directory")
+def _cache_dir(cache: Path | None) -> Path:
+    """Where facts of real frames are cached: --cache, else $XDG_CACHE_HOME/lv3d (~/.cache/lv3d)."""
+    import os
+
+    if cache is not None:
+        return Path(cache).expanduser()
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "lv3d"
+
+
+def _frame_folder_scenes(data: Path, modality: str, cache: Path | None):
+    from ..experiment.code_version import facts_version
+    from ..experiment.real_data import ensure_frame_facts, example_facts_of, real_data
+    from ..frame_folder import FrameFolder
+
+    objects, problems = FrameFolder(data).objects()
+    rd = real_data([str(data)], sorted({o.shape for o in objects}))
+    for p in problems:
+        click.echo(f"lv3d: warning: {p} (left out)", err=True)
+    frames = ensure_frame_facts(rd, _cache_dir(cache) / "facts", facts_version(), modality, True)
+    facts, errors = example_facts_of(rd, frames)
+    for i in sorted(errors):
+        click.echo(f"lv3d: warning: {errors[i]} (example {i} has no object)", err=True)
+    return [facts[it.id] for it in rd.items], [it.cls for it in rd.items]
+
+
+def _learnable(scenes, labels):
+    """The examples with a target object (perception found one), and how many were left out."""
+    keep = [(s, y) for s, y in zip(scenes, labels) if s.target is not None]
+    return [s for s, _ in keep], [y for _, y in keep], len(scenes) - len(keep)
+
+
+_data = click.option("--data", type=click.Path(path_type=Path), required=True,
+                     help="a rendered data set (manifest.json) or a folder of labelled real frames (objects.csv)")
 _modality = click.option("--modality", type=click.Choice(MODALITIES), default="rgbd", show_default=True)
-_facts = click.option("--facts", type=click.Choice(["truth", "pipeline"]), default="truth", show_default=True,
-                      help="facts from the ground truth or from perception + grounding")
+_facts = click.option("--facts", type=click.Choice(["truth", "pipeline"]), default=None,
+                      help="facts from perception + grounding (pipeline, the default) or, on a rendered data set "
+                           "only, from its ground truth (truth)")
+_cache = click.option("--cache", type=click.Path(path_type=Path), default=None,
+                      help="folder caching the facts of real frames (default $XDG_CACHE_HOME/lv3d or ~/.cache/lv3d)")
 
 
 @learn.command()
 @_data
 @_modality
 @_facts
+@_cache
 @click.option("--classes", default=None, help="comma-separated classes to learn (default: all in the data)")
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="directory for the programs")
 @click.option("--seed", type=click.IntRange(0, 2 ** 32 - 1), default=0, show_default=True)
 @click.option("--time-limit", type=click.FloatRange(0, 86400, min_open=True), default=None, help="seconds per class")
-def fit(data: Path, modality: str, facts: str, classes: str | None, out: Path, seed: int, time_limit: float | None):
-    """Learn one program per class and save them as .pl files in OUT."""
+def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classes: str | None, out: Path, seed: int,
+        time_limit: float | None):
+    """Learn one program per class and save them as .pl files in OUT. Examples where perception found no
+    object are left out (counted)."""
     from ..output import check_out, replacing
     from ..learn.model import Model
 
@@ -135,10 +190,19 @@ def fit(data: Path, modality: str, facts: str, classes: str | None, out: Path, s
     wanted = [c.strip() for c in classes.split(",") if c.strip()] if classes is not None else None
     if wanted is not None and not wanted:
         raise InputError("--classes", "no class given")
-    scenes, labels = _dataset_scenes(data, modality, facts)
+    scenes, labels = _dataset_scenes(data, modality, facts, cache)
     for c in wanted or ():
         if c not in labels:
-            raise InputError("--classes", f"no item of {data} is a {c!r}; its classes: {', '.join(sorted(set(labels)))}")
+            raise InputError("--classes", f"no example of {data} is a {c!r}; its classes: {', '.join(sorted(set(labels)))}")
+    scenes, labels, left_out = _learnable(scenes, labels)
+    if left_out:
+        click.echo(f"% {left_out} example(s) left out: perception found no object there", err=True)
+    if not scenes:
+        raise click.ClickException(f"{data}: perception found no object in any example; nothing to learn from")
+    present = set(labels)
+    lost = [c for c in (wanted or []) if c not in present]
+    if lost:
+        raise click.ClickException(f"perception found no object in any example of {', '.join(lost)}")
     settings = {"time_limit": time_limit} if time_limit is not None else None
     model = Model.fit(scenes, labels, settings=settings, seed=seed, classes=wanted)
     if not model.programs and model.failures:  # nothing learned: no empty model is saved
@@ -146,6 +210,7 @@ def fit(data: Path, modality: str, facts: str, classes: str | None, out: Path, s
         raise click.ClickException(f"no program learned for any class ({why})")
     with replacing(out, (data,)) as tmp:  # written beside OUT, then moved into its place
         model.save(tmp)
+    click.echo(f"% learned from {len(scenes)} examples ({', '.join(f'{c} {labels.count(c)}' for c in sorted(present))})")
     for c, p in model.programs.items():
         if p.target != c:
             click.echo(f"% {c}: learned as {p.target}, since {c} names a body predicate")
@@ -155,14 +220,7 @@ def fit(data: Path, modality: str, facts: str, classes: str | None, out: Path, s
         click.echo(f"no program for {c}: {why}", err=True)
 
 
-@learn.command()
-@_data
-@_modality
-@_facts
-@click.option("--model", "model_dir", type=click.Path(path_type=Path), required=True)
-@click.option("--explain/--no-explain", default=False, help="print each answer's proof")
-def predict(data: Path, modality: str, facts: str, model_dir: Path, explain: bool):
-    """Classify every item of a data set with saved programs; print accuracy."""
+def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path):
     from ..learn.model import Model
 
     model = Model.load(model_dir)
@@ -172,10 +230,27 @@ def predict(data: Path, modality: str, facts: str, model_dir: Path, explain: boo
     if learned and learned != [modality]:
         raise InputError("--modality", f"the model in {model_dir} was learned from {', '.join(learned)} facts; "
                                        f"predict with --modality {learned[0]}")
-    scenes, labels = _dataset_scenes(data, modality, facts)
+    scenes, labels = _dataset_scenes(data, modality, facts, cache)
+    return model, scenes, labels
+
+
+@learn.command()
+@_data
+@_modality
+@_facts
+@_cache
+@click.option("--model", "model_dir", type=click.Path(path_type=Path), required=True)
+@click.option("--explain/--no-explain", default=False, help="print each answer's proof")
+def predict(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path, explain: bool):
+    """Classify every example of a data set or folder with saved programs; print accuracy. An example where
+    perception found no object is answered "unknown" (and counts as wrong)."""
+    model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir)
     correct = 0
     for s, y in zip(scenes, labels):
-        if explain:
+        if s.target is None:
+            label, conf = "unknown", 0.0
+            click.echo(f"{s.scene}\t{y}\t{label}\t{conf:.3f}")
+        elif explain:
             e = model.explain(s)
             label, conf = e.label, e.confidence
             click.echo(f"{s.scene} ({y}): {e}")
@@ -185,3 +260,27 @@ def predict(data: Path, modality: str, facts: str, model_dir: Path, explain: boo
         correct += label == y
     click.echo(f"accuracy {correct}/{len(scenes)} = {correct / len(scenes):.3f}")
 
+
+@learn.command()
+@_data
+@_modality
+@_facts
+@_cache
+@click.option("--model", "model_dir", type=click.Path(path_type=Path), required=True)
+@click.option("--example", "examples", multiple=True, metavar="ID",
+              help="explain this example only (an id predict prints; repeatable; default: every example)")
+def explain(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path,
+            examples: tuple[str, ...]):
+    """Print why each example gets its label: the program that proves it and the facts (with confidences)
+    the proof used."""
+    model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir)
+    by_id = {s.scene: (s, y) for s, y in zip(scenes, labels)}
+    unknown = [e for e in examples if e not in by_id]
+    if unknown:
+        raise InputError("--example", f"no example {unknown[0]!r} in {data}; e.g. {', '.join(list(by_id)[:5])}")
+    for i in examples or list(by_id):
+        s, y = by_id[i]
+        if s.target is None:
+            click.echo(f"{i} ({y}): unknown: perception found no object under its labelled pixel")
+            continue
+        click.echo(f"{i} ({y}): {model.explain(s)}")

@@ -22,7 +22,7 @@ def test_extract_writes_scene_and_overlay(tmp_path, box_frame):
     rc = main(["extract", str(c), "--depth", str(d), "--intrinsics", str(k), "--modality", "rgbd", "--out", str(out)])
     assert rc == 0
     scene = json.loads((out / "scene.json").read_text())
-    assert scene["modality"] == "rgbd" and scene["target"] == "s000000_o1"
+    assert scene["modality"] == "rgbd" and scene["target"] == "box_o1"  # the scene is named after the frame
     assert len(scene["objects"][0]["faces"]) == 3
     assert cv2.imread(str(out / "overlay.png")).shape == (240, 320, 3)
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".out")]  # no temporary folder left
@@ -103,3 +103,17 @@ def test_extract_caps_objects_and_says_how_many_it_left_out(tmp_path, capsys):
     rc = main(["extract", str(c), "--depth", str(d), "--intrinsics", str(k), "--max-objects", "0",
                "--out", str(tmp_path / "out2")])
     assert rc == 2 and "--max-objects" in capsys.readouterr().err
+
+
+def test_extract_names_the_scene_after_a_frame_whose_name_is_no_prolog_atom(tmp_path, box_frame):
+    c, d, k = _write_frame(tmp_path, box_frame[0])
+    c2, d2 = tmp_path / "frame-000000_rgb.png", tmp_path / "frame-000000_depth.png"
+    c.rename(c2)
+    d.rename(d2)
+    out = tmp_path / "out"
+    assert main(["extract", str(c2), "--depth", str(d2), "--intrinsics", str(k), "--modality", "rgbd",
+                 "--out", str(out), "--facts"]) == 0
+    scene = json.loads((out / "scene.json").read_text())
+    assert scene["id"].startswith("frame_000000_") and scene["target"].startswith(scene["id"])
+    facts = json.loads((out / "facts.json").read_text())
+    assert facts["scene"] == scene["id"] and facts["facts"]
