@@ -15,7 +15,7 @@ from typing import Iterable
 
 from .errors import InputError
 
-SCHEMA = "lv3d.facts/1"
+SCHEMA = "lv3d.facts/2"
 
 # predicate name -> (arity, modalities that may emit it). The same table drives the learner's
 # body predicates, so all three systems share one vocabulary and differ only in what they see.
@@ -28,6 +28,8 @@ PREDICATES: dict[str, tuple[int, frozenset[str]]] = {
     "quadrilateral": (1, frozenset({"rgb", "depth", "rgbd"})),
     "pentagon": (1, frozenset({"rgb", "depth", "rgbd"})),
     "hexagon": (1, frozenset({"rgb", "depth", "rgbd"})),
+    # the face is a curved surface: the side of a cylinder (a can, a tin, a cup); needs depth
+    "cylindrical": (1, frozenset({"depth", "rgbd"})),
     # 2D shape of the image polygon
     "parallelogram": (1, frozenset({"rgb", "rgbd"})),
     # metric shape of the face on its plane (depth, rgbd); for colour alone, the same tests on the image

@@ -195,3 +195,19 @@ def test_rgbd_judges_a_face_depth_found_against_depth_edges_where_colour_has_non
     near = (slice(shared[1] - 2, shared[1] + 3), slice(shared[0] - 2, shared[0] + 3))
     np.testing.assert_array_equal(filled[near], colour_only[near])
     assert np.array_equal(filled[:20], colour_only[:20])
+
+
+def test_curved_evidence_tells_a_can_side_from_a_flat_face():
+    from lv3d.cylinder import Cylinder
+    from lv3d.describe import curved_evidence
+
+    rng = np.random.default_rng(0)
+    cyl = Cylinder((0.0, 1.0, 0.0), (0.0, 0.0, 1.0), 0.04)
+    ang = rng.uniform(-1.2, 1.2, 2000)  # the front 140 deg of a can of radius 4 cm, 1 mm noise
+    side = np.stack([0.04 * np.sin(ang), rng.uniform(-0.05, 0.05, 2000), 1.0 - 0.04 * np.cos(ang)], 1)
+    side += rng.normal(0, 0.001, side.shape)
+    flat = np.stack([rng.uniform(-0.04, 0.04, 2000), rng.uniform(-0.05, 0.05, 2000), np.full(2000, 0.96)], 1)
+    flat += rng.normal(0, 0.001, flat.shape)
+    assert curved_evidence(side, cyl) > 0.9
+    assert curved_evidence(flat, Cylinder((0.0, 1.0, 0.0), (0.0, 0.0, 1.0), 0.04)) < 0.05
+    assert curved_evidence(side[:5], cyl) is None
