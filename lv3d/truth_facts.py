@@ -69,7 +69,13 @@ def _face_shape(poly_px: np.ndarray, poly_3d: np.ndarray) -> list[str]:
 
 def _exact_facts(truth: dict, k: dict, scene_id: str, modality: str = "rgbd") -> list[Fact]:
     """Every fact of the contract that the ground truth supports, confidence 1; for colour alone the shape
-    facts of the image polygon (lv3d.image_shape) in place of the metric ones."""
+    facts of the image polygon (lv3d.image_shape) in place of the metric ones.
+
+    Faces of the curved solids (a ``surface`` in the truth): a cylinder's side is ``cylindrical`` (value:
+    its radius, as perception gives it) and has no plane, so no plane facts; a cone's side and a sphere have
+    no predicate of their own and get only ``face_of`` and their adjacency. Their ``sides`` is 0: a circular
+    cap or base is planar (``horizontal`` / ``vertical`` and the plane pairs hold) but has no side count,
+    no corners and no polygon shape (its outline is sampled along a curve, not a polygon)."""
     o = object_id(scene_id, 1)
     facts = [Fact("object", (o,), 1.0)]
     up = np.asarray(truth["support_plane"]["normal"], float)
@@ -79,17 +85,23 @@ def _exact_facts(truth: dict, k: dict, scene_id: str, modality: str = "rgbd") ->
             continue
         fid = face_id(scene_id, 1, int(f["id"]))
         names[int(f["id"])] = fid
+        facts.append(Fact("face_of", (o, fid), 1.0))
+        surface = f.get("surface", {"type": "plane"})
+        if surface["type"] == "cylinder":
+            facts.append(Fact("cylindrical", (fid,), 1.0, float(surface["radius"])))
+        if surface["type"] != "plane":
+            continue
         n = np.asarray(f["plane"]["normal"], float)
         normals[int(f["id"])] = n
-        facts.append(Fact("face_of", (o, fid), 1.0))
         if int(f["sides"]) in SIDES:
             facts.append(Fact(SIDES[int(f["sides"])], (fid,), 1.0, float(f["sides"])))
-        poly = np.asarray(f["polygon"], float)
-        poly3 = _on_plane(poly, n, float(f["plane"]["offset"]), k)
-        shape = _face_shape(poly, poly3)
-        if modality == "rgb":
-            shape = [p for p in shape if p not in ("square", "rectangle", "regular")] + exact_image_shape(poly)
-        facts += [Fact(p, (fid,), 1.0) for p in shape]
+        if int(f["sides"]) >= 3:  # a face bounded by a curve has no corners and no polygon shape
+            poly = np.asarray(f["polygon"], float)
+            poly3 = _on_plane(poly, n, float(f["plane"]["offset"]), k)
+            shape = _face_shape(poly, poly3)
+            if modality == "rgb":
+                shape = [p for p in shape if p not in ("square", "rectangle", "regular")] + exact_image_shape(poly)
+            facts += [Fact(p, (fid,), 1.0) for p in shape]
         tilt = _angle_deg(n, up)
         if tilt <= PLANE_ANGLE_DEG:
             facts.append(Fact("horizontal", (fid,), 1.0, tilt))
@@ -106,7 +118,7 @@ def _exact_facts(truth: dict, k: dict, scene_id: str, modality: str = "rgbd") ->
                 facts.append(Fact("acute", (x, y), 1.0, d))
             elif d > OBTUSE_ABOVE_DEG:
                 facts.append(Fact("obtuse", (x, y), 1.0, d))
-    for i, j in itertools.combinations(sorted(names), 2):
+    for i, j in itertools.combinations(sorted(normals), 2):
         # visible faces of a convex solid face the camera, so plane normals are outward normals
         d = 180.0 - _angle_deg(normals[i], normals[j])
         for x, y in ((names[i], names[j]), (names[j], names[i])):

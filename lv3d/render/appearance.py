@@ -4,7 +4,9 @@ printed like packaging (label panels, bands, a round logo, rows of text-like blo
 Prints are drawn in each face's own plane (metres), so they follow the face's perspective, lighting
 and shadows exactly; they change the albedo only, never the geometry or the truth (a printed label is
 no face). A face's frame: origin at the centroid of its vertices, ``s`` along its longest edge,
-``t`` = normal x ``s`` in the face's plane.
+``t`` = normal x ``s`` in the face's plane. A curved face (a cylinder's, a cone's side, a sphere) is
+printed on its unrolled surface: its frame is the object frame, and (s, t) are the arc length round the
+axis and the height along it (:meth:`lv3d.render.curved.Curved.print_coords`), so a label wraps round a can.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .curved import Curved
 from .raycast import Hits, ray_planes
 from .solids import Solid
 
@@ -59,16 +62,22 @@ class TextBlock:
 @dataclass(frozen=True)
 class Print:
     """The design printed on one face: ``frame`` (4, 4) maps face coordinates (s, t, 0) into the object
-    frame; ``shapes`` are painted in order, then ``text``."""
+    frame; ``shapes`` are painted in order, then ``text``. ``wrap``: the curved surface whose unrolled
+    coordinates (s, t) are (``frame`` is then the object frame), None for a planar face."""
 
     frame: np.ndarray
     shapes: tuple[Shape, ...]
     text: tuple[TextBlock, ...]
+    wrap: Curved | None = None
 
 
 def face_frame(solid: Solid, face: int) -> tuple[np.ndarray, np.ndarray]:
     """The frame of face ``face`` ((4, 4), face coordinates into the object frame) and the face's polygon
-    (m, 2) in face coordinates (metres)."""
+    (m, 2) in face coordinates (metres); of a curved face, the object frame and its unrolled rectangle."""
+    if solid.curved is not None:
+        if solid.curved.face_kinds()[face] != "plane":
+            return np.eye(4), solid.curved.unrolled(face)
+        face = solid.rep_facet(face)
     v = solid.vertices[list(solid.faces[face])]
     n = solid.normals()[face]
     edges = np.roll(v, -1, axis=0) - v
@@ -162,13 +171,16 @@ def design(solid: Solid, face: int, base_rgb, rng: np.random.Generator) -> Print
             block = _text(a, a + ws, b, b + hs, ground, rng)
             if block is not None:
                 text.append(block)
-    return Print(frame, tuple(shapes), tuple(text))
+    wrap = None
+    if solid.curved is not None and solid.curved.face_kinds()[face] != "plane":
+        wrap = solid.curved
+    return Print(frame, tuple(shapes), tuple(text), wrap)
 
 
 def design_prints(solid: Solid, albedo: np.ndarray, share: float, rng: np.random.Generator) -> dict[int, Print]:
     """Designs for the faces of ``solid`` (albedo (faces, 3)), each face printed with probability ``share``."""
     out = {}
-    for i in range(len(solid.faces)):
+    for i in range(solid.n_faces):
         if rng.random() < share:
             out[i] = design(solid, i, albedo[i], rng)
     return out
@@ -219,7 +231,10 @@ def paint_prints(albedo: np.ndarray, hits: Hits, prints: list[tuple[int, np.ndar
             continue
         z, rx, ry = z_all[idx], rx_all[idx], ry_all[idx]
         a = cam_to_face.astype(np.float32)
-        s, t = (z * (a[i, 0] * rx + a[i, 1] * ry + a[i, 2]) + a[i, 3] for i in range(2))
+        if pr.wrap is None:
+            s, t = (z * (a[i, 0] * rx + a[i, 1] * ry + a[i, 2]) + a[i, 3] for i in range(2))
+        else:
+            s, t = pr.wrap.print_coords(*(z * (a[i, 0] * rx + a[i, 1] * ry + a[i, 2]) + a[i, 3] for i in range(3)))
         col = flat[idx]
         for sh in pr.shapes:
             if sh.kind == "rect":

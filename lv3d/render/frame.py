@@ -84,16 +84,16 @@ def render_scene(cls: str, seed: int, noise: str | NoiseConfig = "clean", width:
     for role, placed in objects:
         roles.append(role)
         body = Body(placed.solid, w2c @ placed.to_world)
-        n_faces = len(placed.solid.faces)
+        n_faces = placed.solid.n_faces
         alb = object_albedo(n_faces, paint_rng if role == "contact" else look_rng)
         if cfg.face_hues > 0 and paint_rng.random() < cfg.face_hues:
             alb = multi_hue_albedo(n_faces, paint_rng)
         if cfg.printed_faces > 0:
             first = sum(len(b.solid.faces) for b in bodies)  # the body's first flat face index
             for face, pr in design_prints(placed.solid, alb, cfg.printed_faces, paint_rng).items():
-                prints.append((first + face, np.linalg.inv(body.to_camera @ pr.frame), pr))
+                prints.append((first + placed.solid.rep_facet(face), np.linalg.inv(body.to_camera @ pr.frame), pr))
         bodies.append(body)
-        albedo.append(alb)
+        albedo.append(alb if placed.solid.facet_face is None else alb[placed.solid.face_ids()])
     target_index = roles.index("target")
 
     # the light comes from the camera's side of the scene, so the wall behind the table cannot shade it all
@@ -109,6 +109,10 @@ def render_scene(cls: str, seed: int, noise: str | NoiseConfig = "clean", width:
     if cfg.grazing_deg < 90:
         offset = np.take(np.append(hits.face_offset, 1.0).astype(np.float32), hits.gface)
         cos_inc = np.abs(offset) / np.maximum(hits.depth * ray_lengths(k), np.float32(1e-9))
+        if len(hits.curved_idx):  # curved faces: the true normal at each pixel
+            ray = hits.rays.reshape(-1, 3)[hits.curved_idx].astype(np.float64)
+            cos = np.abs(np.einsum("mc,mc->m", hits.curved_normal, ray)) / np.linalg.norm(ray, axis=1)
+            cos_inc.ravel()[hits.curved_idx] = cos.astype(np.float32)
     depth = noisy_depth(hits.depth, cos_inc, cfg, noise_rng, fx=k.fx, sensor_rng=sensor_rng)
     color8 = noisy_color(color, cfg, noise_rng)
     mask = np.where(hits.body == target_index, hits.face + 1, 0).astype(np.uint8)

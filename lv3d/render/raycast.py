@@ -6,7 +6,7 @@ Rays leave the camera centre with direction ((u - cx)/fx, (v - cy)/fy, 1), so th
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import cv2
@@ -24,7 +24,10 @@ class Hits:
     into the bodies cast against and ``face`` the face id within it (-1 = none); ``gface`` the face's
     index into the flat per-face tables ``face_normal`` (F, 3) (camera-frame outward unit normals) and
     ``face_offset`` (F,) (n . X + offset = 0 on the face's plane). ``shadow``: float32 in 0..1, the
-    fraction of the light blocked (all 0 when no light was given)."""
+    fraction of the light blocked (all 0 when no light was given). The flat tables hold a curved solid's
+    facets; its pixels get the first facet of the face they see, and the pixels on a curved face are
+    listed in ``curved_idx`` (flat pixel indices, ascending) with the true surface's camera-frame outward
+    unit normal in ``curved_normal`` (m, 3) float64."""
 
     depth: np.ndarray
     body: np.ndarray
@@ -34,6 +37,8 @@ class Hits:
     face_offset: np.ndarray
     shadow: np.ndarray  # (H, W) float32 0..1
     rays: np.ndarray  # (H, W, 3) float32 pixel ray directions with z = 1
+    curved_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    curved_normal: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     def points(self) -> np.ndarray:
         """(H, W, 3) float32 camera-frame hit points (metres); zeros where nothing was hit."""
@@ -110,14 +115,14 @@ def raycast(bodies: list[Body], k: Intrinsics, light_cam: np.ndarray | None = No
     face_base = np.cumsum([0] + [len(b.solid.faces) for b in bodies])
     # per flat face: its body and its id within the body; a last entry -1 answers gface = -1 (nothing hit)
     face_body = np.append(np.repeat(np.arange(len(bodies), dtype=np.int32), np.diff(face_base)), np.int32(-1))
-    face_id = np.append(np.concatenate([np.arange(len(b.solid.faces), dtype=np.int32) for b in bodies]),
-                        np.int32(-1))
+    face_id = np.append(np.concatenate([b.solid.face_ids() for b in bodies]), np.int32(-1))
     normals = np.concatenate([b.normals() for b in bodies])
     offsets_f = np.concatenate([-np.einsum("fc,fc->f", b.normals(), b.vertices()[[f[0] for f in b.solid.faces]])
                                 for b in bodies])
     depth, gface = _fill_background(bodies[:background], normals, offsets_f, k)
 
     solids = bodies[background:]
+    scene = None
     if solids:
         scene, offsets, tri_body, tri_face = build_scene(solids)
         idx = _silhouette_pixels(solids, k)
@@ -129,14 +134,83 @@ def raycast(bodies: list[Body], k: Intrinsics, light_cam: np.ndarray | None = No
             tri = offsets[out["geometry_ids"].numpy()[hit]] + out["primitive_ids"].numpy()[hit]
             depth.ravel()[idx] = t
             gface.ravel()[idx] = face_base[background + tri_body[tri]] + tri_face[tri]
+    curved_idx, curved_normal = _exact_curved(bodies, face_base, face_body, depth, gface, k)
     depth[gface < 0] = 0  # inf where nothing was hit
     body = np.take(face_body, gface)
     face = np.take(face_id, gface)
     if light_cam is not None:
-        shadow = soft_shadow(bodies, gface, normals, offsets_f, face_body[:-1], k, np.asarray(light_cam, float))
+        light = np.asarray(light_cam, float)
+        not_receiver, extra = None, None
+        if len(curved_idx):  # curved faces take their shadows from shadow rays, not from the polygons
+            not_receiver = np.zeros(len(normals), bool)
+            for i, b in enumerate(bodies):
+                if b.solid.curved is not None:
+                    flat = b.solid.planar_facets()
+                    not_receiver[face_base[i]:face_base[i + 1]] = True
+                    not_receiver[[face_base[i] + f for f in flat]] = False
+            extra = _curved_shadow(scene, background, curved_idx, curved_normal, body.ravel()[curved_idx],
+                                   depth, k, light, nthreads)
+        shadow = soft_shadow(bodies, gface, normals, offsets_f, face_body[:-1], k, light, not_receiver, extra)
     else:
         shadow = np.zeros(depth.shape, np.float32)
-    return Hits(depth, body, face, gface, normals, offsets_f, shadow, pixel_rays(k))
+    return Hits(depth, body, face, gface, normals, offsets_f, shadow, pixel_rays(k), curved_idx, curved_normal)
+
+
+def _exact_curved(bodies: list[Body], face_base: np.ndarray, face_body: np.ndarray, depth: np.ndarray,
+                  gface: np.ndarray, k: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
+    """Ray cast again, against their exact shapes, the pixels that see a curved solid's tessellation: their
+    depth and face (``depth`` and ``gface`` changed in place: the face's first facet). Returns the flat
+    indices (ascending) of the pixels on curved faces and the true outward normals there (camera frame).
+    A ray that meets the inscribed tessellation meets the true solid (a little nearer)."""
+    idx_all, n_all = [], []
+    curved = [i for i, b in enumerate(bodies) if b.solid.curved is not None]
+    if not curved:
+        return np.zeros(0, np.int64), np.zeros((0, 3))
+    owner = np.take(face_body, gface).ravel()
+    rays = pixel_rays(k).reshape(-1, 3)
+    for i in curved:
+        b = bodies[i]
+        idx = np.flatnonzero(owner == i)
+        if len(idx) == 0:
+            continue
+        rot, t = b.to_camera[:3, :3], b.to_camera[:3, 3]
+        o = -rot.T @ t
+        d = rays[idx].astype(np.float64) @ rot  # rows: rot.T @ ray
+        z, face = b.solid.curved.intersect(o, d)
+        ok = face >= 0  # (a miss would be rounding at the rim: the tessellation's hit stays)
+        idx, z, face, d = idx[ok], z[ok], face[ok], d[ok]
+        depth.ravel()[idx] = z.astype(np.float32)
+        reps = np.array([b.solid.rep_facet(f) for f in range(b.solid.n_faces)])
+        gface.ravel()[idx] = face_base[i] + reps[face]
+        kinds = np.array(b.solid.curved.face_kinds())
+        on_curve = kinds[face] != "plane"
+        p = o + z[on_curve, None] * d[on_curve]
+        idx_all.append(idx[on_curve])
+        n_all.append(b.solid.curved.normal(p, face[on_curve]) @ rot.T)
+    if not idx_all:
+        return np.zeros(0, np.int64), np.zeros((0, 3))
+    idx, n = np.concatenate(idx_all), np.concatenate(n_all)
+    order = np.argsort(idx, kind="stable")
+    return idx[order], n[order]
+
+
+def _curved_shadow(scene, background: int, idx: np.ndarray, normal: np.ndarray, owner: np.ndarray,
+                   depth: np.ndarray, k: Intrinsics, light: np.ndarray, nthreads: int) -> np.ndarray:
+    """(H, W) uint8: 1 where a point of a curved face that turns to the light sees another solid on the way
+    to it (one shadow ray per pixel, from 0.1 mm off the surface; the tables, floor and wall cast none here)."""
+    out = np.zeros(depth.shape, np.uint8)
+    lit = normal @ light > 0
+    idx, normal, owner = idx[lit], normal[lit], owner[lit]
+    if len(idx) == 0 or scene is None:
+        return out
+    p = pixel_rays(k).reshape(-1, 3)[idx].astype(np.float64) * depth.ravel()[idx, None] + 1e-4 * normal
+    r = np.concatenate([p, np.broadcast_to(light, p.shape)], axis=1).astype(np.float32)
+    hit = scene.cast_rays(o3d.core.Tensor(r), nthreads=nthreads)
+    t = hit["t_hit"].numpy()
+    gid = hit["geometry_ids"].numpy().astype(np.int64)
+    blocked = np.isfinite(t) & (gid + background != owner)
+    out.ravel()[idx[blocked]] = 1
+    return out
 
 
 def _silhouette_pixels(bodies: list[Body], k: Intrinsics) -> np.ndarray:

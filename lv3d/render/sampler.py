@@ -10,7 +10,7 @@ import numpy as np
 
 from ..camera import Intrinsics
 from .noise import NoiseConfig
-from .solids import CLASSES, Solid, box, make_solid, prism
+from .solids import POLYHEDRA, Solid, box, make_solid, prism
 
 FLOOR_Z_M = -0.75
 TABLE_THICKNESS_M = 0.03
@@ -84,11 +84,14 @@ def rot_z(angle: float) -> np.ndarray:
 
 def rest(solid: Solid, face: int, yaw: float, xy: np.ndarray) -> Placed:
     """Stand ``solid`` on its face ``face`` on the table (z = 0), turned by ``yaw`` about the vertical,
-    with the centre of its footprint's bounding vertices at ``xy``."""
-    r = rot_z(yaw) @ rotation_between(solid.normals()[face], np.array([0, 0, -1.0]))
+    with the centre of its footprint's bounding vertices at ``xy``. A curved solid stands on its exact
+    shape (a cap, the cone's base, the sphere's lowest point, a cylinder's side along a line)."""
+    down = solid.normals()[face] if solid.curved is None else solid.curved.rest_normal(face)
+    r = rot_z(yaw) @ rotation_between(down, np.array([0, 0, -1.0]))
     v = solid.vertices @ r.T
     centre = np.array([(v[:, 0].max() + v[:, 0].min()) / 2, (v[:, 1].max() + v[:, 1].min()) / 2])
-    t = np.array([xy[0] - centre[0], xy[1] - centre[1], -v[:, 2].min()])
+    low = v[:, 2].min() if solid.curved is None else solid.curved.support(r[2])
+    t = np.array([xy[0] - centre[0], xy[1] - centre[1], -low])
     m = np.eye(4)
     m[:3, :3], m[:3, 3] = r, t
     return Placed(solid, m, face)
@@ -130,10 +133,38 @@ def _axes(p: Placed) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return v, p.solid.normals() @ p.to_world[:3, :3].T, e / np.linalg.norm(e, axis=1, keepdims=True)
 
 
+def _sphere_overlaps(ball: Placed, other: Placed, tol: float) -> bool:
+    """Does a placed sphere share interior points with a placed convex polyhedron (or the tessellation of a
+    curved solid)? Its centre lies inside it, or nearer than the radius less ``tol`` to one of its faces."""
+    c = ball.to_world[:3, 3]
+    r = ball.solid.curved.radius
+    v = other.world_vertices()
+    n = other.solid.normals() @ other.to_world[:3, :3].T
+    dist = np.inf
+    inside = True
+    for i, f in enumerate(other.solid.faces):
+        p = v[list(f)]
+        h = float(n[i] @ (c - p[0]))
+        inside &= h <= 0
+        foot = c - h * n[i]  # the centre's foot on the face's plane: inside the loop, or nearest its edges
+        q = np.roll(p, -1, axis=0)
+        if np.all(np.einsum("ec,ec->e", np.cross(q - p, foot - p), np.broadcast_to(n[i], p.shape)) >= 0):
+            dist = min(dist, abs(h))
+            continue
+        e = q - p
+        s = np.clip(np.einsum("ec,ec->e", c - p, e) / np.einsum("ec,ec->e", e, e), 0, 1)
+        dist = min(dist, float(np.linalg.norm(p + s[:, None] * e - c, axis=1).min()))
+    return bool(inside or dist < r - tol)
+
+
 def overlaps(a: Placed, b: Placed, tol: float = 1e-7) -> bool:
     """Do two placed convex solids share interior points? Separating-axis test over the face normals of
     both and the cross products of their edge directions (exact for convex polyhedra); solids that only
-    touch (a gap of up to ``tol`` metres either way) do not overlap."""
+    touch (a gap of up to ``tol`` metres either way) do not overlap. A cylinder or cone is tested by its
+    tessellation (exact to its sagitta, under 0.1 mm); a sphere exactly, by its centre's distance."""
+    for ball, other in ((a, b), (b, a)):
+        if ball.solid.curved is not None and ball.solid.curved.kind == "sphere":
+            return _sphere_overlaps(ball, other, tol)
     va, na, ea = _axes(a)
     vb, nb, eb = _axes(b)
     cross = np.cross(ea[:, None, :], eb[None, :, :]).reshape(-1, 3)
@@ -171,8 +202,13 @@ def slide_to_contact(mover: Placed, fixed: list[Placed], direction: np.ndarray, 
 
 
 def _top_face(p: Placed) -> int | None:
-    """The id of the face of a placed solid that faces straight up (None if none does)."""
+    """The index into ``faces`` of the planar face of a placed solid that faces straight up (None if none
+    does; a curved solid's facets are no faces)."""
     n = p.solid.normals() @ p.to_world[:3, :3].T
+    if p.solid.curved is not None:
+        flat = p.solid.planar_facets()
+        i = flat[int(np.argmax(n[flat, 2]))] if flat else 0
+        return i if flat and n[i, 2] > 1 - 1e-6 else None
     i = int(np.argmax(n[:, 2]))
     return i if n[i, 2] > 1 - 1e-6 else None
 
@@ -255,7 +291,7 @@ def sample_layout(cls: str, cfg: NoiseConfig, k: Intrinsics, rng: np.random.Gene
     placed: list[Placed] = [target]
     if cfg.touching > 0 and extra_rng.random() < cfg.touching:
         # a solid against the stack, beside or behind it as the camera sees it (like clutter)
-        solid = make_solid(str(extra_rng.choice(CLASSES)), extra_rng, scale=float(extra_rng.uniform(0.6, 1.0)))
+        solid = make_solid(str(extra_rng.choice(POLYHEDRA)), extra_rng, scale=float(extra_rng.uniform(0.6, 1.0)))
         mover = _stand(solid, extra_rng, target.centre_xy())
         ang = az + np.pi + extra_rng.uniform(-0.6, 0.6) * np.pi
         stack_parts = [target] + [c.placed for c in contacts]
@@ -267,7 +303,7 @@ def sample_layout(cls: str, cfg: NoiseConfig, k: Intrinsics, rng: np.random.Gene
     placed += [c.placed for c in contacts if c.relation != "on_target"]  # what stands on the table
     clutter = []
     for _ in range(cfg.clutter):
-        solid = make_solid(str(rng.choice(CLASSES)), rng, scale=float(rng.uniform(0.5, 0.9)))
+        solid = make_solid(str(rng.choice(POLYHEDRA)), rng, scale=float(rng.uniform(0.5, 0.9)))
         for _try in range(20):
             # beside or behind the target as the camera sees it, so clutter does not hide it
             ang = az + np.pi + rng.uniform(-0.7, 0.7) * np.pi

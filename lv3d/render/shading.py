@@ -124,8 +124,9 @@ def _table(hits: Hits, low: _LowRes, idx: np.ndarray, cam_to_table: np.ndarray, 
 def shade(hits: Hits, layout: Layout, roles: list[str], albedo: list[np.ndarray], light_cam: np.ndarray,
           cfg: NoiseConfig, rng: np.random.Generator, prints: list | None = None) -> np.ndarray:
     """(H, W, 3) float32 RGB 0..255 of the scene. ``roles``: per body 'table', 'floor', 'wall' or an object
-    role; ``albedo``: per body (faces, 3) albedo in 0..1. Albedo and Lambert term are per face (flat
-    faces, directional light), looked up through ``hits.gface``; printed designs (``prints``, see
+    role; ``albedo``: per body (faces, 3) albedo in 0..1 (a curved solid: per facet). Albedo and Lambert
+    term are per face (flat faces, directional light), looked up through ``hits.gface``, but per pixel on
+    curved faces (``hits.curved_normal``); printed designs (``prints``, see
     :func:`lv3d.render.appearance.paint_prints`) replace the albedo where they are; textures scale it
     per pixel."""
     f32 = np.float32
@@ -137,6 +138,9 @@ def shade(hits: Hits, layout: Layout, roles: list[str], albedo: list[np.ndarray]
     diffuse = (255 * (1.0 - ambient) * 1.1 * lambert).astype(np.float32)
     gface = hits.gface  # -1 (nothing hit) picks the last rows
     intensity = np.take(diffuse, gface)
+    if len(hits.curved_idx):  # curved faces: the true surface's normal at every pixel, smooth
+        lam = np.clip(hits.curved_normal @ light_cam, 0.0, None)
+        intensity.ravel()[hits.curved_idx] = (255 * (1.0 - ambient) * 1.1 * lam).astype(np.float32)
     if np.any(hits.shadow):
         intensity *= f32(1.0) - hits.shadow
     intensity += f32(255 * ambient)

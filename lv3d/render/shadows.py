@@ -7,7 +7,9 @@ hull of the projected vertices on that side plus the points where the caster's e
 Projected into the image, filled exactly at pixel centres and kept only on the pixels that see that
 face, it gives the same shadow as one shadow ray per pixel (tests/render/test_render_fast_paths.py)
 for the cost of a few polygon fills (open3d's shadow rays cost ~100 ns each). A convex solid never
-shadows its own lit faces, so a body is no caster for its own faces.
+shadows its own lit faces, so a body is no caster for its own faces. A curved solid casts the shadow of
+its tessellation; its curved faces are no receivers here: they get one shadow ray per pixel
+(:mod:`lv3d.render.raycast`), joined in through :func:`soft_shadow`'s ``extra``.
 """
 
 from __future__ import annotations
@@ -102,16 +104,21 @@ def _pixel_box(poly: np.ndarray, k: Intrinsics) -> tuple[np.ndarray, np.ndarray,
 
 
 def shadow_mask(bodies: list[Body], gface: np.ndarray, face_normal: np.ndarray, face_offset: np.ndarray,
-                face_body: np.ndarray, k: Intrinsics, light: np.ndarray) -> np.ndarray:
+                face_body: np.ndarray, k: Intrinsics, light: np.ndarray,
+                not_receiver: np.ndarray | None = None) -> np.ndarray:
     """(H, W) uint8: 1 where the point a pixel sees lies in the shadow of another body. ``gface``: (H, W)
     flat face index per pixel (-1 = none) into ``face_normal`` (F, 3), ``face_offset`` (F,) (camera
-    frame) and ``face_body`` (F,) (the body of each face); ``light``: (3,) unit vector to the light."""
+    frame) and ``face_body`` (F,) (the body of each face); ``light``: (3,) unit vector to the light.
+    ``not_receiver`` (F,) bool: faces left out as receivers (the facets of curved faces)."""
     h, w = gface.shape
     out = np.zeros((h, w), np.uint8)
     towards = face_normal @ light
     present = np.bincount(gface.ravel() + 1, minlength=len(face_normal) + 1)[1:] > 0
     # faces turned away get no direct light (a shadow changes nothing); unseen faces need none
-    receivers = np.flatnonzero((towards > 1e-6) & present & (face_offset > _EPS))
+    receiving = (towards > 1e-6) & present & (face_offset > _EPS)
+    if not_receiver is not None:
+        receiving &= ~not_receiver
+    receivers = np.flatnonzero(receiving)
     if len(receivers) == 0:
         return out
     first = np.concatenate([[0], np.cumsum([len(b.solid.faces) for b in bodies])])
@@ -156,10 +163,14 @@ def shadow_mask(bodies: list[Body], gface: np.ndarray, face_normal: np.ndarray, 
 
 
 def soft_shadow(bodies: list[Body], gface: np.ndarray, face_normal: np.ndarray, face_offset: np.ndarray,
-                face_body: np.ndarray, k: Intrinsics, light: np.ndarray) -> np.ndarray:
-    """(H, W) float32 in 0..1: the :func:`shadow_mask` with edges softened over about two pixels at
+                face_body: np.ndarray, k: Intrinsics, light: np.ndarray, not_receiver: np.ndarray | None = None,
+                extra: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) float32 in 0..1: the :func:`shadow_mask` (``not_receiver`` as there), joined with ``extra``
+    (H, W) uint8 when given (the shadows on curved faces), with edges softened over about two pixels at
     640x480 (a penumbra, and no staircase)."""
-    m = shadow_mask(bodies, gface, face_normal, face_offset, face_body, k, light)
+    m = shadow_mask(bodies, gface, face_normal, face_offset, face_body, k, light, not_receiver)
+    if extra is not None:
+        m |= extra
     out = np.zeros(m.shape, np.float32)
     rows, cols = np.flatnonzero(m.any(axis=1)), np.flatnonzero(m.any(axis=0))
     if len(rows) == 0:

@@ -1,9 +1,12 @@
-"""The solids of the data set as convex polyhedra with explicit faces.
+"""The solids of the data set: convex polyhedra with explicit faces, and curved solids (cylinder, cone,
+sphere) whose faces are tessellated and whose exact shape rides along (:mod:`lv3d.render.curved`).
 
 Object frame: metres, z up; the solid's resting faces are listed so that a sampler can stand it on
 the table. Each face is a loop of vertex indices ordered counter-clockwise seen from outside, so the
 right-hand rule gives its outward normal. Face ids are the positions in ``faces`` and are fixed per
 class (prisms: 0 = bottom base, 1 = top base, 2.. = lateral faces; pyramids: 0 = base, 1.. = lateral).
+A curved solid's ``faces`` are the facets of its tessellation; ``facet_face`` maps them to its faces
+(cylinder: 0 bottom cap, 1 top cap, 2 side; cone: 0 base, 1 side; sphere: 0).
 """
 
 from __future__ import annotations
@@ -14,9 +17,13 @@ from functools import cached_property
 import numpy as np
 
 from ..errors import InputError
+from .curved import CURVED_CLASSES, SEGMENTS, Curved, uv_sphere
 
-CLASSES = ("cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
-           "tetrahedron")
+# the polyhedra; clutter and the solids that touch the target are drawn from these alone, so that adding
+# classes changes no scene of the polyhedra
+POLYHEDRA = ("cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
+             "tetrahedron")
+CLASSES = POLYHEDRA + CURVED_CLASSES
 
 EDGE_RANGE_M = (0.06, 0.14)
 
@@ -25,13 +32,38 @@ EDGE_RANGE_M = (0.06, 0.14)
 class Solid:
     """A convex polyhedron. ``vertices``: (n, 3) metres, object frame. ``faces``: vertex-index loops,
     counter-clockwise seen from outside. ``resting``: ids of faces the solid may stand on.
-    ``size_m``: the sizes it was built from (named per class, metres)."""
+    ``size_m``: the sizes it was built from (named per class, metres). A curved solid also has
+    ``facet_face`` (the face each loop of ``faces``, a facet, belongs to) and ``curved`` (its exact shape)."""
 
     cls: str
     vertices: np.ndarray
     faces: tuple[tuple[int, ...], ...]
     resting: tuple[int, ...]
     size_m: dict = field(default_factory=dict)
+    facet_face: tuple[int, ...] | None = None
+    curved: Curved | None = None
+
+    @property
+    def n_faces(self) -> int:
+        """The number of faces (of a curved solid: its faces, not its facets)."""
+        return len(self.faces) if self.facet_face is None else max(self.facet_face) + 1
+
+    def face_ids(self) -> np.ndarray:
+        """The face id of each loop of ``faces`` (int32): 0, 1, 2, ... for a polyhedron."""
+        if self.facet_face is None:
+            return np.arange(len(self.faces), dtype=np.int32)
+        return np.asarray(self.facet_face, np.int32)
+
+    def rep_facet(self, face: int) -> int:
+        """The first facet of face ``face`` (a planar face of a curved solid is one facet: its whole loop)."""
+        return face if self.facet_face is None else self.facet_face.index(face)
+
+    def planar_facets(self) -> list[int]:
+        """The loops of ``faces`` that are whole planar faces: all of a polyhedron's, a curved solid's caps."""
+        if self.curved is None:
+            return list(range(len(self.faces)))
+        kinds = self.curved.face_kinds()
+        return [self.rep_facet(f) for f, k in enumerate(kinds) if k == "plane"]
 
     def normals(self) -> np.ndarray:
         """Outward unit normals (f, 3) of the faces, object frame (read-only, computed once per solid)."""
@@ -111,8 +143,31 @@ def tetrahedron(edge: float) -> Solid:
     return Solid("tetrahedron", s.vertices, s.faces, tuple(range(4)), {"edge": edge})
 
 
+def cylinder(radius: float, length: float) -> Solid:
+    """A cylinder of ``radius`` and ``length`` along z, centred at the origin (faces 0 bottom cap, 1 top cap,
+    2 side); tessellated as a prism over a ``SEGMENTS``-gon inscribed in its circles, a vertex at angle 0."""
+    s = prism(SEGMENTS, 2 * radius * np.sin(np.pi / SEGMENTS), length, "cylinder")
+    return Solid("cylinder", s.vertices, s.faces, (0, 1, 2), {"radius": radius, "length": length},
+                 (0, 1) + (2,) * SEGMENTS, Curved("cylinder", radius, length))
+
+
+def cone(radius: float, height: float) -> Solid:
+    """A right circular cone: base of ``radius`` at z = 0 (face 0), apex at z = ``height`` (face 1 the side);
+    tessellated as a pyramid over a ``SEGMENTS``-gon inscribed in the base circle."""
+    s = pyramid(SEGMENTS, 2 * radius * np.sin(np.pi / SEGMENTS), height, "cone")
+    return Solid("cone", s.vertices, s.faces, (0,), {"radius": radius, "height": height},
+                 (0,) + (1,) * SEGMENTS, Curved("cone", radius, height))
+
+
+def sphere(radius: float) -> Solid:
+    """A sphere of ``radius`` centred at the origin (one face), tessellated in bands of latitude."""
+    v, faces = uv_sphere(radius)
+    return Solid("sphere", v, faces, (0,), {"radius": radius}, (0,) * len(faces), Curved("sphere", radius))
+
+
 def make_solid(cls: str, rng: np.random.Generator, scale: float = 1.0) -> Solid:
-    """A solid of class ``cls`` with sizes drawn from this data set's ranges (edges 6-14 cm, times ``scale``)."""
+    """A solid of class ``cls`` with sizes drawn from this data set's ranges (edges 6-14 cm, times ``scale``;
+    the curved solids' diameters and lengths from the same range)."""
     lo, hi = EDGE_RANGE_M[0] * scale, EDGE_RANGE_M[1] * scale
 
     def edge() -> float:
@@ -137,4 +192,11 @@ def make_solid(cls: str, rng: np.random.Generator, scale: float = 1.0) -> Solid:
         return prism(n, float(rng.uniform(lo, e_max)), edge(), cls)
     if cls == "tetrahedron":
         return tetrahedron(edge())
+    if cls == "cylinder":
+        return cylinder(edge() / 2, edge())
+    if cls == "cone":  # height 0.6-1.2 x the base's diameter, like the square pyramid's
+        d = edge()
+        return cone(d / 2, d * float(rng.uniform(0.6, 1.2)))
+    if cls == "sphere":
+        return sphere(edge() / 2)
     raise InputError("class", f"unknown class {cls!r}; known: {', '.join(CLASSES)}")

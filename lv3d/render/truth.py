@@ -4,6 +4,12 @@ A face is listed when it faces the camera and covers at least ``MIN_FACE_PIXELS`
 mask. Its ``polygon`` is the whole 3D face projected to pixels (exact: a convex solid cannot hide its
 own front faces; only other objects and the image border can), ordered clockwise on screen, i.e. with
 a positive shoelace sum of (u, v); ``visible_fraction`` = mask pixels / polygon area.
+
+Faces of the curved solids (cylinder, cone, sphere) also carry ``surface`` (the exact surface in the
+camera frame: plane, cylinder, cone or sphere with its parameters); their ``polygon`` is the outline of
+the part that faces the camera, sampled along its curves (not convex for a cylinder's or a cone's side
+seen from above), and ``sides`` is 0: no face of theirs has straight sides. Their ``adjacency`` lists the
+faces that meet along a rim, with ``"edge": "circle"``.
 """
 
 from __future__ import annotations
@@ -40,6 +46,9 @@ def object_truth(body: Body, k: Intrinsics, mask: np.ndarray | None) -> dict:
            "object_to_camera": _r(body.to_camera)}
     if mask is None:
         return out
+    if body.solid.curved is not None:
+        out.update(_curved_faces(body, k, mask))
+        return out
     verts = body.vertices()
     normals = body.normals()
     counts = np.bincount(mask.ravel(), minlength=len(body.solid.faces) + 1)
@@ -65,6 +74,62 @@ def object_truth(body: Body, k: Intrinsics, mask: np.ndarray | None) -> dict:
             adjacency.append({"faces": [i, j], "dihedral_deg": round(dihedral_deg(normals[i], normals[j]), 4)})
     out.update(faces=faces, adjacency=adjacency)
     return out
+
+
+def _curved_faces(body: Body, k: Intrinsics, mask: np.ndarray) -> dict:
+    """The faces and adjacency of a curved solid (see the module's docstring)."""
+    shape = body.solid.curved
+    rot, t = body.to_camera[:3, :3], body.to_camera[:3, 3]
+    cam = -rot.T @ t  # the camera centre in the object frame
+    counts = np.bincount(mask.ravel(), minlength=body.solid.n_faces + 1)
+    faces, visible = [], set()
+    for i, kind in enumerate(shape.face_kinds()):
+        loop = shape.outline(i, cam)
+        n_px = int(counts[i + 1])
+        if loop is None or n_px < MIN_FACE_PIXELS:
+            continue
+        poly = k.project(loop @ rot.T + t)
+        if shoelace(poly) < 0:
+            poly = poly[::-1]
+        area = abs(shoelace(poly))
+        surface = shape.surface(i, body.to_camera)
+        visible.add(i)
+        entry = {"id": i, "sides": 0, "visible": True, "pixels": n_px, "polygon": _r(poly, 3),
+                 "visible_fraction": round(min(1.0, n_px / max(area, 1e-9)), 4), "surface": surface}
+        if kind == "plane":
+            entry["plane"] = {"normal": surface["normal"], "offset": surface["offset"]}
+        faces.append(entry)
+    adjacency = []
+    for a, b in shape.meeting():
+        if a in visible and b in visible:
+            na, nb = shape.rim_normals(a, b)
+            adjacency.append({"faces": [a, b], "dihedral_deg": round(dihedral_deg(na, nb), 4), "edge": "circle"})
+    return {"faces": faces, "adjacency": adjacency}
+
+
+def surface_distance(surface: dict, points: np.ndarray) -> np.ndarray:
+    """Unsigned distances (m,) of camera-frame points (m, 3) from a face's ``surface`` (its meta.json dict:
+    plane, cylinder, cone or sphere; a cone and a cylinder as infinite surfaces of their kind)."""
+    p = np.asarray(points, np.float64)
+    kind = surface["type"]
+    if kind == "plane":
+        return np.abs(p @ np.asarray(surface["normal"], float) + float(surface["offset"]))
+    if kind == "sphere":
+        return np.abs(np.linalg.norm(p - np.asarray(surface["centre"], float), axis=1) - float(surface["radius"]))
+    if kind == "cylinder":
+        a = np.asarray(surface["axis"], float)
+        q = p - np.asarray(surface["point"], float)
+        radial = np.linalg.norm(q - np.outer(q @ a, a), axis=1)
+        return np.abs(radial - float(surface["radius"]))
+    if kind == "cone":
+        a = np.asarray(surface["axis"], float)
+        q = p - np.asarray(surface["apex"], float)
+        along = q @ a
+        radial = np.linalg.norm(q - np.outer(along, a), axis=1)
+        half = np.radians(float(surface["half_angle_deg"]))
+        # distance from the cone's generator in the plane through the axis and the point
+        return np.abs(radial * np.cos(half) - along * np.sin(half))
+    raise ValueError(f"unknown surface type {kind!r}")
 
 
 def scene_truth(layout: Layout, target: Body, clutter: list[Body], occluder: Body | None,

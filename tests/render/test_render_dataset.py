@@ -65,8 +65,8 @@ def test_finished_set_is_returned_and_mismatch_refused(made):
 
 
 def test_bad_inputs(tmp_path):
-    with pytest.raises(InputError, match="unknown class 'sphere'"):
-        make_dataset(tmp_path / "a", **{**ARGS, "classes": ["cube", "sphere"]})
+    with pytest.raises(InputError, match="unknown class 'dodecahedron'"):
+        make_dataset(tmp_path / "a", **{**ARGS, "classes": ["cube", "dodecahedron"]})
     with pytest.raises(InputError, match="unknown noise preset 'fog'"):
         make_dataset(tmp_path / "a", **{**ARGS, "noise": "fog"})
     with pytest.raises(InputError, match="per-class"):
