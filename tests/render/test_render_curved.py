@@ -244,3 +244,25 @@ def test_make_solid_sizes_are_in_the_polyhedra_range():
         assert 0.6 <= k.size_m["height"] / (2 * k.size_m["radius"]) <= 1.2
         s = make_solid("sphere", rng)
         assert 0.03 <= s.size_m["radius"] <= 0.07
+
+
+# scenes of the polyhedra under the realism knobs, where clutter and a touching solid are drawn by class
+# index: sha256 over colour, depth and face-mask bytes and the meta as sorted JSON, as rendered before
+# the curved classes existed (adding classes must change none of them)
+PINNED_REALISM = [("realistic", "cube", 8, "ea4430ea07e277ae584bbaf675a791e0c6befccb68df081610f580308ec4201d"),
+                  ("realistic", "square_pyramid", 4, "f8f16382e3cd40d0f88fb3aff8c2243e60ef9e09c1441246a4a6e1a23c8fb0ec"),
+                  ("kinect", "hexagonal_prism", 8, "53c9b29faf379cefe0b8f1e7ba01d49a56efb9c7fa98add38fd188f97168b8be")]
+
+
+@pytest.mark.parametrize("preset,cls,seed,digest", PINNED_REALISM)
+def test_polyhedra_with_touching_solids_render_as_before(preset, cls, seed, digest):
+    import hashlib
+    import json
+
+    frame, faces = render_scene(cls, seed, preset, 160, 120)
+    assert "beside" in {c["relation"] for c in frame.meta["truth"]["contacts"]}
+    h = hashlib.sha256()
+    for a in (frame.color, frame.depth, faces):
+        h.update(a.tobytes())
+    h.update(json.dumps(frame.meta, sort_keys=True).encode())
+    assert h.hexdigest() == digest
