@@ -30,6 +30,11 @@ PREDICATES: dict[str, tuple[int, frozenset[str]]] = {
     "hexagon": (1, frozenset({"rgb", "depth", "rgbd"})),
     # the face is a curved surface: the side of a cylinder (a can, a tin, a cup); needs depth
     "cylindrical": (1, frozenset({"depth", "rgbd"})),
+    # the side of a cone, and a sphere's surface; needs depth
+    "conical": (1, frozenset({"depth", "rgbd"})),
+    "spherical": (1, frozenset({"depth", "rgbd"})),
+    # a planar face bounded by a circle (an ellipse in the image): a can's lid, a cone's base
+    "circular": (1, frozenset({"rgb", "depth", "rgbd"})),
     # 2D shape of the image polygon
     "parallelogram": (1, frozenset({"rgb", "rgbd"})),
     # metric shape of the face on its plane (depth, rgbd); for colour alone, the same tests on the image

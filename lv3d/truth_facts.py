@@ -72,10 +72,11 @@ def _exact_facts(truth: dict, k: dict, scene_id: str, modality: str = "rgbd") ->
     facts of the image polygon (lv3d.image_shape) in place of the metric ones.
 
     Faces of the curved solids (a ``surface`` in the truth): a cylinder's side is ``cylindrical`` (value:
-    its radius, as perception gives it) and has no plane, so no plane facts; a cone's side and a sphere have
-    no predicate of their own and get only ``face_of`` and their adjacency. Their ``sides`` is 0: a circular
-    cap or base is planar (``horizontal`` / ``vertical`` and the plane pairs hold) but has no side count,
-    no corners and no polygon shape (its outline is sampled along a curve, not a polygon)."""
+    its radius, as perception gives it), a cone's side ``conical`` (value: its half-angle in degrees), a
+    sphere ``spherical`` (value: its radius); they have no plane, so no plane facts. Their ``sides`` is 0:
+    a circular cap or base is planar (``horizontal`` / ``vertical`` and the plane pairs hold) and
+    ``circular``, but has no side count, no corners and no polygon shape (its outline is sampled along a
+    curve, not a polygon)."""
     o = object_id(scene_id, 1)
     facts = [Fact("object", (o,), 1.0)]
     up = np.asarray(truth["support_plane"]["normal"], float)
@@ -89,8 +90,14 @@ def _exact_facts(truth: dict, k: dict, scene_id: str, modality: str = "rgbd") ->
         surface = f.get("surface", {"type": "plane"})
         if surface["type"] == "cylinder":
             facts.append(Fact("cylindrical", (fid,), 1.0, float(surface["radius"])))
+        elif surface["type"] == "cone":
+            facts.append(Fact("conical", (fid,), 1.0, float(surface["half_angle_deg"])))
+        elif surface["type"] == "sphere":
+            facts.append(Fact("spherical", (fid,), 1.0, float(surface["radius"])))
         if surface["type"] != "plane":
             continue
+        if int(f["sides"]) == 0:  # a planar face bounded by a circle: a cap or a cone's base
+            facts.append(Fact("circular", (fid,), 1.0))
         n = np.asarray(f["plane"]["normal"], float)
         normals[int(f["id"])] = n
         if int(f["sides"]) in SIDES:

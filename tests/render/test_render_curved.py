@@ -221,7 +221,9 @@ def test_truth_facts_of_curved_faces():
     assert "cylindrical" not in preds[("cylinder", "rgb")]
     assert "horizontal" in preds[("cylinder", "depth")] or "vertical" in preds[("cylinder", "depth")]
     assert "cylindrical" not in preds[("cone", "depth")] | preds[("sphere", "depth")]
-    assert preds[("sphere", "rgbd")] == {"object", "face_of"}
+    assert "conical" in preds[("cone", "depth")] and "conical" not in preds[("cone", "rgb")]
+    assert preds[("sphere", "rgbd")] == {"object", "face_of", "spherical"}
+    assert "circular" in preds[("cylinder", "rgb")]  # a visible cap: a planar face bounded by a circle
 
 
 def test_old_class_lists_keep_their_ids(tmp_path):
