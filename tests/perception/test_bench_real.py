@@ -242,3 +242,18 @@ def test_without_masks_the_support_reads_only_the_surface_connected_to_the_label
     assert bench.connected_region(depth, outline, 11, 11).sum() == region.sum()  # no reading: the nearest seed
     assert not bench.connected_region(depth, outline, 15, 15).any()  # none within 2 % of the diagonal (2 px)
     assert not bench.connected_region(depth, _mask(10, 10, 19, 19), 15, 15).any()
+
+
+def test_cylinders_read_need_a_cylindrical_fact_of_0_7_and_boxes_count_any_curved_face():
+    scene, facts, frame = _scene()
+    scene.objects[1].faces[1].surface = "cylinder"
+    scene.objects[0].faces[2].surface = "cylinder"   # the box's third face taken for a curved one
+    facts = SceneFacts("s0", "depth", list(facts.facts) + [Fact("cylindrical", ("s0_o2_f2",), 0.8)])
+    labels = [_lab(1, 10, 10, "box"), _lab(2, 50, 20, "cylinder"), _lab(3, 70, 30, "cylinder", partial=True)]
+    row = bench.evaluate_frame(scene, facts, frame, labels, None)
+    assert (row["cyl_unocc"], row["cyl_read"], row["box_curved"]) == (1, 1, 1)  # the partial cylinder is left out
+    f = bench.summarise([dict(row, ms=1.0)], "depth")
+    assert f["cylinder_read_frac"] == 1.0 and f["box_curved_frac"] == 1.0
+    weak = SceneFacts("s0", "depth", [Fact("cylindrical", ("s0_o2_f2",), 0.6)])
+    assert bench.evaluate_frame(scene, weak, frame, labels, None)["cyl_read"] == 0
+    assert bench.summarise([dict(row, ms=1.0)], "rgb")["cylinder_read_frac"] is None

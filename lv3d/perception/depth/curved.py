@@ -10,9 +10,14 @@ points within the sensor's noise, its normals turn through a wide, gap-free arc 
 faces leave a gap of nearly 90 deg), and its radius is below the object's size. Its face then holds every cell
 of the object on the surface, and the fan's planes are gone. Planes across the axis (a can's lid) stay planes.
 
-Why not a RANSAC over all the object's points (PCL's SACMODEL_CYLINDER): a tin's lid, a large plane, fits a
-cylinder of huge radius better than the side fits any, and a box's two faces fit one of radius about half the
-box; the fan of planes already says where the surface turns.
+A fan is not always there: on RealSense frames the plane search cuts a small can's side into facets 60 deg
+apart (as far apart as a hexagonal prism's sides), or hands half of it to the lid's plane, or the can is one of
+several objects the segmentation joined. So after the fan, a seeded sample consensus over the object's remaining
+cells draws pairs of cells with their normals (Schnabel, Wahl and Klein 2007: two oriented points fix a cylinder)
+and keeps the cylinder most cells agree with; it is refitted on every cell on its surface in one connected piece,
+and stands only where it fits those cells better than the object's planes do and its normals fill a wide arc
+without the dip two planes leave (a box's two faces at 90 deg stay planes), and where it takes over at least half
+of one of the object's planes. A tin's lid fits no pair (its normals are parallel).
 """
 
 from __future__ import annotations
@@ -40,6 +45,20 @@ class CurvedSettings:
     ``min_arc_deg`` / ``max_gap_deg`` (degrees): the surface's normals must turn through at least this arc around
     the axis, with no gap inside it wider than this (two faces of a box turn by 90 deg with nothing between).
     ``max_radius_frac`` (fraction of the object's extent in metres): a larger radius is a plane's.
+    ``min_radius_cells`` (grid cells at the object's depth): a smaller radius turns the normals within the 5x5
+    cells they are averaged over (a box's edge, rounded by the sensor, fits one).
+    ``min_share`` (fraction): the share of one plane's residual variance over the face's cells the cylinder must
+    explain (describe.curved_evidence, the fact's confidence; 0.5: curved is the likelier reading).
+    ``plane_ratio`` (fraction): a sampled cylinder's RMS residual over its cells must be at most this share of
+    the RMS distance of those cells from their own planes (it explains them better than the planes do).
+    ``sample_arc_deg`` / ``min_dip`` (degrees / fraction): the normals of a sampled cylinder's cells, binned every
+    ``max_gap_deg / 2`` around the axis, must spread over this arc, its emptiest bin holding this share of its
+    fullest (curved.normal_profile): RealSense normals scatter by 7-10 deg on a flat face, which fills the gaps a
+    box's edge leaves between single normals but not the dip between its faces' two peaks.
+    ``bin_cells`` (cells): a bin of positions around the axis counts when it holds this many (curved.track).
+    ``max_faces`` (faces): the most cylindrical faces of one object (a clutter of cans the segmentation joined).
+    ``trials`` / ``score_cells`` / ``refits``: the sample consensus's pairs of cells, the seeded sample of cells
+    each is scored on, and the least-squares refits on all the object's cells on the surface.
     """
 
     max_step_deg: float = 50.0
@@ -49,6 +68,16 @@ class CurvedSettings:
     min_arc_deg: float = 40.0
     max_gap_deg: float = 20.0
     max_radius_frac: float = 1.0
+    min_radius_cells: float = 4.0
+    min_share: float = 0.5
+    plane_ratio: float = 0.9
+    sample_arc_deg: float = 60.0
+    min_dip: float = 0.1
+    bin_cells: int = 10
+    max_faces: int = 3
+    trials: int = 256
+    score_cells: int = 800
+    refits: int = 3
 
 
 DEFAULT = CurvedSettings()
@@ -153,3 +182,237 @@ def fan_cylinder(normals: list[np.ndarray], sizes: list[int], adjacency: list[tu
             continue
         return cyl, inl, fan
     return None
+
+
+def _pair_cylinders(p1: np.ndarray, n1: np.ndarray, p2: np.ndarray, n2: np.ndarray, min_sin: float
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Cylinders through pairs of oriented points (k, 3) each (Schnabel, Wahl and Klein 2007): the axis is
+    perpendicular to both normals, the centre where the lines back along the normals meet, seen along the axis.
+    Returns axes (k, 3), centres (k, 3), radii (k,) and which pairs give one (their normals turned by an angle
+    whose sine is ``min_sin`` or more, the centre behind both points at distances that agree within half)."""
+    a = np.cross(n1, n2)
+    s = np.linalg.norm(a, axis=1)
+    ok = s >= min_sin
+    a = a / np.maximum(s, 1e-12)[:, None]
+    d = p1 - p2
+    d = d - np.einsum("ij,ij->i", d, a)[:, None] * a
+    # t n1 - u n2 = d (both normals are perpendicular to the axis): p1 - t n1 = p2 - u n2 is the centre
+    c12 = np.einsum("ij,ij->i", n1, n2)
+    det = c12 * c12 - 1.0  # of [[1, -c12], [c12, -1]]
+    b1, b2 = np.einsum("ij,ij->i", n1, d), np.einsum("ij,ij->i", n2, d)
+    det = np.where(np.abs(det) < 1e-12, 1e-12, det)
+    t = (-b1 + c12 * b2) / det
+    u = (-c12 * b1 + b2) / det
+    r = 0.5 * (t + u)
+    ok &= (t > 0) & (u > 0) & (np.abs(t - u) <= 0.5 * r)
+    centre = p1 - t[:, None] * n1
+    return a, centre, r, ok
+
+
+def sample_cylinder(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: float, r_min: float, r_max: float,
+                    rng: np.random.Generator, trials: int = 256, score_points: int = 800,
+                    min_pair_deg: float = 15.0) -> Cylinder | None:
+    """The cylinder with most inliers (within ``dist_m`` of the surface, the normal within ``arccos(cos_min)`` of
+    the radial direction) among ``trials`` seeded random pairs of the oriented points (m, 3) and unit normals
+    (m, 3), scored on a seeded sample of ``score_points`` of them; its radius in [r_min, r_max]. None when no pair
+    gives one."""
+    m = len(pts)
+    if m < 20:
+        return None
+    score = rng.choice(m, min(m, score_points), replace=False)
+    sp, sn = pts[score], nrm[score]
+    i, j = rng.integers(0, m, trials), rng.integers(0, m, trials)
+    axes, centres, radii, ok = _pair_cylinders(pts[i], nrm[i], pts[j], nrm[j], np.sin(np.radians(min_pair_deg)))
+    ok &= (radii >= r_min) & (radii <= r_max)
+    if not ok.any():
+        return None
+    axes, centres, radii = axes[ok], centres[ok], radii[ok]
+    d = sp[None, :, :] - centres[:, None, :]                       # (k, s, 3)
+    d = d - np.einsum("ksj,kj->ks", d, axes)[:, :, None] * axes[:, None, :]
+    r = np.linalg.norm(d, axis=2)
+    cos = np.einsum("ksj,sj->ks", d, sn) / np.maximum(r, 1e-12)
+    count = np.count_nonzero((np.abs(r - radii[:, None]) <= dist_m) & (cos >= cos_min), axis=1)
+    b = int(np.argmax(count))
+    return Cylinder(tuple(axes[b]), tuple(centres[b]), float(radii[b]))
+
+
+def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of: np.ndarray, planes: list,
+                     dist_m: float, extent_m: float, cell_m: float, min_cells: int, seed: int = 0,
+                     settings: CurvedSettings = DEFAULT, adjacency: list[tuple[int, int]] = ()
+                     ) -> list[tuple[Cylinder, np.ndarray, list[int]]]:
+    """The cylindrical faces of an object: ``pts`` (m, 3) metres and unit ``nrm`` (m, 3) (zero where unknown) are
+    its cells, in row-major order of ``box`` (the object's cells on its bounding box of the grid, bool);
+    ``plane_of`` (m,) the index of each cell's plane (-1: none) among ``planes`` (lv3d.plane.Plane), which touch
+    in pairs ``adjacency``; ``dist_m`` the inlier distance, ``extent_m`` the object's size, ``cell_m`` the width of
+    one grid cell at its depth (metres), ``min_cells`` the fewest cells of a face.
+
+    First a fan of planes that a cylinder fits (:func:`fan_cylinder`); then, on the cells of no face found, the
+    cylinder a seeded sample consensus over the cells' points and normals finds (:func:`sample_cylinder`),
+    refitted on every free cell on its surface in one connected piece. A sampled cylinder stands when it fits its
+    cells better than the object's planes do (``plane_ratio``) and passes :func:`_stands`: a fan of planes 60 deg
+    apart on a small can, a can whose planes took cells of its lid, a can in a clutter of objects. Returns
+    (cylinder, its cells (m,) bool, the planes it replaces: those with half their cells or more on it) per face,
+    at most ``settings.max_faces``."""
+    rng = np.random.default_rng(seed)
+    n_planes = len(planes)
+    known = np.linalg.norm(nrm, axis=1) > 0.5
+    free = known.copy()
+    cos_min = np.cos(np.radians(settings.normal_deg))
+    dist = settings.inlier_dists * dist_m
+    r_min, r_max = settings.min_radius_cells * cell_m, settings.max_radius_frac * extent_m
+    plane_cells = np.bincount(plane_of[known & (plane_of >= 0)], minlength=n_planes)
+    res = np.full(len(pts), np.nan)
+    for k, p in enumerate(planes):
+        res[plane_of == k] = p.distance(pts[plane_of == k])
+    out = []
+
+    def replaced(on: np.ndarray) -> list[int]:
+        got = np.bincount(plane_of[on & (plane_of >= 0)], minlength=n_planes)
+        return [k for k in range(n_planes) if plane_cells[k] and got[k] >= 0.5 * plane_cells[k]]
+
+    if n_planes >= 2 and adjacency:
+        fan = fan_cylinder([p.n for p in planes], [int(c) for c in plane_cells], list(adjacency), pts, nrm,
+                           plane_of, dist_m, extent_m, settings)
+        if fan is not None:
+            cyl, on, members = fan
+            on = _piece(on, box)
+            if _stands(cyl, pts[on], nrm[on], None, dist_m, min_cells, settings):
+                out.append((cyl, on, sorted(set(members) | set(replaced(on)))))
+                free &= ~on
+    for _ in range(settings.max_faces * 2):  # a rejected sample does not end the search at once
+        if len(out) >= settings.max_faces or np.count_nonzero(free) < max(20, min_cells):
+            break
+        idx = np.flatnonzero(free)
+        cyl = sample_cylinder(pts[idx], nrm[idx], dist, cos_min, r_min, r_max, rng, settings.trials,
+                              settings.score_cells)
+        if cyl is None:
+            break
+        on = np.zeros(len(pts), bool)
+        for _ in range(settings.refits):
+            on = _piece(free & _inliers(cyl, pts, nrm, dist, cos_min), box)
+            if np.count_nonzero(on) < max(20, min_cells):
+                break
+            again = refine(pts[on], nrm[on])
+            if again is None or not r_min <= again.radius <= r_max:
+                break
+            cyl = again
+        on = _piece(free & _inliers(cyl, pts, nrm, dist, cos_min), box)
+        ok = on & (plane_of >= 0)
+        gone = replaced(on) if ok.any() else []
+        if gone and _stands(cyl, pts[on], nrm[on], res[ok], dist, min_cells, settings):
+            out.append((cyl, on, gone))
+            free &= ~on
+        elif on.any():
+            free &= ~on  # the next sample searches elsewhere
+        else:
+            break
+    return out
+
+
+def _piece(sel: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """The largest 8-connected piece of the selected cells ``sel`` (m,) bool laid out on ``box``."""
+    from .planes import largest_piece
+
+    if not sel.any():
+        return sel
+    grid = np.zeros(box.shape, bool)
+    grid[box] = sel
+    return largest_piece(grid)[box]
+
+
+def _stands(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarray | None, dist_m: float,
+            min_cells: int, settings: CurvedSettings) -> bool:
+    """Whether a cylinder's cells (points and normals) make a curved face: enough of them, within the inlier
+    distance of it on average and closer to it than to the object's planes (``plane_res``: each cell's distance
+    from its own plane, None for a fan of planes already read as a cylinder), spread around the axis through a
+    wide arc without a gap (:func:`track`), and a cylinder that explains most of one plane's residual over them
+    (:func:`curved_share`)."""
+    if len(pts) < max(20, min_cells):
+        return False
+    r, _ = cyl.radial(pts)
+    rms = float(np.sqrt(np.mean((r - cyl.radius) ** 2)))
+    if rms > dist_m:
+        return False
+    if plane_res is not None and rms > settings.plane_ratio * float(np.sqrt(np.mean(plane_res ** 2))):
+        return False
+    _, arc, gap = track(cyl, pts, nrm, settings.max_gap_deg / 2, settings.bin_cells)
+    if arc < settings.min_arc_deg or gap > settings.max_gap_deg:
+        return False
+    arc, dip = normal_profile(cyl, nrm, settings.max_gap_deg / 2)
+    if arc < settings.sample_arc_deg or dip < settings.min_dip:
+        return False
+    return curved_share(pts, cyl) >= settings.min_share
+
+
+def curved_share(pts: np.ndarray, cyl: Cylinder) -> float:
+    """The share of a plane's residual variance over the points (m, 3) that the cylinder explains,
+    1 - rms_cylinder^2 / rms_plane^2, in [0, 1] (describe.curved_evidence, the fact's confidence)."""
+    centred = pts - pts.mean(axis=0)
+    plane_ms = float(np.linalg.svd(centred, compute_uv=False)[-1] ** 2 / len(pts))
+    r, _ = cyl.radial(pts)
+    cyl_ms = float(np.mean((r - cyl.radius) ** 2))
+    if not (plane_ms > 0 and np.isfinite(cyl_ms)):
+        return 0.0
+    return float(np.clip(1.0 - cyl_ms / plane_ms, 0.0, 1.0))
+
+
+def _basis(axis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    a = np.asarray(axis, float)
+    b1 = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
+    b1 /= np.linalg.norm(b1)
+    return a, b1, np.cross(a, b1)
+
+
+def track(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, bin_deg: float, min_count: int
+          ) -> tuple[float, float, float]:
+    """How the normals (m, 3) of points (m, 3) on a cylinder follow its surface: the points' angles around the
+    axis are cut into bins ``bin_deg`` wide; in each bin of ``min_count`` points or more, the median turn of the
+    normals from the radial direction (degrees, seen along the axis). Returns (the largest of those medians in
+    absolute value, the arc the points span over such bins, the widest gap between them), degrees. A cylinder's
+    normals follow the radial direction and only their noise spreads them (a median cancels it); two planes a
+    cylinder was fitted through keep their normals fixed while the radial direction turns along them."""
+    a, b1, b2 = _basis(cyl.axis)
+    d = pts - np.asarray(cyl.point)
+    theta = np.degrees(np.arctan2(d @ b2, d @ b1))
+    phi = np.degrees(np.arctan2(nrm @ b2, nrm @ b1))
+    turn = (phi - theta + 180.0) % 360.0 - 180.0
+    # unwrap the positions at their widest gap, so that the arc is one run of bins
+    order = np.sort(theta)
+    gaps = np.diff(np.concatenate([order, order[:1] + 360.0]))
+    k = int(np.argmax(gaps))
+    start = order[(k + 1) % len(order)]
+    theta = (theta - start) % 360.0
+    bins = (theta // bin_deg).astype(int)
+    counts = np.bincount(bins)
+    full = np.flatnonzero(counts >= min_count)
+    if len(full) == 0:
+        return 180.0, 0.0, 0.0
+    worst = max(abs(float(np.median(turn[bins == b]))) for b in full)
+    arc = float((full[-1] - full[0] + 1) * bin_deg)
+    gap = float((np.diff(full).max() - 1) * bin_deg) if len(full) > 1 else 0.0
+    return worst, arc, gap
+
+
+def normal_profile(cyl: Cylinder, nrm: np.ndarray, bin_deg: float, edge_frac: float = 0.25) -> tuple[float, float]:
+    """How evenly the unit normals (m, 3) turn around the cylinder's axis: their angles seen along it, in bins
+    ``bin_deg`` wide. The arc runs from the first to the last bin holding ``edge_frac`` of the fullest bin or more;
+    the dip is the emptiest bin inside it over the fullest. Returns (arc, dip), degrees and a fraction. A curved
+    side's normals fill their arc (a camera sees fewer cells per degree towards its rims, half as many at 60 deg
+    from the line of sight); two planes' normals make two peaks with a dip between them that their noise does not
+    fill (a box's edge, rounded by the sensor, holds a few cells per degree where its faces hold hundreds)."""
+    a, b1, b2 = _basis(cyl.axis)
+    phi = np.degrees(np.arctan2(nrm @ b2, nrm @ b1))
+    nb = int(np.ceil(360.0 / bin_deg))
+    counts = np.bincount(((phi + 180.0) // bin_deg).astype(int) % nb, minlength=nb)
+    # start the circle of bins after its longest empty run, so that the arc does not wrap
+    empty = counts == 0
+    if empty.any():
+        run, best, best_end = 0, -1, 0
+        for i in range(2 * nb):
+            run = run + 1 if empty[i % nb] else 0
+            if run > best:
+                best, best_end = run, i
+        counts = np.roll(counts, -((best_end + 1) % nb))
+    full = np.flatnonzero(counts >= edge_frac * counts.max())
+    inside = counts[full[0]:full[-1] + 1]
+    return float(len(inside) * bin_deg), float(inside.min() / counts.max())

@@ -21,7 +21,7 @@ from ...rgbd import RGBD
 from ..boundary import mask_polygon
 from .cloud import PointGrid, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
-from .curved import CurvedFace, CurvedSettings, fan_cylinder
+from .curved import CurvedFace, CurvedSettings, object_cylinders
 from .occlusion import OcclusionSettings, join_occluded
 from .objects import DepthObject, heavy_noise, segment_objects, support_band
 from .planes import DepthPlane, largest_piece, merge_coplanar, object_planes, plane_adjacency
@@ -150,7 +150,8 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
         ta = time.perf_counter()
         planes = merge_coplanar(planes)
         adj = plane_adjacency(planes)
-        planes, adj, curved = _curved(grid, o, planes, adj, settings.curved, normals)
+        planes, adj, curved = _curved(grid, o, planes, adj, settings.curved, normals, stride / frame.intrinsics.fx,
+                                      _plane_need(o, plane_args), seed + k)
         curved_adj = [(i, j) for j, c in enumerate(curved) for i, p in enumerate(planes)
                       if np.count_nonzero(cv2.dilate(c.mask.view(np.uint8), np.ones((5, 5), np.uint8)).view(bool)
                                           & p.mask) >= 4]
@@ -214,37 +215,50 @@ def _solids(grid: PointGrid, support: Plane | None, objs: list[DepthObject], see
 
 
 def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list[tuple[int, int]],
-            settings: CurvedSettings, normals: _Normals) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
-    """The object's planes and their adjacency with a fan of planes replaced by the cylindrical face it is
-    (curved.fan_cylinder), and that face; the inputs unchanged when there is none."""
-    if len(planes) < 2 or not adj:
+            settings: CurvedSettings, normals: _Normals, cell_rel: float, min_cells: int, seed: int
+            ) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
+    """The object's planes and their adjacency with the planes its cylindrical faces replace left out, and those
+    faces (curved.object_cylinders); the inputs unchanged when there is none. ``cell_rel``: a grid cell's width as
+    a fraction of the depth (stride / fx); ``min_cells``: the fewest cells of a face, as of a plane."""
+    if not planes:
         return planes, adj, []
     m = o.mask
     rows, cols = np.flatnonzero(m.any(axis=1)), np.flatnonzero(m.any(axis=0))
     i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
-    nrm = normals(m)[m[i0:i1, j0:j1]].astype(np.float64)
-    pts = grid.xyz[m].astype(np.float64)
+    box = m[i0:i1, j0:j1]
+    nrm = normals(m)[box].astype(np.float64)
+    pts = grid.xyz[i0:i1, j0:j1][box].astype(np.float64)
     plane_of = np.full(len(pts), -1)
     for k, p in enumerate(planes):
-        plane_of[p.mask[m]] = k
+        plane_of[p.mask[i0:i1, j0:j1][box]] = k
     extent = float(np.linalg.norm(np.percentile(pts, 95, axis=0) - np.percentile(pts, 5, axis=0)))
-    dist = noise_threshold(float(np.median(pts[:, 2])))
-    found = fan_cylinder([p.plane.n for p in planes], [len(p.points) for p in planes], adj, pts, nrm, plane_of,
-                         dist, extent, settings)
-    if found is None:
+    z = float(np.median(pts[:, 2]))
+    found = object_cylinders(pts, nrm, box, plane_of, [p.plane for p in planes], noise_threshold(z), extent, cell_rel * z,
+                             min_cells, seed, settings, adj)
+    if not found:
         return planes, adj, []
-    cyl, on, fan = found
-    keep = [k for k in range(len(planes)) if k not in fan]
+    gone = {k for _, _, fan in found for k in fan}
+    keep = [k for k in range(len(planes)) if k not in gone]
     kept = [planes[k] for k in keep]
-    face = np.zeros_like(m)
-    face[m] = on
-    for p in kept:
-        face &= ~p.mask
-    face = largest_piece(face)
-    r, _ = cyl.radial(grid.xyz[face].astype(np.float64))
-    curved = CurvedFace(cyl, face, grid.xyz[face].astype(np.float32), float(np.sqrt(np.mean((r - cyl.radius) ** 2))))
+    curved = []
+    for cyl, on, _ in found:
+        face = np.zeros_like(m)
+        face[i0:i1, j0:j1][box] = on
+        for p in kept:
+            face &= ~p.mask
+        face = largest_piece(face)
+        if not face.any():
+            continue
+        r, _ = cyl.radial(grid.xyz[face].astype(np.float64))
+        curved.append(CurvedFace(cyl, face, grid.xyz[face].astype(np.float32),
+                                 float(np.sqrt(np.mean((r - cyl.radius) ** 2)))))
     index = {k: i for i, k in enumerate(keep)}
-    return kept, [(index[a], index[b]) for a, b in adj if a in index and b in index], [curved]
+    return kept, [(index[a], index[b]) for a, b in adj if a in index and b in index], curved
+
+
+def _plane_need(o: DepthObject, plane_args: dict) -> int:
+    """The fewest cells of a face of object ``o``, as planes.object_planes asks of a plane."""
+    return max(plane_args["min_points"], min(int(plane_args["min_frac"] * o.size), plane_args["max_need"]))
 
 
 def _height(grid: PointGrid, support: Plane | None, mask: np.ndarray) -> float:
