@@ -4,6 +4,7 @@ confident proof, and the proof as the explanation. Depends on the fact contract 
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -98,6 +99,14 @@ def predicate_name(label: str) -> str:
     return f"is_{label}" if label in taken else label
 
 
+def few_negatives(n_neg: int) -> int:
+    """Negatives a sample holds when the task has only ``n_neg``: two thirds of them, rounded up (at least one).
+    With every negative in every sample, one negative whose facts are wrong (a bowl read as a cylinder's side)
+    would veto the right hypothesis in all samples; with two thirds, some samples leave it out, and scoring on
+    all examples still counts it against the hypothesis."""
+    return max(1, math.ceil(2 * n_neg / 3))
+
+
 def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: dict | None = None,
         seed: int = 0) -> Program:
     """Learn ``target(O)`` from the scenes' target objects: positives where label == target,
@@ -111,7 +120,10 @@ def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: d
     neg = [s.target for s, y in zip(scenes, labels) if y != target]
     if not pos:
         raise InputError("labels", f"no scene is labelled {target!r}")
-    opts = {**SHAPE_SETTINGS, **check_settings(settings), "seed": int(seed)}
+    user = check_settings(settings)
+    opts = {**SHAPE_SETTINGS, **user, "seed": int(seed)}
+    if "sample_neg" not in user:  # few negatives: a sample holds at most two thirds of them (docs/learner.md)
+        opts["sample_neg"] = min(opts["sample_neg"], few_negatives(len(neg)))
     label, target = target, predicate_name(target)
     preds = engine.plist(f"{p}/{a}" for p, a in body_preds(modality, opts.pop("derived", True)))
     mrs = engine.plist(opts.pop("metarules", SHAPE_METARULES))

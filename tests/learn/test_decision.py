@@ -100,3 +100,29 @@ def test_no_clause_repeats_a_literal():
     with pytest.raises(LearnError):
         fit(scenes, labels, "hit", settings={"metarules": ["part2"], "disjunctions": 0})
     assert "triangle(B)" in fit(scenes, labels, "hit", settings={"metarules": ["part"]}).clauses[0]
+
+
+def test_one_negative_with_a_wrong_fact_does_not_veto_the_concept():
+    """Three cans (a cylindrical face and a hexagonal cap) against three negatives, one of them a bowl that
+    perception read as curved: every sample used to hold every negative, so the bowl vetoed `cylindrical` in
+    all of them; a sample now holds two thirds of the negatives (model.few_negatives)."""
+    from lv3d.facts import Fact, SceneFacts
+    from lv3d.learn import Model
+    from lv3d.learn.model import few_negatives
+
+    def scene(name, faces):
+        o = f"{name}_o1"
+        facts = [Fact("object", (o,), 1.0)]
+        for j, preds in enumerate(faces):
+            f = f"{o}_f{j}"
+            facts.append(Fact("face_of", (o, f), 0.99))
+            facts += [Fact(p, (f,), c) for p, c in preds]
+        return SceneFacts(name, "depth", facts, o)
+
+    cans = [scene(f"can{i}", [[("cylindrical", 0.95)], [("quadrilateral", 0.9)]]) for i in range(3)]
+    negs = [scene("bowl", [[("cylindrical", 0.8)]]),
+            scene("box1", [[("quadrilateral", 0.95)], [("rectangle", 0.9)]]),
+            scene("box2", [[("quadrilateral", 0.95)], [("triangle", 0.9)]])]
+    assert few_negatives(3) == 2 and few_negatives(1) == 1 and few_negatives(12) == 8
+    model = Model.fit(cans + negs, ["can"] * 3 + ["not_can"] * 3, classes=["can"], seed=0)
+    assert "cylindrical(B)" in str(model.programs["can"])
