@@ -29,7 +29,10 @@ from ..errors import InputError
 from ..limits import MAX_DATASET_IMAGES
 
 LOGIC_SYSTEMS = ("lv3d-rgb", "lv3d-depth", "lv3d-rgbd")
-BASELINE_SYSTEMS = ("cnn-rgb", "cnn-depth", "cnn-rgbd", "cnn-rgbd-2s", "tree-rgb", "tree-depth", "tree-rgbd")
+BASELINE_SYSTEMS = ("cnn-rgb", "cnn-depth", "cnn-rgbd", "cnn-rgbd-2s", "tree-rgb", "tree-depth", "tree-rgbd",
+                    "effnet-rgb", "effnet-depth", "effnet-rgbd")
+# BaselineConfig's keys that only the effnet-* systems read: left out of the other baselines' result keys
+EFFNET_KEYS = ("effnet_c", "effnet_input_size")
 SYSTEMS = LOGIC_SYSTEMS + BASELINE_SYSTEMS
 MAX_FOLDS = 100
 MAX_WORKERS = 256
@@ -187,6 +190,12 @@ class BaselineConfig:
     tree_min_samples_leaf: int = _int(2, 1, 100000)
     patience: int = _int(0, 0, 10000, doc="early stopping (0: off)")
     val_fraction: float = _num(0.15, 0, 0.9)
+    # The pretrained baseline (effnet-*: lv3d.baselines.pretrained.PretrainedSettings says why these values);
+    # it runs its network on ``threads`` CPU threads.
+    effnet_c: float = _num(0.1, 0, 1e6, lo_open=True,
+                           doc="inverse L2 strength of the logistic regression on standardised features")
+    effnet_input_size: int = _int(224, 32, 1024, doc="pixels a side of the network's input (tensors resized "
+                                                     "bilinearly; 224: the weights' own resolution)")
 
 
 @dataclass(frozen=True)

@@ -53,6 +53,15 @@ def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
         relevant["code"] = learner_version()  # changed perception, grounding or learner: recompute
     else:
         relevant["settings"] = d["baselines"]
+    if system not in LOGIC_SYSTEMS:
+        from .config import EFFNET_KEYS
+
+        # effnet-* read their own keys and their input only; the other baselines' keys stay as before effnet-*
+        b = relevant["settings"]
+        if system.startswith("effnet-"):
+            relevant["settings"] = {k: b.get(k) for k in ("image_size", "threads", *EFFNET_KEYS)}
+        else:
+            relevant["settings"] = {k: v for k, v in b.items() if k not in EFFNET_KEYS}
     relevant["data"] = {"classes": d["data"]["classes"], "per_class": d["data"]["per_class"],
                         "noise": d["data"]["noise"], "noise_overrides": d["data"]["noise_overrides"] or {},
                         "seed": d["seed"]}

@@ -83,7 +83,8 @@ class FittedLogic:
 
 
 class PixelSystem:
-    """A CNN or a decision tree over the pixel tensors of one modality."""
+    """A CNN, a decision tree or pretrained features with a linear classifier (effnet-*) over the pixel
+    tensors of one modality."""
 
     def __init__(self, name: str, pixels: dict[str, np.ndarray], baselines: BaselineConfig):
         self.name, self.pixels, self.b = name, pixels, baselines
@@ -100,6 +101,8 @@ class PixelSystem:
         b = self.b
         if self.name.startswith("tree-"):
             model = PixelTree(cells=b.tree_cells, min_samples_leaf=b.tree_min_samples_leaf)
+        elif self.name.startswith("effnet-"):
+            model = self._pretrained()
         else:
             settings = CNNSettings(epochs=b.epochs, batch_size=b.batch_size, lr=b.lr, weight_decay=b.weight_decay,
                                    augment=b.augment, width=b.width, threads=b.threads, patience=b.patience,
@@ -107,6 +110,24 @@ class PixelSystem:
             model = CNNClassifier(self.modality, "twostream" if self.name.endswith("-2s") else "early", settings)
         model.fit(self._x(ids), labels, seed=seed)
         return FittedPixels(model, self)
+
+    def _pretrained(self):
+        """The effnet-* classifier (lv3d.baselines.pretrained). On first use, the network's features of every
+        image this system sees, computed in batched passes of at most PRETRAINED_CHUNK images and cached in
+        the process, so that the many fits of a study run the network once per image."""
+        from ..baselines.pretrained import PretrainedClassifier, PretrainedSettings, features
+
+        b = self.b
+        settings = PretrainedSettings(C=b.effnet_c, input_size=b.effnet_input_size, threads=b.threads)
+        if not getattr(self, "_features_ready", False):
+            ids = list(self.pixels)
+            for start in range(0, len(ids), PRETRAINED_CHUNK):
+                features(self._x(ids[start:start + PRETRAINED_CHUNK]), self.modality, settings)
+            self._features_ready = True
+        return PretrainedClassifier(self.modality, settings)
+
+
+PRETRAINED_CHUNK = 1024  # images stacked at once for the features: 1024 rgbd tensors of 64x64 are 64 MB
 
 
 class FittedPixels:
