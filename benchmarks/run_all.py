@@ -8,6 +8,7 @@
 |---|---|---|---|
 | bench_real | perception + grounding on the real frames of ../shared/data/real (the arbiter) | 3 frames a folder | every frame |
 | bench_perception | perception on rendered scenes, every noise preset | 2 scenes a class, 2 presets | 5 a class |
+| bench_curved | cylinders, cones and spheres as faces of their kind; boxes without curved faces (rendered) | 3 scenes a class | 10 a class |
 | bench_grounding | refinement error, fact calibration, ms per frame | 2 scenes a class, 1 speed run | 6 a class |
 | bench_dataset | renderer throughput (images/s) | 8 images | 42 |
 | bench_learner | learner accuracy, clean against realsense, and speed | 8 scenes a class | 30 a class |
@@ -42,6 +43,7 @@ def commands(quick: bool, work: Path, json_dir: Path | None) -> list[tuple[str, 
     return [
         ("bench_real", real),
         ("bench_perception", ["--quick"] if quick else ["--per-class", "5"]),
+        ("bench_curved", ["--quick"] if quick else []),
         ("bench_grounding", ["--quick", "--speed-runs", "1", "--speed-frames", "4"] if quick else []),
         ("bench_dataset", ["--images", "8", "--single", "4"] if quick else []),
         ("bench_learner", ["--root", str(dev), "--per-class", str(per_class), "--seed", str(LEARNER_SEED)]

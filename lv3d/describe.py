@@ -272,6 +272,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                     p_curved = curved_evidence(f.points, f.cylinder)
                     if p_curved is not None:
                         curved.append(("cylindrical", (f.id,), p_curved, float(f.cylinder.radius)))
+                curved += quadric_candidates(f)
                 if has_plane[i]:
                     if n == 4:
                         cands.append(("square", (f.id,), c["p_square"][i], c["side_ratio"][i]))
@@ -333,6 +334,28 @@ def curved_evidence(points: np.ndarray, cylinder) -> float | None:
     if not (plane_ms > 0 and np.isfinite(cyl_ms)):
         return None
     return float(np.clip(1.0 - cyl_ms / plane_ms, 0.0, 1.0))
+
+
+def quadric_candidates(face: Face) -> list[tuple[str, tuple[str, ...], float, float | None]]:
+    """The ``spherical`` or ``conical`` fact of a depth face fitted as a sphere or a cone, as (pred, args, conf,
+    value) with no calibration map (yet); none for other faces or where the evidence cannot be measured.
+    ``spherical``: the share of a plane's residual variance over the face's points that the sphere explains
+    (quadrics.sphere_evidence; a sphere of growing radius tends to a plane), value its radius in metres.
+    ``conical``: the share of a least-squares cylinder's residual variance that the cone explains
+    (quadrics.cone_evidence; a cone of half-angle near 0 is a cylinder, and a cylinder fits a cone's points at
+    least as well as a plane, so the cylinder is the alternative a cone must beat), value its half-angle in
+    degrees."""
+    from .perception.depth.quadrics import cone_evidence, sphere_evidence
+
+    if face.points is None:
+        return []
+    if face.surface == "sphere" and face.sphere is not None:
+        p = sphere_evidence(face.points, face.sphere)
+        return [] if p is None else [("spherical", (face.id,), p, float(face.sphere.radius))]
+    if face.surface == "cone" and face.cone is not None:
+        p = cone_evidence(face.points, face.cone)
+        return [] if p is None else [("conical", (face.id,), p, float(face.cone.half_angle_deg))]
+    return []
 
 
 @functools.cache

@@ -11,8 +11,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .camera import Intrinsics
+from .cone import Cone
 from .cylinder import Cylinder
 from .plane import Plane
+from .sphere import Sphere
 
 PROVENANCE = ("rgb", "depth", "rgbd")
 
@@ -22,7 +24,8 @@ class Face:
     """One face. ``polygon``: (n, 2) float pixels, in order around the face. ``plane``: where depth
     found one. ``points``: the camera-frame depth points (m, 3) the plane was fitted to (not serialised).
     ``provenance``: which modality found it ('rgbd' = matched in both). A curved face of depth (``surface``
-    'cylinder': a can's side) has its ``cylinder`` and no plane."""
+    'cylinder': a can's side; 'sphere': a ball; 'cone': a cone's side) has its ``cylinder``, ``sphere`` or
+    ``cone`` and no plane."""
 
     id: str
     polygon: np.ndarray
@@ -31,8 +34,10 @@ class Face:
     points: np.ndarray | None = None
     edge_support: float | None = None  # fraction of the polygon's perimeter on image edges, in [0, 1]
     plane_rms_m: float | None = None   # RMS point-to-surface residual of the fit, metres
-    surface: str = "plane"             # 'plane' (or a polygon without depth), or 'cylinder'
+    surface: str = "plane"             # 'plane' (or a polygon without depth), 'cylinder', 'sphere' or 'cone'
     cylinder: Cylinder | None = None  # the fitted cylinder of a cylindrical face (then ``plane`` is None)
+    sphere: Sphere | None = None      # the fitted sphere of a spherical face
+    cone: Cone | None = None          # the fitted cone of a conical face
 
     @property
     def sides(self) -> int:
@@ -44,7 +49,9 @@ class Face:
                 "plane": self.plane.to_dict() if self.plane else None,
                 "n_points": 0 if self.points is None else int(len(self.points)),
                 "edge_support": self.edge_support, "plane_rms_m": self.plane_rms_m, "surface": self.surface,
-                "cylinder": self.cylinder.to_dict() if self.cylinder is not None else None}
+                "cylinder": self.cylinder.to_dict() if self.cylinder is not None else None,
+                "sphere": self.sphere.to_dict() if self.sphere is not None else None,
+                "cone": self.cone.to_dict() if self.cone is not None else None}
 
 
 @dataclass
@@ -79,6 +86,7 @@ class Scene:
     support_plane: Plane | None = None
     timings_ms: dict[str, float] = field(default_factory=dict)
     dropped_objects: int = 0  # objects found beyond perception's cap on objects (the smallest), not described
+    unconverged_fits: int = 0  # depth's sphere and cone fits that did not converge (no face came of them)
 
     def target(self) -> SceneObject | None:
         """The object a label speaks of: the one nearest the image centre (the camera is aimed at it; clutter
@@ -104,5 +112,5 @@ class Scene:
                 "intrinsics": self.intrinsics.to_dict(),
                 "support_plane": self.support_plane.to_dict() if self.support_plane else None,
                 "target": t.id if t else None, "objects": [o.to_dict() for o in self.objects],
-                "dropped_objects": self.dropped_objects,
+                "dropped_objects": self.dropped_objects, "unconverged_fits": self.unconverged_fits,
                 "timings_ms": self.timings_ms}

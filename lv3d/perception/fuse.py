@@ -30,6 +30,7 @@ from ..rgbd import RGBD
 from ..scene import Face
 from .edges import channel_edges, channels, edge_distance, edge_support
 from .depth.holes import UnreadFace, add_hole_faces
+from .depth.quadrics import surface_fields
 from .polygons import area, rasterize
 
 # a depth outline lying on colour edges (within edges.edge_support's 2 px) for at least this fraction of its
@@ -67,7 +68,7 @@ def fused_faces(frame: RGBD, o, object_px: np.ndarray, box: tuple[int, int, int,
 
     index = {j: add(poly, plane=p.plane, points=p.points, plane_rms_m=p.rms_m)
              for j, (p, poly) in enumerate(zip(o.planes, o.polygons)) if poly is not None}
-    curved = {j: add(poly, points=c.points, plane_rms_m=c.rms_m, surface="cylinder", cylinder=c.cylinder)
+    curved = {j: add(poly, points=c.points, plane_rms_m=c.rms_m, **surface_fields(c))
               for j, (c, poly) in enumerate(zip(o.curved, o.curved_polygons)) if poly is not None}
     pairs = {(index[a], index[b]) for a, b in o.adjacency if a in index and b in index}
     pairs |= {(index[i], curved[j]) for i, j in o.curved_adjacency if i in index and j in curved}

@@ -14,6 +14,7 @@ from .depth import MAX_OBJECTS, DepthObjectResult, DepthResult, depth_scene
 from .boundary import grid_to_pixels
 from .fuse import fused_faces, largest_first
 from .depth.holes import UnreadFace, unread_faces
+from .depth.quadrics import surface_fields
 from .polygons import area
 from .rgb import RGBFace, rgb_faces
 
@@ -41,7 +42,7 @@ def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 
         return scene
     dres = depth_scene(frame, seed=seed, max_objects=max_objects)
     scene = Scene(scene_id, modality, frame.intrinsics, support_plane=dres.support, timings_ms=dict(dres.timings_ms),
-                  dropped_objects=dres.dropped_objects)
+                  dropped_objects=dres.dropped_objects, unconverged_fits=dres.unconverged_fits)
     if modality == "depth":
         scene.objects = [_depth_object(scene_id, k + 1, o, dres, frame) for k, o in enumerate(dres.objects)]
         return scene
@@ -118,15 +119,14 @@ def _depth_object(scene_id: str, k: int, o: DepthObjectResult, dres: DepthResult
 
 def _curved_faces(scene_id: str, k: int, o: DepthObjectResult, faces: list[Face], index: dict[int, str]
                   ) -> list[tuple[str, str]]:
-    """The depth object's cylindrical faces appended to ``faces`` (ids go on from their count; ``index``: plane
-    index -> face id), and their adjacency to the plane faces."""
+    """The depth object's curved faces (cylinders, spheres, cones) appended to ``faces`` (ids go on from their
+    count; ``index``: plane index -> face id), and their adjacency to the plane faces."""
     adj = []
     for j, (c, poly) in enumerate(zip(o.curved, o.curved_polygons)):
         if poly is None:
             continue
         fid = face_id(scene_id, k, len(faces) + 1)
-        faces.append(Face(fid, poly, "depth", points=c.points, plane_rms_m=c.rms_m, surface="cylinder",
-                          cylinder=c.cylinder))
+        faces.append(Face(fid, poly, "depth", points=c.points, plane_rms_m=c.rms_m, **surface_fields(c)))
         adj += [tuple(sorted((index[i], fid))) for i, jj in o.curved_adjacency if jj == j and i in index]
     return adj
 

@@ -23,6 +23,7 @@ from .cloud import PointGrid, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
 from .curved import CurvedFace, CurvedSettings, object_cylinders
 from .occlusion import OcclusionSettings, join_occluded
+from .quadrics import QuadricFace, QuadricSettings, quadric_faces
 from .objects import DepthObject, heavy_noise, segment_objects, support_band
 from .planes import DepthPlane, largest_piece, merge_coplanar, object_planes, plane_adjacency
 from .plane_outline import simplify_on_plane
@@ -56,6 +57,7 @@ class DepthSettings:
     centre) over what part of it (support.support_plane).
     ``convexity``: the cut at concave creases (convexity.ConvexitySettings).
     ``curved``: a fan of planes read as one cylindrical face (curved.CurvedSettings).
+    ``quadrics``: an object's sphere or cone side read as one face (quadrics.QuadricSettings).
     ``occlusion``: two pieces of one solid seen around an occluder joined (occlusion.OcclusionSettings).
     """
 
@@ -72,6 +74,7 @@ class DepthSettings:
     support_inner: float = 0.85
     convexity: ConvexitySettings = field(default_factory=ConvexitySettings)
     curved: CurvedSettings = field(default_factory=CurvedSettings)
+    quadrics: QuadricSettings = field(default_factory=QuadricSettings)
     occlusion: OcclusionSettings = field(default_factory=OcclusionSettings)
 
     def __post_init__(self) -> None:
@@ -99,7 +102,8 @@ class DepthObjectResult:
     adjacency: list[tuple[int, int]]
     centroid_m: np.ndarray
     box_px: tuple[int, int, int, int]  # (u0, v0, u1, v1), end exclusive
-    curved: list[CurvedFace] = field(default_factory=list)  # cylindrical faces (a can's side), not in ``planes``
+    # curved faces (a can's side, a ball, a cone's side), not in ``planes``
+    curved: list[CurvedFace | QuadricFace] = field(default_factory=list)
     curved_polygons: list[np.ndarray | None] = field(default_factory=list)
     curved_adjacency: list[tuple[int, int]] = field(default_factory=list)  # (plane i, curved face j) touching
 
@@ -111,6 +115,7 @@ class DepthResult:
     objects: list[DepthObjectResult]
     timings_ms: dict[str, float] = field(default_factory=dict)
     dropped_objects: int = 0  # objects found beyond the cap (``max_objects``), smallest first
+    unconverged_fits: int = 0  # sphere and cone least-squares fits that did not converge (no face came of them)
 
 
 def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | None = None,
@@ -146,12 +151,19 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
     h, w = frame.shape
     results = []
     t_planes = t_boundary = 0.0
+    unconverged = 0
     for k, (o, planes) in enumerate(solids):
         ta = time.perf_counter()
         planes = merge_coplanar(planes)
         adj = plane_adjacency(planes)
+        # a sphere or a cone first: the cylinder search would read a cone's side as a cylinder
+        planes, adj, quads, failed = quadric_faces(grid.xyz, o.mask, normals(o.mask), planes, adj,
+                                                   stride / frame.intrinsics.fx, _plane_need(o, plane_args), seed + k,
+                                                   settings.quadrics)
+        unconverged += failed
         planes, adj, curved = _curved(grid, o, planes, adj, settings.curved, normals, stride / frame.intrinsics.fx,
                                       _plane_need(o, plane_args), seed + k)
+        curved = quads + [c for c in curved if not any(np.any(c.mask & q.mask) for q in quads)]
         curved_adj = [(i, j) for j, c in enumerate(curved) for i, p in enumerate(planes)
                       if np.count_nonzero(cv2.dilate(c.mask.view(np.uint8), np.ones((5, 5), np.uint8)).view(bool)
                                           & p.mask) >= 4]
@@ -178,7 +190,7 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
                                          curved, curved_polys, curved_adj))
     timings = {"cloud": (t1 - t0) * 1e3, "support": (t2 - t1) * 1e3, "objects": (t3 - t2) * 1e3,
                "planes": t_planes * 1e3, "boundary": t_boundary * 1e3}
-    return DepthResult(grid, support, results, timings, dropped)
+    return DepthResult(grid, support, results, timings, dropped, unconverged)
 
 
 class _Normals:

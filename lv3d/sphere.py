@@ -1,0 +1,29 @@
+"""Spheres in the camera frame (metres), beside :mod:`lv3d.plane` and :mod:`lv3d.cylinder`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Sphere:
+    """A sphere in the camera frame: its ``centre`` and ``radius`` (metres)."""
+
+    centre: tuple[float, float, float]
+    radius: float
+
+    def radial(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Distances (m,) of ``points`` (m, 3) from the centre, and the unit directions (m, 3) away from it (the
+        outward normals of the surface there)."""
+        d = np.asarray(points, float) - np.asarray(self.centre)
+        r = np.linalg.norm(d, axis=1)
+        return r, d / np.maximum(r, 1e-12)[:, None]
+
+    def residual(self, points: np.ndarray) -> np.ndarray:
+        """Signed distances (m,) of ``points`` (m, 3) from the surface, positive outside."""
+        return self.radial(points)[0] - self.radius
+
+    def to_dict(self) -> dict:
+        return {"centre": list(self.centre), "radius": self.radius}
