@@ -300,6 +300,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 p = min(face_conf[a], face_conf[b])  # the shared edge is as real as the weaker face
                 cands.append(("adjacent", (a, b), p, None))
                 cands.append(("adjacent", (b, a), p, None))
+        curved += cap_candidates(obj)
         cands.append(("object", (obj.id,), max(face_conf.values(), default=0.0), None))
         results.append(ObjectResult(obj, face_results, dihedrals, status, raw))
     if calibrate:
@@ -334,6 +335,37 @@ def curved_evidence(points: np.ndarray, cylinder) -> float | None:
     if not (plane_ms > 0 and np.isfinite(cyl_ms)):
         return None
     return float(np.clip(1.0 - cyl_ms / plane_ms, 0.0, 1.0))
+
+
+# A planar face meeting a cylindrical face is its cap, bounded by a circle, when its normal lies along the
+# cylinder's axis: within CAP_TOL_DEG (degrees; the tolerance of the plane predicates, parallel within 8-10
+# deg), the measured angle read with a Gaussian error of CAP_SIGMA_DEG (a plane fitted to hundreds of depth
+# points is good to 1-2 deg, a cylinder's axis to 2-3 deg: about 4 deg together).
+CAP_TOL_DEG = 10.0
+CAP_SIGMA_DEG = 4.0
+
+
+def cap_candidates(obj: SceneObject) -> list[tuple[str, tuple[str, ...], float, float | None]]:
+    """``circular`` for each planar face of ``obj`` that meets one of its cylindrical faces with its normal along
+    the cylinder's axis: the probability that the angle between them is within CAP_TOL_DEG, value the angle
+    in degrees. A can's lid is read as a polygon of a few sides; this says its outline is a circle."""
+    out = []
+    faces = {f.id: f for f in obj.faces}
+    for a, b in obj.adjacency:
+        for cap, side in ((faces.get(a), faces.get(b)), (faces.get(b), faces.get(a))):
+            if cap is None or side is None or cap.plane is None or side.cylinder is None:
+                continue
+            cos = abs(float(np.dot(np.asarray(cap.plane.n, float), np.asarray(side.cylinder.axis, float))))
+            theta = math.degrees(math.acos(min(1.0, cos)))
+            z = math.sqrt(2.0) * CAP_SIGMA_DEG
+            p = 0.5 * (math.erf((CAP_TOL_DEG - theta) / z) - math.erf((-CAP_TOL_DEG - theta) / z))
+            if p > 0:
+                out.append(("circular", (cap.id,), p, round(theta, 2)))
+    best: dict = {}
+    for c in out:  # a cap meeting two cylindrical faces: its better reading
+        if c[1] not in best or c[2] > best[c[1]][2]:
+            best[c[1]] = c
+    return list(best.values())
 
 
 def quadric_candidates(face: Face) -> list[tuple[str, tuple[str, ...], float, float | None]]:

@@ -211,3 +211,19 @@ def test_curved_evidence_tells_a_can_side_from_a_flat_face():
     assert curved_evidence(side, cyl) > 0.9
     assert curved_evidence(flat, Cylinder((0.0, 1.0, 0.0), (0.0, 0.0, 1.0), 0.04)) < 0.05
     assert curved_evidence(side[:5], cyl) is None
+
+
+def test_a_lid_along_a_cylinder_axis_is_circular_and_a_side_face_is_not():
+    from lv3d.cylinder import Cylinder
+    from lv3d.describe import cap_candidates
+    from lv3d.plane import Plane
+    from lv3d.scene import Face, SceneObject
+
+    square = np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)
+    side = Face("o_f1", square, "depth", surface="cylinder", cylinder=Cylinder((0.0, -1.0, 0.0), (0.0, 0.0, 1.0), 0.04))
+    lid = Face("o_f2", square, "depth", plane=Plane((0.0, -0.9986, -0.0523), 0.1))   # 3 deg off the axis
+    wall = Face("o_f3", square, "depth", plane=Plane((1.0, 0.0, 0.0), 0.1))          # 90 deg off it
+    obj = SceneObject("o", [side, lid, wall], [("o_f1", "o_f2"), ("o_f1", "o_f3")])
+    got = {c[1][0]: c for c in cap_candidates(obj)}
+    assert set(got) == {"o_f2"} and got["o_f2"][0] == "circular"
+    assert got["o_f2"][2] > 0.9 and abs(got["o_f2"][3] - 3.0) < 0.1
