@@ -136,6 +136,17 @@ def check_value(value, meta: dict, key: str, where: str):
         if len(value) < meta["min_len"]:
             bad(f"needs a list of at least {meta['min_len']}")
         return tuple(value)
+    if kind in ("ints", "bools"):  # a grid of values: a non-empty list, each value checked, none twice
+        if not isinstance(value, (list, tuple)) or not value:
+            bad("must be a non-empty list")
+        for v in value:
+            if kind == "bools" and not isinstance(v, bool):
+                raise InputError(where, f"{key}: each value must be true or false, got {v!r}")
+            if kind == "ints" and (not _is_int(v) or (lo is not None and v < lo) or (hi is not None and v > hi)):
+                raise InputError(where, f"{key}: each value must be a whole number {_range_text(lo, hi)}, got {v!r}")
+        if len(set(value)) != len(value):
+            bad("lists a value twice")
+        return tuple(value)
     if kind == "mapping":
         if not isinstance(value, dict):
             bad("must be a mapping")
@@ -196,6 +207,25 @@ class BaselineConfig:
                            doc="inverse L2 strength of the logistic regression on standardised features")
     effnet_input_size: int = _int(224, 32, 1024, doc="pixels a side of the network's input (tensors resized "
                                                      "bilinearly; 224: the weights' own resolution)")
+    # Tuning (lv3d.baselines.tuning, experiments/README.md "Tuning the CNN"): per outer fold, on its training
+    # examples only, the CNN's width, epochs, augmentation and input size are chosen from this grid by grouped
+    # inner cross-validation of the multi-class task; they then replace width, epochs, augment and image_size
+    # for every task of that fold. The default grid: the fixed setting (16 channels, 20 epochs, no augmentation,
+    # 64 px), half and twice its width, twice its epochs, augmentation on, half its input size; its search costs
+    # about 4.4 min of one core per outer fold for cnn-rgbd and 8.2 min for cnn-rgbd-2s (experiments/README.md).
+    tune: bool = _bool(False, doc="tune the CNNs per outer fold (false: the fixed settings above)")
+    tune_width: tuple = _spec((8, 16, 32), "ints", lo=1, hi=1024, doc="channels of the first layer tried")
+    tune_epochs: tuple = _spec((20, 40), "ints", lo=1, hi=10000, doc="epochs tried")
+    tune_augment: tuple = _spec((False, True), "bools", doc="augmentation off and/or on (lv3d.baselines.augment)")
+    tune_image_size: tuple = _spec((32, 64), "ints", lo=8, hi=512,
+                                   doc="input pixels a side tried; each divides image_size (the cached tensors "
+                                       "area-downsampled by a whole factor); 8 at least: the stem halves the "
+                                       "input and two 2x2 pools follow")
+    tune_folds: int = _int(3, 2, 20, doc="inner cross-validation folds (groups of examples never split)")
+
+
+# BaselineConfig's tuning keys: left out of a result's key where they cannot change it (runner.result_key)
+TUNE_KEYS = ("tune", "tune_width", "tune_epochs", "tune_augment", "tune_image_size", "tune_folds")
 
 
 @dataclass(frozen=True)
@@ -322,6 +352,9 @@ def from_dict(cfg: dict, where: str) -> StudyConfig:
     if b.tree_cells > b.image_size or b.image_size % b.tree_cells:
         raise InputError(where, f"baselines.tree_cells: must divide baselines.image_size ({b.image_size}), "
                                 f"got {b.tree_cells}")
+    if b.tune and any(b.image_size % s for s in b.tune_image_size):
+        raise InputError(where, f"baselines.tune_image_size: each must divide baselines.image_size ({b.image_size}, "
+                                f"the size of the cached tensors), got {list(b.tune_image_size)}")
     pairs = study.stats.pairs
     if pairs is not None:
         if not isinstance(pairs, (list, tuple)):

@@ -18,11 +18,18 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Item:
-    """One image of the data set: its id, class and folder (relative to the data set)."""
+    """One example of a study: its id, class and where its pixels are (a rendered image's folder relative to
+    the data set; a labelled real object's frame). ``group``: examples that must stay in one fold (the
+    objects of one real frame); empty means the example is its own group."""
 
     id: str
     cls: str
     dir: str
+    group: str = ""
+
+    @property
+    def group_key(self) -> str:
+        return self.group or self.id
 
 
 def fold_path(out: Path, condition: str, system: str, fold: int) -> Path:

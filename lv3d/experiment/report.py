@@ -72,6 +72,11 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
         per["mean"] = {"mean": m, "std": sd}
         per["seconds"] = sum(r["seconds"] for r in recs)
         per["code"] = sorted({r["code"] for r in recs if r.get("code")})
+        # settings a tuned baseline chose per fold (baselines.tune), with their inner cross-validation accuracy
+        tuned = [{"fold": r["fold"], **r["tuned"]["setting"], "inner_accuracy": r["tuned"]["inner_accuracy"]}
+                 for r in recs if r.get("tuned")]
+        if tuned:
+            per["tuned"] = tuned
         summary["systems"][s] = per
     for a, b in cfg.stats.pairs or default_pairs(list(cfg.systems)):
         common = sorted(set(cells[a]) & set(cells[b]))
@@ -129,6 +134,15 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
             for s, per in failing.items():
                 lines.append(f"- {s}: {per['learn_failures']} (" + "; ".join(per["learn_failure_examples"]) +
                              ("; ..." if per["learn_failures"] > len(per["learn_failure_examples"]) else "") + ")")
+        tuned = [(s, t) for s, per in summ["systems"].items() for t in per.get("tuned", [])]
+        if tuned:
+            lines += ["", "CNN settings chosen per fold by inner cross-validation on that fold's training examples "
+                      "(baselines.tune; inner accuracy: multi-class, mean over the inner folds):", "",
+                      "| system | fold | width | epochs | augment | input px | inner accuracy |",
+                      "|---|---|---|---|---|---|---|"]
+            for s, t in tuned:
+                lines.append(f"| {s} | {t['fold']} | {t['width']} | {t['epochs']} | {'on' if t['augment'] else 'off'} "
+                             f"| {t['image_size']} | {100 * t['inner_accuracy']:.1f} |")
         best = summ.get("against_best_cnn")
         if best:
             lo, hi = best["ci95"]

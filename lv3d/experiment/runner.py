@@ -28,7 +28,7 @@ from tqdm import tqdm
 from ..output import claim, clean_stale, locked, write_atomic
 from . import data as data_mod
 from .code_version import learner_version
-from .config import LOGIC_SYSTEMS, Study, StudyConfig, digest, load_study
+from .config import LOGIC_SYSTEMS, TUNE_KEYS, Study, StudyConfig, digest, load_study
 from .executor import LocalExecutor
 from .folds import Item, class_task, fold_path, multiclass_task, split, stratified_folds
 from .report import write_report
@@ -38,6 +38,14 @@ from .systems import make_system, modality_of, negative_label
 def task_seed(seed: int, fold: int, task: int, draw: int = 0) -> int:
     """A seed for one draw of one (fold, task) cell, independent of the system."""
     return int(np.random.SeedSequence([seed, fold, task] + ([draw] if draw else [])).generate_state(1)[0])
+
+
+TUNE_TASK = 1_000_000  # the task number of tuning's seeds: above every class task (0, 1, ...) and the multi-class one
+
+
+def tune_seed(seed: int, fold: int) -> int:
+    """The seed of tuning a baseline on one fold's training examples, independent of the system."""
+    return task_seed(seed, fold, TUNE_TASK)
 
 
 def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
@@ -52,7 +60,9 @@ def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
         relevant["settings"] = {k: v for k, v in d["lv3d"].items() if k != "workers"}  # workers: speed only
         relevant["code"] = learner_version()  # changed perception, grounding or learner: recompute
     else:
-        relevant["settings"] = d["baselines"]
+        # tuning changes the CNNs only; off, the key is the one results made before the setting existed have
+        tuned = system.startswith("cnn-") and d["baselines"].get("tune")
+        relevant["settings"] = {k: v for k, v in d["baselines"].items() if tuned or k not in TUNE_KEYS}
     if system not in LOGIC_SYSTEMS:
         from .config import EFFNET_KEYS
 
@@ -156,6 +166,8 @@ def run_cell(job: tuple, inputs: dict) -> tuple[dict, dict[str, str]]:
     ccfg, sname, k, train, test = job
     system = make_system(sname, ccfg, inputs)
     t0 = time.perf_counter()
+    # a baseline that tunes (baselines.tune) chooses its settings here, from this fold's training examples only
+    tuned = system.tune(train, tune_seed(ccfg.seed, k)) if hasattr(system, "tune") else None
     files: dict[str, str] = {}
     if sname in LOGIC_SYSTEMS:
         with tempfile.TemporaryDirectory(prefix="lv3d-programs-") as tmp:
@@ -163,6 +175,8 @@ def run_cell(job: tuple, inputs: dict) -> tuple[dict, dict[str, str]]:
             files = {str(p.relative_to(tmp)): p.read_text() for p in sorted(Path(tmp).rglob("*")) if p.is_file()}
     else:
         record = run_fold(system, ccfg, train, test, k, None)
+    if tuned is not None:
+        record["tuned"] = tuned
     record["seconds"] = round(time.perf_counter() - t0, 3)
     return record, files
 

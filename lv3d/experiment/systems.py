@@ -90,13 +90,47 @@ class PixelSystem:
         self.name, self.pixels, self.b = name, pixels, baselines
         self.modality = modality_of(name)
         self.channels = {"rgb": slice(0, 3), "depth": slice(3, 4), "rgbd": slice(0, 4)}[self.modality]
+        self.tuned: dict | None = None  # the CNN setting tune() chose: width, epochs, augment, image_size
 
     def _x(self, ids: list[str]) -> np.ndarray:
-        return np.stack([self.pixels[i][self.channels] for i in ids])
+        x = np.stack([self.pixels[i][self.channels] for i in ids])
+        if self.tuned is not None:
+            from ..baselines.tuning import area_downsample
+
+            x = area_downsample(x, self.tuned["image_size"])
+        return x
+
+    def cnn_settings(self):
+        """The CNN's training settings (lv3d.baselines.CNNSettings): the study's, with the width, epochs and
+        augmentation tune() chose when it ran."""
+        from ..baselines import CNNSettings
+
+        b, t = self.b, self.tuned or {}
+        return CNNSettings(epochs=t.get("epochs", b.epochs), batch_size=b.batch_size, lr=b.lr,
+                           weight_decay=b.weight_decay, augment=t.get("augment", b.augment),
+                           width=t.get("width", b.width), threads=b.threads, patience=b.patience,
+                           val_fraction=b.val_fraction)
+
+    def tune(self, items: list, seed: int) -> dict | None:
+        """With ``baselines.tune``, a CNN's width, epochs, augmentation and input size chosen by grouped inner
+        cross-validation of the multi-class task on ``items`` (one outer fold's training examples: the runner
+        never passes its test fold) and used by every later fit and predict; returns the search's record
+        (lv3d.baselines.tuning.tune). None, changing nothing, for the trees or without ``baselines.tune``."""
+        if not self.b.tune or not self.name.startswith("cnn-"):
+            return None
+        from ..baselines.tuning import grid, tune
+
+        b, arch = self.b, "twostream" if self.name.endswith("-2s") else "early"
+        self.tuned = None
+        settings = grid(b.tune_width, b.tune_epochs, b.tune_augment, b.tune_image_size, self.modality, arch)
+        out = tune(self._x([it.id for it in items]), [it.cls for it in items], [it.group_key for it in items],
+                   self.modality, arch, self.cnn_settings(), settings, b.tune_folds, seed)
+        self.tuned = dict(out["setting"])
+        return out
 
     def fit(self, ids: list[str], labels: list[str], seed: int, positive: str | None = None) -> "FittedPixels":
         """Train on the labels as given (a binary task's negatives share one label per task)."""
-        from ..baselines import CNNClassifier, CNNSettings, PixelTree
+        from ..baselines import CNNClassifier, PixelTree
 
         b = self.b
         if self.name.startswith("tree-"):
@@ -104,10 +138,8 @@ class PixelSystem:
         elif self.name.startswith("effnet-"):
             model = self._pretrained()
         else:
-            settings = CNNSettings(epochs=b.epochs, batch_size=b.batch_size, lr=b.lr, weight_decay=b.weight_decay,
-                                   augment=b.augment, width=b.width, threads=b.threads, patience=b.patience,
-                                   val_fraction=b.val_fraction)
-            model = CNNClassifier(self.modality, "twostream" if self.name.endswith("-2s") else "early", settings)
+            model = CNNClassifier(self.modality, "twostream" if self.name.endswith("-2s") else "early",
+                                  self.cnn_settings())
         model.fit(self._x(ids), labels, seed=seed)
         return FittedPixels(model, self)
 
