@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from lv3d.experiment.stats import ece, reliability_bins  # noqa: F401  (the benchmarks' ECE is the studies')
+
 ECE_TARGET = 0.05  # issue 4: per fact type, at the realsense preset
 
 
@@ -18,22 +20,6 @@ def log_loss(p: np.ndarray, y: np.ndarray) -> float:
     p = np.clip(np.asarray(p, float), 1e-6, 1 - 1e-6)
     y = np.asarray(y, float)
     return float(-np.mean(y * np.log(p) + (1 - y) * np.log(1 - p)))
-
-
-def ece(p: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
-    """Expected calibration error: sum over equal-width confidence bins of |mean confidence - share true| *
-    share of facts in the bin. ``p`` (n,) confidences in [0, 1]; ``y`` (n,) truth as 0/1 or bool."""
-    if len(p) == 0:
-        return float("nan")
-    return float(sum(abs(conf - true) * n / len(p) for _, n, conf, true in reliability_bins(p, y, bins)))
-
-
-def reliability_bins(p: np.ndarray, y: np.ndarray, bins: int = 10) -> list[tuple[float, int, float, float]]:
-    """The bins :func:`ece` sums over: (lower edge, facts, mean confidence, share true) of each non-empty one."""
-    p, y = np.asarray(p, float), np.asarray(y, float)
-    idx = np.minimum((p * bins).astype(int), bins - 1)
-    return [(b / bins, int(np.sum(idx == b)), float(p[idx == b].mean()), float(y[idx == b].mean()))
-            for b in range(bins) if np.any(idx == b)]
 
 
 def chance_ece(p: np.ndarray, bins: int = 10, draws: int = 400, seed: int = 0) -> float:

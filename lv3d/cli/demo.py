@@ -5,6 +5,10 @@ images each with lv3d (rgb, depth and rgbd facts) and, on the same images, a sma
 decision tree; prints the learned programs, an accuracy table on the held-out images and the
 explanation of one test answer; writes perception overlays, the programs, a plot and
 ``results.json`` into DIR. Built from the experiment runner's parts (one split instead of folds).
+
+Then, where a folder of labelled real frames is at hand (``--real``, by default ../shared/data/real/osd-learn
+beside the checkout), it learns box and cylinder from 4 labelled objects each in some of its frames and shows
+a frame it did not learn from: what perception found there (an overlay) and the proof for one real object.
 """
 
 from __future__ import annotations
@@ -91,7 +95,12 @@ def plot_accuracy(acc: dict[str, float], path: Path) -> None:
 @click.option("--systems", default="lv3d-rgb,lv3d-depth,lv3d-rgbd,cnn-rgbd,tree-rgbd", show_default=True,
               help="comma-separated systems to compare")
 @click.option("--threads", default=1, show_default=True, type=click.IntRange(1, 256), help="CPU threads for the CNN")
-def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int, systems: str, threads: int):
+@click.option("--real", "real", type=click.Path(path_type=Path), default=None,
+              help="a folder of labelled real frames for the last step (default: ../shared/data/real/osd-learn beside "
+                   "the checkout, when there)")
+@click.option("--no-real", is_flag=True, help="skip the real-frame step")
+def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int, systems: str, threads: int,
+         real: Path | None, no_real: bool):
     """Learn four shape classes from a few RGB-D images and explain an answer."""
     from ..errors import InputError
     from ..experiment import data as data_mod
@@ -160,10 +169,86 @@ def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int,
     click.echo("\n4. overlays of what perception found (rgbd)")
     write_overlays(data, test, out / "overlays")
     plot_accuracy(acc, out / "accuracy.png")
+    real_result = None
+    folder = None if no_real else (real if real is not None else _default_real())
+    if folder is not None:
+        click.echo(f"\n5. a real frame ({folder})")
+        real_result = real_step(folder, out, seed)
     (out / "results.json").write_text(json.dumps(
         {"classes": CLASSES, "train": [it.id for it in train], "test": [it.id for it in test], "accuracy": acc,
          "predictions": {n: [[it.id, str(l), float(c)] for it, (l, c) in zip(test, p)] for n, (_, p) in fitted.items()},
-         "seconds": round(time.perf_counter() - t_start, 1)}, indent=1))
+         "real": real_result, "seconds": round(time.perf_counter() - t_start, 1)}, indent=1))
     click.echo(f"\nWrote {out / 'results.json'}, {out / 'accuracy.png'}, {out / 'overlays'}/, {out / 'programs'}/ "
                f"in {time.perf_counter() - t_start:.0f} s")
     lock.release()
+
+
+REAL_CLASSES = ("box", "cylinder")
+REAL_TRAIN = 4  # labelled objects of each class to learn from
+
+
+def _default_real() -> Path | None:
+    """../shared/data/real/osd-learn beside the checkout holding lv3d, when it is there."""
+    folder = Path(__file__).resolve().parents[3] / "shared" / "data" / "real" / "osd-learn"
+    return folder if (folder / "objects.csv").is_file() else None
+
+
+def real_step(folder: Path, out: Path, seed: int) -> dict:
+    """Learn box and cylinder (lv3d-rgbd) from REAL_TRAIN labelled objects each of ``folder``'s frames, then show
+    one frame none of them came from: perception's overlay and the proof for one of its labelled objects."""
+    from dataclasses import replace
+
+    import cv2
+
+    from ..experiment.code_version import facts_version
+    from ..experiment.folds import grouped_folds, multiclass_task
+    from ..experiment.real_data import ensure_frame_facts, example_facts_of, real_data
+    from ..experiment.systems import FittedLogic
+    from ..learn import Model
+    from ..perception import perceive
+    from ..perception.overlay import draw_overlay
+
+    rd = real_data([str(folder)], REAL_CLASSES)
+    if len({it.cls for it in rd.items}) < 2:
+        click.echo(f"   {folder} holds no labelled {' and no '.join(REAL_CLASSES)}: step skipped")
+        return {"skipped": "no examples of both classes"}
+    train_fold, test_fold = grouped_folds(rd.items, 2, seed)
+    train = multiclass_task(train_fold, REAL_TRAIN, seed)
+    # the test frame: the first of the other fold's frames with objects of both classes (else any)
+    frames = sorted({it.group_key for it in test_fold})
+    both = [f for f in frames if {it.cls for it in test_fold if it.group_key == f} >= set(REAL_CLASSES)]
+    test_frame = (both or frames)[0]
+    test = [it for it in test_fold if it.group_key == test_frame]
+    keep = {it.group_key for it in train} | {test_frame}
+    small = replace(rd, items=train + test, frames={a: v for a, v in rd.frames.items() if a in keep},
+                    labels={a: v for a, v in rd.labels.items() if a in keep})
+    ff = ensure_frame_facts(small, out / "real_facts", facts_version(), "rgbd", True)
+    facts, errors = example_facts_of(small, ff)
+    usable = [it for it in train if facts[it.id].target is not None]
+    click.echo(f"   learning {', '.join(REAL_CLASSES)} (lv3d-rgbd) from {len(usable)} labelled objects of "
+               f"{len({it.group_key for it in train})} frames")
+    model = Model.fit([facts[it.id] for it in usable], [it.cls for it in usable], seed=seed)
+    fit = FittedLogic(model, facts)
+    fit.save(out / "programs" / "real")
+    for pl in sorted((out / "programs" / "real").rglob("*.pl")):
+        click.echo(pl.read_text().rstrip())
+    fold_folder, name = rd.frames[test_frame]
+    frame = fold_folder.load(name)
+    scene = perceive(frame, "rgbd", scene_id=test_frame)
+    (out / "overlays").mkdir(parents=True, exist_ok=True)
+    overlay = out / "overlays" / f"real_{test_frame}.png"
+    cv2.imwrite(str(overlay), cv2.cvtColor(draw_overlay(frame.color, scene), cv2.COLOR_RGB2BGR))
+    click.echo(f"   frame {name}: perception found {len(scene.objects)} objects, "
+               f"{sum(len(o.faces) for o in scene.objects)} faces ({overlay})")
+    answers = {}
+    for it, (label, conf) in zip(test, fit.predict([it.id for it in test])):
+        answers[it.id] = [it.cls, label, conf]
+        click.echo(f"   {it.id}: labelled {it.cls}, lv3d-rgbd says {label} ({conf:.2f})"
+                   + (f" [{errors[it.id]}]" if it.id in errors else ""))
+    shown = next((it for it in test if facts[it.id].target is not None), None)
+    if shown is not None:
+        click.echo(f"\nWhy lv3d-rgbd says the real object {shown.id} (labelled {shown.cls}) is "
+                   f"{answers[shown.id][1]}:")
+        click.echo(str(fit.explain(shown.id)))
+    return {"folder": str(folder), "train": [it.id for it in train], "frame": name, "answers": answers,
+            "overlay": str(overlay)}

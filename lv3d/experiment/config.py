@@ -120,6 +120,26 @@ def check_value(value, meta: dict, key: str, where: str):
         if not isinstance(value, str) or not value.strip() or "\0" in value:
             bad("must be a folder (a path)")
         return value
+    if kind == "paths":
+        if not isinstance(value, (list, tuple)) or not value:
+            bad("must be a non-empty list of folders")
+        for v in value:
+            if not isinstance(v, str) or not v.strip() or "\0" in v:
+                raise InputError(where, f"{key}: {v!r} is not a folder (a path)")
+        if len(set(value)) != len(value):
+            bad("lists a folder twice")
+        return tuple(value)
+    if kind == "labels":  # class names: words here; which names exist depends on the data (checked in from_dict)
+        if not isinstance(value, (list, tuple)):
+            bad("must be a list")
+        for v in value:
+            if not isinstance(v, str) or not re.fullmatch(r"[a-z][a-z0-9_]*", v):
+                raise InputError(where, f"{key}: {v!r} is not a class name (a lower-case word)")
+        if len(set(value)) != len(value):
+            bad("lists a name twice")
+        if len(value) < meta["min_len"]:
+            bad(f"needs a list of at least {meta['min_len']}")
+        return tuple(value)
     names = meta["names"]() if callable(meta["names"]) else meta["names"]
     if kind == "name":
         if not isinstance(value, str) or value not in names:
@@ -158,11 +178,16 @@ def check_value(value, meta: dict, key: str, where: str):
 
 @dataclass(frozen=True)
 class DataConfig:
-    """The images of the study: rendered once, cached by (classes, per_class, noise, seed)."""
+    """The examples of the study: images rendered once, cached by (classes, per_class, noise, seed); or, with
+    ``folders``, the labelled objects of real frames (lv3d.frame_folder), each object one example."""
 
-    classes: tuple = _spec(("cube", "square_pyramid", "triangular_prism", "pentagonal_prism"), "names",
-                           names=_classes, min_len=2)
-    per_class: int = _int(50, 1, MAX_DATASET_IMAGES // 2, doc="images per class")
+    classes: tuple = _spec(("cube", "square_pyramid", "triangular_prism", "pentagonal_prism"), "labels",
+                           names=_classes, min_len=2,
+                           doc="rendered classes; with folders, the objects.csv shapes to learn (others left out)")
+    folders: tuple | None = _spec(None, "paths", optional=True,
+                                  doc="folders of labelled real frames (relative to the working directory); "
+                                      "None: a rendered data set")
+    per_class: int = _int(50, 1, MAX_DATASET_IMAGES // 2, doc="images per class (rendered only)")
     noise: str = _spec("realsense", "name", names=_presets, doc="a preset of lv3d.render.noise")
     noise_overrides: dict = _spec({}, "mapping", doc="knob -> value, on top of the preset")
     cache: str | None = _spec(None, "path", optional=True, doc="a folder shared between studies; None: <out>/data")
@@ -342,9 +367,18 @@ def from_dict(cfg: dict, where: str) -> StudyConfig:
             top[f.name] = check_value(cfg[f.name], f.metadata, f.name, where)
     study = StudyConfig(**top)
     d, b = study.data, study.baselines
-    if d.per_class < study.folds:
+    if d.folders is not None:
+        from .real_data import check_folders
+
+        check_folders(d, study.folds, where)
+    else:
+        known = _classes()
+        for c in d.classes:
+            if c not in known:
+                raise InputError(where, f"data.classes: unknown name {c!r}; known: {', '.join(known)}")
+    if d.folders is None and d.per_class < study.folds:
         raise InputError(where, f"data.per_class: must be at least folds ({study.folds}), got {d.per_class}")
-    if d.per_class * len(d.classes) > MAX_DATASET_IMAGES:
+    if d.folders is None and d.per_class * len(d.classes) > MAX_DATASET_IMAGES:
         raise InputError(where, f"data.per_class: {d.per_class} images of {len(d.classes)} classes exceed the "
                                 f"{MAX_DATASET_IMAGES} images a data set may hold (lv3d.limits)")
     check_noise(d, where)

@@ -83,3 +83,17 @@ def multiclass_task(train: list[Item], per_class: int, seed: int) -> list[Item]:
         pool = sorted((it for it in train if it.cls == cls), key=lambda it: it.id)
         out += [pool[i] for i in sorted(rng.permutation(len(pool))[:per_class])]
     return out
+
+
+def grouped_folds(items: list[Item], k: int, seed: int) -> list[list[Item]]:
+    """k disjoint folds covering ``items`` that never split a group (the labelled objects of one real frame)
+    and keep each class's share as even as the groups allow (sklearn's StratifiedGroupKFold, shuffled with
+    the seed)."""
+    from sklearn.model_selection import StratifiedGroupKFold
+
+    ordered = sorted(items, key=lambda it: it.id)
+    splitter = StratifiedGroupKFold(n_splits=k, shuffle=True, random_state=seed % (2 ** 32))
+    folds = [sorted((ordered[i] for i in test), key=lambda it: it.id)
+             for _, test in splitter.split(np.zeros(len(ordered)), [it.cls for it in ordered],
+                                           [it.group_key for it in ordered])]
+    return folds

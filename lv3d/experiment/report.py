@@ -1,7 +1,8 @@
 """The study's report, regenerated from the fold files (never edited by hand):
 ``results.csv`` (one row per condition x system x fold x task), ``results.json`` (means, standard
-deviations and paired tests), ``results.md`` (the tables) and ``accuracy.png`` (+ ``sweep.png``
-when the study has several conditions).
+deviations, paired tests and the calibration of the multi-class answers), ``results.md`` (the tables),
+``accuracy.png``, ``reliability.png`` (the answers' reliability diagram, last condition) and ``sweep.png``
+when the study has several conditions.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from pathlib import Path
 from ..output import write_atomic
 from .config import LOGIC_SYSTEMS, StudyConfig
 from .folds import fold_path
-from .stats import mean_std, paired
+from .stats import ece, mean_std, paired, reliability_bins
 
 
 def _load(out: Path, cond: str, system: str, folds: int) -> list[dict]:
@@ -72,6 +73,13 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
         per["mean"] = {"mean": m, "std": sd}
         per["seconds"] = sum(r["seconds"] for r in recs)
         per["code"] = sorted({r["code"] for r in recs if r.get("code")})
+        calibration = answer_calibration(recs)
+        if calibration:
+            per["calibration"] = calibration
+        left = next((r["left_out"] for r in recs if r.get("left_out") is not None), None)
+        if left is not None:
+            summary["left_out"] = left
+            summary["examples"] = sum(len(r["test_ids"]) for r in recs)
         # settings a tuned baseline chose per fold (baselines.tune), with their inner cross-validation accuracy
         tuned = [{"fold": r["fold"], **r["tuned"]["setting"], "inner_accuracy": r["tuned"]["inner_accuracy"]}
                  for r in recs if r.get("tuned")]
@@ -83,20 +91,41 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
         if common:
             t = paired([cells[a][c] for c in common], [cells[b][c] for c in common])
             summary["tests"].append({"a": a, "b": b, "cells": len(common), **t})
-    summary["against_best_cnn"] = _against_best_cnn(summary)
+    summary["against_best_cnn"] = _against_best(summary, "cnn-")
+    summary["against_best_pretrained"] = _against_best(summary, "effnet-")
     return summary, rows
 
 
-def _against_best_cnn(summary: dict) -> dict | None:
-    """The paired test of the best-seeing lv3d system against the CNN with the highest mean binary accuracy (the
-    issue's margin: lv3d at least 20 points above the CNN), or None when the study has no such test."""
-    lv3d = _best_seeing(summary["systems"])
-    cnns = [s for s, per in summary["systems"].items() if s.startswith("cnn-") and not math.isnan(per["mean"]["mean"])]
-    if lv3d is None or not cnns:
+def answer_calibration(recs: list[dict]) -> dict | None:
+    """How well the confidences of a system's multi-class answers match how often they are right, over every
+    fold and draw: {"ece", "answers", "bins": [(lower edge, answers, mean confidence, share right), ...]}; None
+    where the fold files hold no multi-class predictions with the test classes beside them."""
+    conf, right = [], []
+    for r in recs:
+        truth, preds = r.get("test_classes"), r.get("predictions", {}).get("multiclass")
+        if not truth or not preds:
+            continue
+        for draw in (preds if isinstance(preds[0][0], list) else [preds]):
+            for (_, label, c), y in zip(draw, truth):
+                conf.append(min(1.0, max(0.0, float(c))))
+                right.append(label == y)
+    if not conf:
         return None
-    best = max(cnns, key=lambda s: summary["systems"][s]["mean"]["mean"])
+    return {"ece": ece(conf, right), "answers": len(conf), "bins": reliability_bins(conf, right)}
+
+
+def _against_best(summary: dict, prefix: str) -> dict | None:
+    """The paired test of the best-seeing lv3d system against the system named ``prefix``* (``cnn-``: the CNNs
+    trained from scratch; ``effnet-``: the pretrained networks) with the highest mean binary accuracy, or None
+    when the study has no such test."""
+    lv3d = _best_seeing(summary["systems"])
+    rivals = [s for s, per in summary["systems"].items() if s.startswith(prefix) and not math.isnan(per["mean"]["mean"])]
+    if lv3d is None or not rivals:
+        return None
+    best = max(rivals, key=lambda s: summary["systems"][s]["mean"]["mean"])
     test = next((t for t in summary["tests"] if (t["a"], t["b"]) == (lv3d, best)), None)
-    return None if test is None else {**test, "cnn_mean": summary["systems"][best]["mean"]["mean"]}
+    return None if test is None else {**test, "rival_mean": summary["systems"][best]["mean"]["mean"],
+                                      "cnn_mean": summary["systems"][best]["mean"]["mean"]}
 
 
 def _pct(x: dict) -> str:
@@ -143,11 +172,30 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
             for s, t in tuned:
                 lines.append(f"| {s} | {t['fold']} | {t['width']} | {t['epochs']} | {'on' if t['augment'] else 'off'} "
                              f"| {t['image_size']} | {100 * t['inner_accuracy']:.1f} |")
-        best = summ.get("against_best_cnn")
-        if best:
-            lo, hi = best["ci95"]
-            lines += ["", f"{best['a']} against the best CNN here ({best['b']}, {100 * best['cnn_mean']:.1f}): "
-                      f"{100 * best['mean_diff']:+.1f} points, 95% interval {100 * lo:+.1f} to {100 * hi:+.1f}."]
+        calibrated = {s: per["calibration"] for s, per in summ["systems"].items() if per.get("calibration")}
+        if calibrated:
+            lines += ["", "Calibration of the multi-class answers (the answer's confidence against how often it is "
+                      "right, 10 equal-width bins; reliability.png):", "",
+                      "| system | answers | ECE | mean confidence | share right |", "|---|---|---|---|---|"]
+            for s, c in calibrated.items():
+                n = sum(b[1] for b in c["bins"])
+                mc = sum(b[1] * b[2] for b in c["bins"]) / n
+                mr = sum(b[1] * b[3] for b in c["bins"]) / n
+                lines.append(f"| {s} | {c['answers']} | {c['ece']:.3f} | {mc:.3f} | {mr:.3f} |")
+        left = summ.get("left_out")
+        if left is not None:
+            other = ", ".join(f"{k} {v}" for k, v in sorted(left["other_classes"].items())) or "none"
+            lines += ["", f"Examples: {summ['examples']} labelled objects of the study's classes; left out: "
+                      f"{len(left['unusable_rows'])} unusable rows of objects.csv, objects of other classes: {other}. "
+                      "*pipeline errors*: examples whose labelled pixel lies on no object that system's perception "
+                      "found (answered \"unknown\")."]
+            lines += [f"- {row}" for row in left["unusable_rows"][:10]]
+        for key, what in (("against_best_cnn", "the best CNN"), ("against_best_pretrained", "the best pretrained network")):
+            best = summ.get(key)
+            if best:
+                lo, hi = best["ci95"]
+                lines += ["", f"{best['a']} against {what} here ({best['b']}, {100 * best['rival_mean']:.1f}): "
+                          f"{100 * best['mean_diff']:+.1f} points, 95% interval {100 * lo:+.1f} to {100 * hi:+.1f}."]
         lines.append("")
     versions = sorted({v for summ in summaries.values() for per in summ["systems"].values() for v in per.get("code", [])})
     if versions:
@@ -181,6 +229,22 @@ def plot(out: Path, summaries: dict[str, dict], classes: list[str]) -> None:
     fig.tight_layout()
     fig.savefig(out / "accuracy.png", dpi=110)
     plt.close(fig)
+    last = summaries[list(summaries)[-1]]
+    calibrated = {s: per["calibration"] for s, per in last["systems"].items() if per.get("calibration")}
+    if calibrated:
+        fig, ax = plt.subplots(figsize=(5, 5))
+        ax.plot([0, 1], [0, 1], color="grey", lw=1, ls="--", label="perfect")
+        for s, c in calibrated.items():
+            ax.plot([b[2] for b in c["bins"]], [b[3] for b in c["bins"]], marker="o", label=f"{s} (ECE {c['ece']:.2f})")
+        ax.set_xlabel("confidence of the answer")
+        ax.set_ylabel("share of answers right")
+        ax.set_xlim(0, 1)
+        ax.set_ylim(0, 1)
+        ax.set_title(f"multi-class answers, {list(summaries)[-1]}")
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(out / "reliability.png", dpi=110)
+        plt.close(fig)
     if len(summaries) > 1:
         fig, ax = plt.subplots(figsize=(7, 4))
         conds = list(summaries)

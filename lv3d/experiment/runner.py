@@ -15,8 +15,10 @@ the reason, and counted in the report; a learn call that fails for a reason of t
 
 from __future__ import annotations
 
+import functools
 import json
 import shutil
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -30,7 +32,7 @@ from . import data as data_mod
 from .code_version import learner_version
 from .config import LOGIC_SYSTEMS, TUNE_KEYS, Study, StudyConfig, digest, load_study
 from .executor import LocalExecutor
-from .folds import Item, class_task, fold_path, multiclass_task, split, stratified_folds
+from .folds import Item, class_task, fold_path, grouped_folds, multiclass_task, split, stratified_folds
 from .report import write_report
 from .systems import make_system, modality_of, negative_label
 
@@ -75,7 +77,17 @@ def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
     relevant["data"] = {"classes": d["data"]["classes"], "per_class": d["data"]["per_class"],
                         "noise": d["data"]["noise"], "noise_overrides": d["data"]["noise_overrides"] or {},
                         "seed": d["seed"]}
+    if d["data"].get("folders"):  # labelled real frames: the folders' content, not a rendering recipe
+        relevant["data"] = {"real": _real_key(tuple(d["data"]["folders"]), tuple(d["data"]["classes"])),
+                            "seed": d["seed"]}
     return digest(relevant)
+
+
+@functools.lru_cache(maxsize=16)
+def _real_key(folders: tuple, classes: tuple) -> str:
+    from .real_data import real_data
+
+    return real_data(folders, classes).key
 
 
 def score_binary(preds: list[tuple[str, float]], test: list[Item], cls: str) -> dict:
@@ -181,6 +193,47 @@ def run_cell(job: tuple, inputs: dict) -> tuple[dict, dict[str, str]]:
     return record, files
 
 
+class _RealInputs:
+    """What each system sees of the labelled objects of real frames (real_data), computed on first use."""
+
+    def __init__(self, cfg: StudyConfig, out: Path, rd, executor=None, progress: bool = True):
+        self.cfg, self.out, self.rd, self.executor, self.progress = cfg, out, rd, executor, progress
+        self._frames: dict[str, dict] = {}
+        self._facts: dict[str, dict] = {}
+        self._pixels = None
+        self.errors: dict[str, dict[str, str]] = {}
+
+    def frames(self, modality: str) -> dict:
+        from .code_version import facts_version
+        from .real_data import ensure_frame_facts
+
+        if modality not in self._frames:
+            lv, cfg = self.cfg.lv3d, self.cfg
+            root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else Path(self.out) / "facts"
+            self._frames[modality] = ensure_frame_facts(self.rd, root, facts_version(), modality, lv.refine,
+                                                        lv.workers, executor=self.executor)
+        return self._frames[modality]
+
+    def for_system(self, name: str) -> dict:
+        from .real_data import ensure_real_pixels, example_facts_of
+
+        if name in LOGIC_SYSTEMS:
+            m = modality_of(name)
+            if m not in self._facts:
+                facts, self.errors[m] = example_facts_of(self.rd, self.frames(m))
+                if self.progress:  # each example perception found no object for: one line naming file and line
+                    for why in self.errors[m].values():
+                        tqdm.write(f"lv3d: warning: {why} (lv3d-{m} answers \"unknown\")", file=sys.stderr)
+                if not self.cfg.lv3d.confidences:
+                    facts = {i: data_mod.without_confidences(f) for i, f in facts.items()}
+                self._facts[m] = facts
+            return self._facts[m]
+        if self._pixels is None:
+            self._pixels = ensure_real_pixels(self.rd, data_mod.cache_root(self.cfg, self.out),
+                                              self.cfg.baselines.image_size, self.frames("rgbd"))
+        return self._pixels
+
+
 class _Inputs:
     """What each system sees, computed on first use (facts per modality, pixels once)."""
 
@@ -253,10 +306,16 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
         bar.update(ccfg.folds * len(ccfg.systems) - len(pending))
         if not pending:
             continue
-        data = data_mod.ensure_dataset(ccfg, out)
-        items = data_mod.read_items(data)
-        folds = stratified_folds(items, ccfg.folds, ccfg.seed)
-        inputs = _Inputs(ccfg, out, data, items, remote)
+        if ccfg.data.folders:
+            rd = _real_examples(ccfg, progress)
+            items = rd.items
+            folds = grouped_folds(items, ccfg.folds, ccfg.seed)
+            inputs = _RealInputs(ccfg, out, rd, remote, progress)
+        else:
+            data = data_mod.ensure_dataset(ccfg, out)
+            items = data_mod.read_items(data)
+            folds = stratified_folds(items, ccfg.folds, ccfg.seed)
+            inputs = _Inputs(ccfg, out, data, items, remote)
         by_system: dict[str, list[int]] = {}
         for sname, k in pending:
             by_system.setdefault(sname, []).append(k)
@@ -269,9 +328,11 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
                 if sname in LOGIC_SYSTEMS:
                     _write_programs(out / "programs" / cname / sname / f"fold{k}", files)
                 record.update(key=result_key(ccfg, sname, k), condition=cname, system=sname, fold=k,
-                              test_ids=[it.id for it in test],
+                              test_ids=[it.id for it in test], test_classes=[it.cls for it in test],
                               pipeline_errors=inputs.errors.get(modality_of(sname), {}) if sname in LOGIC_SYSTEMS
                               else {}, code=learner_version() if sname in LOGIC_SYSTEMS else None)
+                if ccfg.data.folders:  # rows of objects.csv and classes the study could not use: counted
+                    record["left_out"] = inputs.rd.left_out
                 _write_json(fold_path(out, cname, sname, k), record)
                 done.setdefault(record["key"], fold_path(out, cname, sname, k))
                 failed += sum(len(v) for v in record.get("learn_failures", {}).values())
@@ -280,6 +341,17 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
     bar.close()
     summary = write_report(out, study.base, conds)
     return {"ran": ran, "skipped": skipped, "report": summary, "learn_failures": failed}
+
+
+def _real_examples(ccfg: StudyConfig, progress: bool):
+    """The labelled objects of the condition's folders; each unusable row of objects.csv one line on stderr."""
+    from .real_data import real_data
+
+    rd = real_data(ccfg.data.folders, ccfg.data.classes)
+    if progress:
+        for p in rd.problems:
+            print(f"lv3d: warning: {p} (left out)", file=sys.stderr)
+    return rd
 
 
 def _is_study(folder: Path) -> bool:

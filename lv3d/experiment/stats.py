@@ -74,3 +74,20 @@ def paired(a: list[float], b: list[float]) -> dict:
         raise ValueError(f"paired test needs equal lengths, got {len(a)} and {len(b)}")
     return {"mean_diff": float(np.mean(np.asarray(a) - np.asarray(b))) if len(a) else float("nan"),
             "ci95": list(mean_diff_ci(a, b)), "sign": sign_test(a, b), "wilcoxon": wilcoxon_test(a, b)}
+
+
+def reliability_bins(p, y, bins: int = 10) -> list[tuple[float, int, float, float]]:
+    """Equal-width confidence bins: (lower edge, answers, mean confidence, share right) of each non-empty one.
+    ``p`` (n,) confidences in [0, 1]; ``y`` (n,) right or wrong as 0/1 or bool."""
+    p, y = np.asarray(p, float), np.asarray(y, float)
+    idx = np.minimum((p * bins).astype(int), bins - 1)
+    return [(b / bins, int(np.sum(idx == b)), float(p[idx == b].mean()), float(y[idx == b].mean()))
+            for b in range(bins) if np.any(idx == b)]
+
+
+def ece(p, y, bins: int = 10) -> float:
+    """Expected calibration error: sum over the bins of :func:`reliability_bins` of |mean confidence - share
+    right| times the share of answers in the bin; nan for no answers."""
+    if len(p) == 0:
+        return float("nan")
+    return float(sum(abs(conf - true) * n / len(p) for _, n, conf, true in reliability_bins(p, y, bins)))

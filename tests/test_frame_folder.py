@@ -1,0 +1,141 @@
+"""Folders of labelled frames (the layout of ../shared/data/real): reading objects.csv, one example per labelled
+object, learning from such a folder on the command line and in a study."""
+
+import json
+
+import cv2
+import numpy as np
+import pytest
+
+from lv3d.cli.app import main
+from lv3d.frame_folder import FrameFolder, scene_atom
+from lv3d.object_facts import example_facts, example_id, frame_facts
+
+CLASSES = {"cube": "box", "triangular_prism": "prism"}
+
+
+def _write_folder(folder, frames):
+    """Rendered frames written in the real layout: (name, rendered class, seed) each; objects.csv labels the
+    target at the centre of its faces' pixels."""
+    from lv3d.render.frame import render_scene
+
+    folder.mkdir()
+    intr, rows = {"width": 320, "height": 240, "frames": {}}, ["frame,object,u,v,shape,partial,stacked,notes"]
+    for name, cls, seed in frames:
+        frame, faces = render_scene(cls, seed, "clean", 320, 240)
+        cv2.imwrite(str(folder / f"{name}_rgb.png"), cv2.cvtColor(frame.color, cv2.COLOR_RGB2BGR))
+        cv2.imwrite(str(folder / f"{name}_depth_mm.png"), np.round(frame.depth * 1000).astype(np.uint16))
+        k = frame.intrinsics
+        intr["frames"][name] = {"fx": k.fx, "fy": k.fy, "cx": k.cx, "cy": k.cy, "depth_scale_m": 0.001}
+        v, u = np.nonzero(faces)
+        i = int(np.argmin(np.hypot(u - u.mean(), v - v.mean())))  # a pixel of the object nearest its centre
+        rows.append(f"{name},1,{u[i]},{v[i]},{CLASSES[cls]},no,no,")
+    (folder / "intrinsics.json").write_text(json.dumps(intr))
+    (folder / "objects.csv").write_text("\n".join(rows) + "\n")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def frames(tmp_path_factory):
+    names = [(f"frame-{i:03d}", cls, 11 + i) for i, cls in enumerate(["cube", "triangular_prism"] * 3)]
+    return _write_folder(tmp_path_factory.mktemp("real") / "frames", names)
+
+
+def test_rows_that_cannot_be_used_are_named_by_file_and_line_and_the_rest_are_read(tmp_path, frames):
+    folder = tmp_path / "copy"
+    folder.mkdir()
+    for p in frames.iterdir():
+        (folder / p.name).write_bytes(p.read_bytes())
+    with (folder / "objects.csv").open("a") as f:
+        f.write("frame-000,x,5,5,box,no,no,\n")       # line 8: not a number
+        f.write("nowhere,1,5,5,box,no,no,\n")          # line 9: no such frame
+        f.write("frame-000,2,900,5,box,no,no,\n")      # line 10: outside the image
+        f.write("frame-000,3,5,5,Big Box,no,no,\n")    # line 11: not a class name
+        f.write("frame-000,1,5,5,box,no,no,\n")        # line 12: labelled twice
+    objects, problems = FrameFolder(folder).objects()
+    assert len(objects) == 6
+    assert [p.line for p in problems] == [8, 9, 10, 11, 12]
+    assert all(str(p).startswith(f"{folder / 'objects.csv'}: line ") for p in problems)
+    assert "outside the 320x240 frame" in str(problems[2]) and "twice" in str(problems[4])
+
+
+def test_a_folder_not_in_the_layout_is_one_clear_error(tmp_path):
+    from lv3d.errors import InputError
+
+    with pytest.raises(InputError, match="no objects.csv"):
+        FrameFolder(tmp_path)
+    (tmp_path / "objects.csv").write_text("frame,u,v\n")
+    (tmp_path / "intrinsics.json").write_text("{}")
+    (tmp_path / "a_rgb.png").write_bytes(b"")
+    (tmp_path / "a_depth_mm.png").write_bytes(b"")
+    with pytest.raises(InputError, match="missing object, shape"):
+        FrameFolder(tmp_path).objects()
+
+
+def test_frame_names_become_distinct_prolog_atoms():
+    names = ["learn0", "frame-000000", "frame_000000", "0001", "Frame-000000", "ä"]
+    atoms = [scene_atom(n) for n in names]
+    assert atoms[0] == "learn0" and len(set(atoms)) == len(atoms)
+    assert all(a[0].islower() and a.replace("_", "").isalnum() and a.isascii() for a in atoms)
+
+
+@pytest.mark.parametrize("modality", ["rgb", "depth", "rgbd"])
+def test_each_labelled_object_is_an_example_of_its_own(frames, modality):
+    folder = FrameFolder(frames)
+    objects, _ = folder.objects()
+    lab = objects[0]
+    atom = scene_atom(lab.frame)
+    ff = frame_facts(folder.load(lab.frame), atom, modality, [(lab.object, lab.u, lab.v), (9, 2, 2)])
+    ex = example_facts(ff, lab.object, example_id(atom, lab.object))
+    assert ex.target == f"{atom}_x1_o" and ex.scene == f"{atom}_x1"
+    assert {f.args[0] for f in ex.facts if f.pred == "face_of"} == {ex.target}
+    assert all(a.startswith(ex.target) for f in ex.facts for a in f.args)
+    # a label in the image's corner, on no object: an example with no target
+    assert ff.under[9] is None and example_facts(ff, 9, example_id(atom, 9)).target is None
+    assert json.loads(json.dumps(ff.to_json())) == type(ff).from_json(ff.to_json()).to_json()
+
+
+def test_learn_fit_predict_and_explain_on_a_folder_of_frames(frames, tmp_path, capsys):
+    cache, model = tmp_path / "cache", tmp_path / "model"
+    args = ["--data", str(frames), "--modality", "depth", "--cache", str(cache)]
+    assert main(["learn", "fit", *args, "--out", str(model), "--time-limit", "20"]) == 0
+    out = capsys.readouterr().out
+    assert "learned from 6 examples (box 3, prism 3)" in out and "box(A) :-" in out
+    assert list(cache.rglob("*.json"))  # the frames' facts are cached: a second command reads them
+    assert main(["learn", "predict", *args, "--model", str(model)]) == 0
+    out = capsys.readouterr().out
+    rows = [line.split("\t") for line in out.splitlines()[:-1]]
+    assert len(rows) == 6 and out.splitlines()[-1].startswith("accuracy ")
+    assert all(r[2] == "box" for r in rows if r[1] == "box")  # every box is proved a box
+    ex = f"{scene_atom('frame-002')}_x1"
+    assert main(["learn", "explain", *args, "--model", str(model), "--example", ex]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"{ex} (box): {ex}_o is a box") and "because" in out
+    assert main(["learn", "fit", *args, "--facts", "truth", "--out", str(tmp_path / "m2")]) == 2
+    assert "no ground-truth facts" in capsys.readouterr().err
+
+
+def test_a_study_on_folders_keeps_each_frame_in_one_fold(frames, tmp_path):
+    from lv3d.experiment.runner import run_study
+
+    config = tmp_path / "real.yaml"
+    config.write_text(f"""
+name: real_tiny
+folds: 3
+data: {{folders: [{frames}], classes: [box, prism], cache: {tmp_path / 'cache'}}}
+train: {{positives: 1, negatives_per_positive: 1, multiclass: true}}
+systems: [lv3d-depth, tree-rgbd]
+lv3d: {{settings: {{time_limit: 10}}}}
+baselines: {{image_size: 16, tree_cells: 4}}
+""")
+    out = tmp_path / "run"
+    summary = run_study(config, out, progress=False)
+    assert summary["ran"] == 6
+    tests = [set(json.loads((out / "folds" / "base" / "lv3d-depth" / f"fold{k}.json").read_text())["test_ids"])
+             for k in range(3)]
+    assert sorted(i for t in tests for i in t) == sorted(f"{scene_atom(f'frame-{i:03d}')}_x1" for i in range(6))
+    rec = json.loads((out / "folds" / "base" / "tree-rgbd" / "fold0.json").read_text())
+    assert rec["left_out"] == {"unusable_rows": [], "other_classes": {}}
+    assert (out / "results.md").is_file()
+    again = run_study(config, out, progress=False)  # resumes: nothing to recompute
+    assert again["ran"] == 0 and again["skipped"] == 6
