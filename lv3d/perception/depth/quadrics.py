@@ -44,7 +44,9 @@ class QuadricSettings:
     cells, so they lag the turn of a small surface), as for cylinders.
     ``min_share`` (fraction): the share of a plane's residual variance over the face's cells that the fit must
     explain (sphere_evidence, the ``spherical`` fact's confidence; for a cone too); 0.5: the curved reading is
-    the likelier one.
+    the likelier one. A sphere must explain as much of a least-squares cylinder's (its axis started where the
+    cells' normals are most nearly perpendicular to): on RealSense frames of YCB objects a sphere fits a cup's
+    side seen from above or a bottle's shoulder within the noise, but no better than a cylinder does.
     ``min_cone_share`` (fraction): the share of a cylinder's residual variance over a cone's cells that the cone
     must explain (cone_evidence, the ``conical`` fact's confidence). Lower than ``min_share``: a cylinder with a
     tilted axis follows the half of a cone's side a camera sees to 2-3 mm, so RealSense's 1-2 mm of noise
@@ -506,6 +508,12 @@ def _stands(model: Sphere | Cone, pts: np.ndarray, nrm: np.ndarray, plane_res: n
         return False
     if isinstance(model, Sphere):
         if _spread_deg(nrm) < settings.min_spread_deg:
+            return False
+        # a sphere must also beat the cylinder the cylinder search would read there (a cup's side seen from above)
+        _, vecs = np.linalg.eigh(nrm.T @ nrm)
+        # (a cylinder whose fit does not converge on the cells is no rival: a ball's cap fits none)
+        over_cylinder = _share(float(np.mean(res ** 2)), cylinder_ms(pts, vecs[:, 0]))
+        if over_cylinder is not None and over_cylinder < settings.min_share:
             return False
         share = sphere_evidence(pts, model)
     else:
