@@ -139,3 +139,17 @@ baselines: {{image_size: 16, tree_cells: 4}}
     assert (out / "results.md").is_file()
     again = run_study(config, out, progress=False)  # resumes: nothing to recompute
     assert again["ran"] == 0 and again["skipped"] == 6
+
+
+def test_the_demo_learns_from_labelled_frames_and_explains_a_real_object(tmp_path, monkeypatch, capsys):
+    from lv3d.cli import demo
+
+    monkeypatch.setitem(CLASSES, "triangular_prism", "cylinder")  # the demo learns box and cylinder
+    folder = _write_folder(tmp_path / "frames", [(f"f{i}", cls, 21 + i)
+                                                 for i, cls in enumerate(["cube", "triangular_prism"] * 4)])
+    got = demo.real_step(folder, tmp_path / "out", seed=0)
+    out = capsys.readouterr().out
+    assert set(got["answers"]) and all(a[0] in ("box", "cylinder") for a in got["answers"].values())
+    assert (tmp_path / "out" / "overlays").is_dir() and got["overlay"].endswith(".png")
+    assert "learning box, cylinder (lv3d-rgbd)" in out and "perception found" in out
+    assert "Why lv3d-rgbd says the real object" in out
