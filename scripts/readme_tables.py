@@ -43,6 +43,7 @@ SECTIONS = {
     "### Learning curve": ("learning_curve", "positives"),
     "### Few-shot": ("few_shot", "positives"),
     "### Ablations": ("ablations", "condition"),
+    "### Real objects": ("real_objects", "positives"),
 }
 REPLICATES = "### Seed protocol: replicates"
 NOISE = {"k": "noise_depth", "p": "noise_occlusion", "colour sigma": "noise_color",
@@ -102,7 +103,8 @@ def rewrite_table(lines: list[str], study: str) -> list[str]:
         raise SystemExit(f"error: {README}: the {study} table has {len(lines) - 2} rows, its results {len(conds)} conditions")
     for line, cond in zip(lines[2:], conds):
         label = _cells(line)[0]
-        row = [label] + [f"{s[cond][_system(c)][0]:.1f} / {s[cond][_system(c)][2]:.1f}" for c in header[1:]]
+        row = [label] + [f"{s[cond][_system(c)][0]:.1f} / {s[cond][_system(c)][2]:.1f}" if _system(c) in s[cond]
+                         else "–" for c in header[1:]]  # a system not run in this condition
         out.append("| " + " | ".join(row) + " |")
     return out
 
