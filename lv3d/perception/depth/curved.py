@@ -238,7 +238,7 @@ def sample_cylinder(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: fl
 
 def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of: np.ndarray, planes: list,
                      dist_m: float, extent_m: float, cell_m: float, min_cells: int, seed: int = 0,
-                     settings: CurvedSettings = DEFAULT, adjacency: list[tuple[int, int]] = ()
+                     settings: CurvedSettings = DEFAULT, adjacency: list[tuple[int, int]] = (), sample: bool = True
                      ) -> list[tuple[Cylinder, np.ndarray, list[int]]]:
     """The cylindrical faces of an object: ``pts`` (m, 3) metres and unit ``nrm`` (m, 3) (zero where unknown) are
     its cells, in row-major order of ``box`` (the object's cells on its bounding box of the grid, bool);
@@ -252,7 +252,8 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
     cells better than the object's planes do (``plane_ratio``) and passes :func:`_stands`: a fan of planes 60 deg
     apart on a small can, a can whose planes took cells of its lid, a can in a clutter of objects. Returns
     (cylinder, its cells (m,) bool, the planes it replaces: those with half their cells or more on it) per face,
-    at most ``settings.max_faces``."""
+    at most ``settings.max_faces``. ``sample`` False: the fan of planes only (the caller found that the object's
+    planes leave no room for a curved surface: quadrics.leaves_room), which spares a box the sample consensus."""
     rng = np.random.default_rng(seed)
     n_planes = len(planes)
     known = np.linalg.norm(nrm, axis=1) > 0.5
@@ -279,7 +280,7 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
             if _stands(cyl, pts[on], nrm[on], None, dist_m, min_cells, settings):
                 out.append((cyl, on, sorted(set(members) | set(replaced(on)))))
                 free &= ~on
-    for _ in range(settings.max_faces * 2):  # a rejected sample does not end the search at once
+    for _ in range(settings.max_faces * 2 if sample else 0):  # a rejected sample does not end the search at once
         if len(out) >= settings.max_faces or np.count_nonzero(free) < max(20, min_cells):
             break
         idx = np.flatnonzero(free)

@@ -638,9 +638,10 @@ def object_quadrics(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of:
     return out
 
 
-def _room(mask: np.ndarray, nrm_box: np.ndarray, rows: np.ndarray, cols: np.ndarray, planes: list,
-          adjacency: list[tuple[int, int]], settings: QuadricSettings) -> bool:
-    """Whether an object's planes leave room for a sphere or a cone (``max_step_deg``, ``free_share``)."""
+def leaves_room(mask: np.ndarray, nrm_box: np.ndarray, rows: np.ndarray, cols: np.ndarray, planes: list,
+                adjacency: list[tuple[int, int]], settings: QuadricSettings) -> bool:
+    """Whether an object's planes leave room for a curved surface (``max_step_deg``, ``free_share``,
+    ``max_flat_faces``): the sample consensus of spheres, cones and cylinders runs only then."""
     if not planes or len(planes) > settings.max_flat_faces:
         return True
     cos_step = np.cos(np.radians(settings.max_step_deg))
@@ -668,7 +669,7 @@ def quadric_faces(xyz: np.ndarray, mask: np.ndarray, nrm_box: np.ndarray, planes
     from .support import noise_threshold
 
     rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    if len(rows) == 0 or not _room(mask, nrm_box, rows, cols, planes, adjacency, settings):
+    if len(rows) == 0 or not leaves_room(mask, nrm_box, rows, cols, planes, adjacency, settings):
         return planes, list(adjacency), [], 0
     i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
     box = mask[i0:i1, j0:j1]

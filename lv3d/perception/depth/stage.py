@@ -162,7 +162,7 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
                                                    settings.quadrics)
         unconverged += failed
         planes, adj, curved = _curved(grid, o, planes, adj, settings.curved, normals, stride / frame.intrinsics.fx,
-                                      _plane_need(o, plane_args), seed + k)
+                                      _plane_need(o, plane_args), seed + k, settings.quadrics)
         curved = quads + [c for c in curved if not any(np.any(c.mask & q.mask) for q in quads)]
         curved_adj = [(i, j) for j, c in enumerate(curved) for i, p in enumerate(planes)
                       if np.count_nonzero(cv2.dilate(c.mask.view(np.uint8), np.ones((5, 5), np.uint8)).view(bool)
@@ -227,11 +227,13 @@ def _solids(grid: PointGrid, support: Plane | None, objs: list[DepthObject], see
 
 
 def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list[tuple[int, int]],
-            settings: CurvedSettings, normals: _Normals, cell_rel: float, min_cells: int, seed: int
+            settings: CurvedSettings, normals: _Normals, cell_rel: float, min_cells: int, seed: int, room_settings
             ) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
     """The object's planes and their adjacency with the planes its cylindrical faces replace left out, and those
     faces (curved.object_cylinders); the inputs unchanged when there is none. ``cell_rel``: a grid cell's width as
-    a fraction of the depth (stride / fx); ``min_cells``: the fewest cells of a face, as of a plane."""
+    a fraction of the depth (stride / fx); ``min_cells``: the fewest cells of a face, as of a plane. The sample
+    consensus of cylinders runs only where the planes leave room for a curved surface (quadrics.leaves_room with
+    ``room_settings``); the fan of planes always."""
     if not planes:
         return planes, adj, []
     m = o.mask
@@ -245,8 +247,11 @@ def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list
         plane_of[p.mask[i0:i1, j0:j1][box]] = k
     extent = float(np.linalg.norm(np.percentile(pts, 95, axis=0) - np.percentile(pts, 5, axis=0)))
     z = float(np.median(pts[:, 2]))
+    from .quadrics import leaves_room
+
+    room = leaves_room(m, normals(m), rows, cols, planes, adj, room_settings)
     found = object_cylinders(pts, nrm, box, plane_of, [p.plane for p in planes], noise_threshold(z), extent, cell_rel * z,
-                             min_cells, seed, settings, adj)
+                             min_cells, seed, settings, adj, sample=room)
     if not found:
         return planes, adj, []
     gone = {k for _, _, fan in found for k in fan}
