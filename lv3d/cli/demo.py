@@ -214,10 +214,15 @@ def real_step(folder: Path, out: Path, seed: int) -> dict:
         return {"skipped": "no examples of both classes"}
     train_fold, test_fold = grouped_folds(rd.items, 2, seed)
     train = multiclass_task(train_fold, REAL_TRAIN, seed)
-    # the test frame: the first of the other fold's frames with objects of both classes (else any)
+    # the test frame, of the other fold's frames: the first whose objects are neither partly hidden nor stacked
+    # (objects.csv's partial and stacked) with both classes, else with a cylinder; else the first with both
+    # classes, else any
     frames = sorted({it.group_key for it in test_fold})
-    both = [f for f in frames if {it.cls for it in test_fold if it.group_key == f} >= set(REAL_CLASSES)]
-    test_frame = (both or frames)[0]
+    classes = {f: {it.cls for it in test_fold if it.group_key == f} for f in frames}
+    plain = [f for f in frames if not any(o.partial or o.stacked for o in rd.labels[f])]
+    test_frame = next(iter([f for f in plain if classes[f] >= set(REAL_CLASSES)]
+                           or [f for f in plain if REAL_CLASSES[1] in classes[f]]
+                           or [f for f in frames if classes[f] >= set(REAL_CLASSES)] or frames))
     test = [it for it in test_fold if it.group_key == test_frame]
     keep = {it.group_key for it in train} | {test_frame}
     small = replace(rd, items=train + test, frames={a: v for a, v in rd.frames.items() if a in keep},
