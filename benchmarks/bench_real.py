@@ -123,6 +123,7 @@ from tqdm import tqdm
 
 from benchmarks.calibration_error import ece
 from lv3d.errors import InputError
+from lv3d.frame_folder import natural_key, read_label_image  # noqa: F401  (calibration_real reads them here)
 from lv3d.facts import MODALITIES, PREDICATES
 from lv3d.object_facts import object_under
 
@@ -184,11 +185,6 @@ class Label:
 # ---------------------------------------------------------------------------------------------- input
 
 
-def natural_key(name: str) -> list:
-    """learn2 before learn10."""
-    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
-
-
 def read_labels(path: Path) -> dict[str, list[Label]]:
     """objects.csv -> {frame: [Label, ...]}; a malformed file is an InputError naming it."""
     path = Path(path)
@@ -240,18 +236,6 @@ def check_folder(folder: Path) -> None:
     unknown = sorted(set(read_labels(folder / "objects.csv")) - set(frames), key=natural_key)
     if unknown:
         raise InputError(folder / "objects.csv", f"names frames that are not in the folder: {', '.join(unknown)}")
-
-
-def read_label_image(path: Path, shape: tuple[int, int]) -> np.ndarray | None:
-    """A ground-truth mask image (uint16 ids) or None where the frame has none."""
-    if not path.is_file():
-        return None
-    lab = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    if lab is None or lab.ndim != 2:
-        raise InputError(path, "cannot read the label image as one channel of object ids")
-    if lab.shape != tuple(shape):
-        raise InputError(path, f"label image is {lab.shape[1]}x{lab.shape[0]}, the frame {shape[1]}x{shape[0]}")
-    return lab
 
 
 # ---------------------------------------------------------------------------------------------- figures

@@ -325,16 +325,12 @@ def curved_evidence(points: np.ndarray, cylinder) -> float | None:
     that perception took for a cylinder gives near 0 (the cylinder fits no better than the plane: on the real
     dev frames, 0.05-0.2 for box faces), a can's side near 1 (its sagitta is many times the sensor's noise:
     0.94-0.99 on the Kinect cans, 0.5-0.8 on small or far RealSense ones). None for fewer than 10 points."""
+    from .perception.depth.curved import cylinder_share
+
     pts = np.asarray(points, float)
     if len(pts) < 10:
         return None
-    centred = pts - pts.mean(axis=0)
-    plane_ms = float(np.linalg.svd(centred, compute_uv=False)[-1] ** 2 / len(pts))
-    r, _ = cylinder.radial(pts)
-    cyl_ms = float(np.mean((r - cylinder.radius) ** 2))
-    if not (plane_ms > 0 and np.isfinite(cyl_ms)):
-        return None
-    return float(np.clip(1.0 - cyl_ms / plane_ms, 0.0, 1.0))
+    return cylinder_share(pts, cylinder)
 
 
 # A planar face meeting a cylindrical face is its cap, bounded by a circle, when its normal lies along the

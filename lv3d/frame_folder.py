@@ -82,6 +82,19 @@ def _yes_no(text: str | None) -> bool:
     raise ValueError(f"expected yes or no, not {text!r}")
 
 
+def read_label_image(path: Path, shape: tuple[int, int]) -> np.ndarray | None:
+    """A ground-truth mask image (uint16 ids, one channel, ``shape`` (h, w)) or None where there is no file."""
+    path = Path(path)
+    if not path.is_file():
+        return None
+    lab = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if lab is None or lab.ndim != 2:
+        raise InputError(path, "cannot read the label image as one channel of object ids")
+    if lab.shape != tuple(shape):
+        raise InputError(path, f"label image is {lab.shape[1]}x{lab.shape[0]}, the frame {shape[1]}x{shape[0]}")
+    return lab
+
+
 def is_frame_folder(path: Path) -> bool:
     return Path(path).is_dir() and (Path(path) / "objects.csv").is_file()
 
@@ -181,15 +194,7 @@ class FrameFolder:
 
     def label_image(self, frame: str, shape: tuple[int, int]) -> np.ndarray | None:
         """The frame's ground-truth masks (uint16 ids) or None where it has none."""
-        path = self.path / f"{frame}_label.png"
-        if not path.is_file():
-            return None
-        lab = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-        if lab is None or lab.ndim != 2:
-            raise InputError(path, "cannot read the label image as one channel of object ids")
-        if lab.shape != tuple(shape):
-            raise InputError(path, f"label image is {lab.shape[1]}x{lab.shape[0]}, the frame {shape[1]}x{shape[0]}")
-        return lab
+        return read_label_image(self.path / f"{frame}_label.png", shape)
 
     def signature(self) -> str:
         """A digest of what the folder holds (objects.csv, intrinsics.json, each frame file's name, size and

@@ -145,7 +145,7 @@ def ensure_facts(cfg: StudyConfig, out: Path, data: Path, items: list[Item], mod
     return facts, errors
 
 
-def _read_pixels(path: Path, items: list[Item], size: int) -> dict[str, np.ndarray] | None:
+def read_pixels(path: Path, items: list[Item], size: int) -> dict[str, np.ndarray] | None:
     try:
         with np.load(path) as z:
             have = dict(zip(z["ids"].tolist(), z["x"]))
@@ -163,12 +163,18 @@ def ensure_pixels(data: Path, items: list[Item], size: int) -> dict[str, np.ndar
 
     path = Path(data) / f"pixels-{size}.npz"
     if path.is_file():
-        got = _read_pixels(path, items, size)
+        got = read_pixels(path, items, size)
         if got is not None:
             return got
     x = np.stack([frame_tensor(load_item(Path(data) / it.dir), "rgbd", size)
                   for it in tqdm(items, desc=f"pixels {size}x{size}")])
-    buf = io.BytesIO()
-    np.savez_compressed(buf, ids=np.array([it.id for it in items]), x=x)
-    write_atomic(path, buf.getvalue())
+    write_pixels(path, [it.id for it in items], x)
     return {it.id: x[i] for i, it in enumerate(items)}
+
+
+def write_pixels(path: Path, ids: list[str], x: np.ndarray) -> None:
+    """The pixel cache file: ``ids`` and their (N, 4, S, S) tensors ``x``, written whole or not at all."""
+    buf = io.BytesIO()
+    np.savez_compressed(buf, ids=np.array(ids), x=x)
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    write_atomic(path, buf.getvalue())

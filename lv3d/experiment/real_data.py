@@ -16,9 +16,7 @@ and counted (``RealData.left_out``); the runner prints the unusable rows, one li
 
 from __future__ import annotations
 
-import io
 import json
-import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -189,26 +187,16 @@ def crop_box(box: list[int] | None, u: int, v: int, shape: tuple[int, int]) -> t
     return cu - side // 2, cv - side // 2, side
 
 
-def _read_pixels(path: Path, ids: list[str], size: int):
-    try:
-        with np.load(path) as z:
-            have = dict(zip(z["ids"].tolist(), z["x"]))
-    except (OSError, EOFError, ValueError, KeyError, zipfile.BadZipFile):
-        return None
-    if not all(i in have and have[i].shape == (4, size, size) for i in ids):
-        return None
-    return {i: have[i] for i in ids}
-
-
 def ensure_real_pixels(rd: RealData, cache: Path, size: int, rgbd_frames: dict) -> dict[str, np.ndarray]:
     """{item id: (4, size, size) float32 crop tensor} (lv3d.baselines.pixels' channels), cached."""
     from ..baselines.pixels import crop_tensor
     from ..object_facts import example_id
+    from .data import read_pixels, write_pixels
 
     path = Path(cache) / rd.key / f"pixels-{size}.npz"
     ids = [it.id for it in rd.items]
     if path.is_file():
-        got = _read_pixels(path, ids, size)
+        got = read_pixels(path, rd.items, size)
         if got is not None:
             return got
     out = {}
@@ -218,8 +206,5 @@ def ensure_real_pixels(rd: RealData, cache: Path, size: int, rgbd_frames: dict) 
         for lab in rd.labels[atom]:
             box = rgbd_frames[atom].boxes.get(lab.object) if atom in rgbd_frames else None
             out[example_id(atom, lab.object)] = crop_tensor(rgbd, crop_box(box, lab.u, lab.v, rgbd.depth.shape), size)
-    buf = io.BytesIO()
-    np.savez_compressed(buf, ids=np.array(ids), x=np.stack([out[i] for i in ids]))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_atomic(path, buf.getvalue())
+    write_pixels(path, ids, np.stack([out[i] for i in ids]))
     return out

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...cylinder import Cylinder
+from .planes import largest_piece_on
 
 
 @dataclass(frozen=True)
@@ -276,7 +277,7 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
                            plane_of, dist_m, extent_m, settings)
         if fan is not None:
             cyl, on, members = fan
-            on = _piece(on, box)
+            on = largest_piece_on(on, box)
             if _stands(cyl, pts[on], nrm[on], None, dist_m, min_cells, settings):
                 out.append((cyl, on, sorted(set(members) | set(replaced(on)))))
                 free &= ~on
@@ -290,14 +291,14 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
             break
         on = np.zeros(len(pts), bool)
         for _ in range(settings.refits):
-            on = _piece(free & _inliers(cyl, pts, nrm, dist, cos_min), box)
+            on = largest_piece_on(free & _inliers(cyl, pts, nrm, dist, cos_min), box)
             if np.count_nonzero(on) < max(20, min_cells):
                 break
             again = refine(pts[on], nrm[on])
             if again is None or not r_min <= again.radius <= r_max:
                 break
             cyl = again
-        on = _piece(free & _inliers(cyl, pts, nrm, dist, cos_min), box)
+        on = largest_piece_on(free & _inliers(cyl, pts, nrm, dist, cos_min), box)
         ok = on & (plane_of >= 0)
         gone = replaced(on) if ok.any() else []
         if gone and _stands(cyl, pts[on], nrm[on], res[ok], dist, min_cells, settings):
@@ -308,17 +309,6 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
         else:
             break
     return out
-
-
-def _piece(sel: np.ndarray, box: np.ndarray) -> np.ndarray:
-    """The largest 8-connected piece of the selected cells ``sel`` (m,) bool laid out on ``box``."""
-    from .planes import largest_piece
-
-    if not sel.any():
-        return sel
-    grid = np.zeros(box.shape, bool)
-    grid[box] = sel
-    return largest_piece(grid)[box]
 
 
 def _stands(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarray | None, dist_m: float,
@@ -345,16 +335,32 @@ def _stands(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarr
     return curved_share(pts, cyl) >= settings.min_share
 
 
-def curved_share(pts: np.ndarray, cyl: Cylinder) -> float:
-    """The share of a plane's residual variance over the points (m, 3) that the cylinder explains,
-    1 - rms_cylinder^2 / rms_plane^2, in [0, 1] (describe.curved_evidence, the fact's confidence)."""
+def plane_ms(pts: np.ndarray) -> float:
+    """Mean square distance of points (m, 3) from their least-squares plane."""
     centred = pts - pts.mean(axis=0)
-    plane_ms = float(np.linalg.svd(centred, compute_uv=False)[-1] ** 2 / len(pts))
+    return float(np.linalg.svd(centred, compute_uv=False)[-1] ** 2 / len(pts))
+
+
+def explained_share(ms: float, alt_ms: float) -> float | None:
+    """1 - ms / alt_ms in [0, 1]: the share of a simpler surface's residual variance (``alt_ms``, mean square)
+    that a surface with residual ``ms`` explains; None where either is not finite or ``alt_ms`` is not above 0.
+    The confidence of the curved-surface facts (describe.curved_evidence, quadrics)."""
+    if not (np.isfinite(ms) and np.isfinite(alt_ms) and alt_ms > 0):
+        return None
+    return float(np.clip(1.0 - ms / alt_ms, 0.0, 1.0))
+
+
+def cylinder_share(pts: np.ndarray, cyl: Cylinder) -> float | None:
+    """The share of a plane's residual variance over the points (m, 3) that the cylinder explains,
+    1 - rms_cylinder^2 / rms_plane^2 (:func:`explained_share`)."""
     r, _ = cyl.radial(pts)
-    cyl_ms = float(np.mean((r - cyl.radius) ** 2))
-    if not (plane_ms > 0 and np.isfinite(cyl_ms)):
-        return 0.0
-    return float(np.clip(1.0 - cyl_ms / plane_ms, 0.0, 1.0))
+    return explained_share(float(np.mean((r - cyl.radius) ** 2)), plane_ms(pts))
+
+
+def curved_share(pts: np.ndarray, cyl: Cylinder) -> float:
+    """:func:`cylinder_share`, 0 where it cannot be measured (describe.curved_evidence, the fact's confidence)."""
+    share = cylinder_share(pts, cyl)
+    return 0.0 if share is None else share
 
 
 def _basis(axis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -34,6 +34,16 @@ def largest_piece(mask: np.ndarray) -> np.ndarray:
     return lab == best
 
 
+def largest_piece_on(sel: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """The largest 8-connected piece of the selected cells ``sel`` (m,) bool laid out on ``box`` (the cells of
+    an object on its bounding box of the grid, bool), as a selection of the same cells."""
+    if not sel.any():
+        return sel
+    grid = np.zeros(box.shape, bool)
+    grid[box] = sel
+    return largest_piece(grid)[box]
+
+
 def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_planes: int = 6,
                   min_frac: float = 0.035, max_need: int = 1500, min_points: int = 25,
                   max_angle_deg: float = 20.0, max_misses: int = 3, normals: np.ndarray | None = None

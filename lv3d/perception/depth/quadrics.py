@@ -31,6 +31,9 @@ import numpy as np
 
 from ...cone import Cone
 from ...sphere import Sphere
+from .curved import explained_share as _share
+from .curved import plane_ms
+from .planes import largest_piece_on
 
 
 @dataclass(frozen=True)
@@ -160,18 +163,6 @@ def surface_fields(c) -> dict:
 
 # ---------------------------------------------------------------------------------------------------------------
 # evidence: the share of a simpler surface's residual variance a fit explains
-
-
-def _share(ms: float, alt_ms: float) -> float | None:
-    if not (np.isfinite(ms) and np.isfinite(alt_ms) and alt_ms > 0):
-        return None
-    return float(np.clip(1.0 - ms / alt_ms, 0.0, 1.0))
-
-
-def plane_ms(pts: np.ndarray) -> float:
-    """Mean square distance of points (m, 3) from their least-squares plane."""
-    centred = pts - pts.mean(axis=0)
-    return float(np.linalg.svd(centred, compute_uv=False)[-1] ** 2 / len(pts))
 
 
 def sphere_evidence(points: np.ndarray, sphere: Sphere) -> float | None:
@@ -450,17 +441,6 @@ def _inliers(model: Sphere | Cone, pts: np.ndarray, nrm: np.ndarray, dist_m: flo
     return ok
 
 
-def _piece(sel: np.ndarray, box: np.ndarray) -> np.ndarray:
-    """The largest 8-connected piece of the selected cells ``sel`` (m,) bool laid out on ``box``."""
-    from .planes import largest_piece
-
-    if not sel.any():
-        return sel
-    grid = np.zeros(box.shape, bool)
-    grid[box] = sel
-    return largest_piece(grid)[box]
-
-
 def _azimuth_profile(axis, nrm: np.ndarray, bin_deg: float, edge_frac: float = 0.25) -> tuple[float, float]:
     """The arc (degrees) the normals (m, 3) fill around ``axis`` (from the first to the last bin of ``bin_deg``
     holding ``edge_frac`` of the fullest or more, the circle cut at its longest empty run) and its emptiest bin
@@ -580,7 +560,7 @@ def object_quadrics(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of:
         sel = np.zeros(len(pts), bool)
         idx = np.flatnonzero(free)
         sel[idx] = _inliers(model, pts[idx], nrm[idx], dist, cos_min)
-        return _piece(sel, box)
+        return largest_piece_on(sel, box)
 
     def valid(model) -> bool:
         if isinstance(model, Sphere):

@@ -23,7 +23,7 @@ from .cloud import PointGrid, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
 from .curved import CurvedFace, CurvedSettings, object_cylinders
 from .occlusion import OcclusionSettings, join_occluded
-from .quadrics import QuadricFace, QuadricSettings, quadric_faces
+from .quadrics import QuadricFace, QuadricSettings, leaves_room, quadric_faces
 from .objects import DepthObject, heavy_noise, segment_objects, support_band
 from .planes import DepthPlane, largest_piece, merge_coplanar, object_planes, plane_adjacency
 from .plane_outline import simplify_on_plane
@@ -247,8 +247,6 @@ def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list
         plane_of[p.mask[i0:i1, j0:j1][box]] = k
     extent = float(np.linalg.norm(np.percentile(pts, 95, axis=0) - np.percentile(pts, 5, axis=0)))
     z = float(np.median(pts[:, 2]))
-    from .quadrics import leaves_room
-
     room = leaves_room(m, normals(m), rows, cols, planes, adj, room_settings)
     found = object_cylinders(pts, nrm, box, plane_of, [p.plane for p in planes], noise_threshold(z), extent, cell_rel * z,
                              min_cells, seed, settings, adj, sample=room)
