@@ -111,7 +111,6 @@ if __name__ == "__main__":  # one core: before numpy, OpenCV, JAX and torch star
 import argparse
 import csv
 import json
-import re
 import sys
 import time
 from dataclasses import dataclass
