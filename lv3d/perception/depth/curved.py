@@ -210,6 +210,22 @@ def _pair_cylinders(p1: np.ndarray, n1: np.ndarray, p2: np.ndarray, n2: np.ndarr
     return a, centre, r, ok
 
 
+def axis_terms(pts: np.ndarray, nrm: np.ndarray, origins: np.ndarray, axes: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For k lines (a point ``origins`` (k, 3) and a unit direction ``axes`` (k, 3) each) and s points (s, 3)
+    with unit normals (s, 3): the points' distances from each line (k, s), and the dot of each point's normal
+    with its offset from the line (k, s) (the distance times the cosine between the normal and the direction
+    away from the line), and each point's position along each line from its origin (k, s). Products of (k, 3)
+    by (3, s) matrices, coordinates about the points' mean."""
+    o = pts.mean(axis=0)
+    p, c = pts - o, origins - o
+    along = axes @ p.T - np.einsum("kj,kj->k", c, axes)[:, None]              # (k, s): d . a
+    dd = np.einsum("sj,sj->s", p, p)[None, :] - 2.0 * (c @ p.T) + np.einsum("kj,kj->k", c, c)[:, None]
+    r = np.sqrt(np.maximum(dd - along * along, 0.0))
+    dn = np.einsum("sj,sj->s", p, nrm)[None, :] - c @ nrm.T - along * (axes @ nrm.T)
+    return r, dn, along
+
+
 def sample_cylinder(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: float, r_min: float, r_max: float,
                     rng: np.random.Generator, trials: int = 256, score_points: int = 800,
                     min_pair_deg: float = 15.0) -> Cylinder | None:
@@ -228,11 +244,11 @@ def sample_cylinder(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: fl
     if not ok.any():
         return None
     axes, centres, radii = axes[ok], centres[ok], radii[ok]
-    d = sp[None, :, :] - centres[:, None, :]                       # (k, s, 3)
-    d = d - np.einsum("ksj,kj->ks", d, axes)[:, :, None] * axes[:, None, :]
-    r = np.linalg.norm(d, axis=2)
-    cos = np.einsum("ksj,sj->ks", d, sn) / np.maximum(r, 1e-12)
-    count = np.count_nonzero((np.abs(r - radii[:, None]) <= dist_m) & (cos >= cos_min), axis=1)
+    # each hypothesis k against each scored point s, d = p_s - c_k, in (k, s) products rather than (k, s, 3)
+    # arrays: along = d . a, r^2 = |d|^2 - along^2, and the radial direction's dot with the normal is
+    # (d . n - along (a . n)) / r (coordinates taken about the scored points' mean, where they are small)
+    r, radial_n, _ = axis_terms(sp, sn, centres, axes)
+    count = np.count_nonzero((np.abs(r - radii[:, None]) <= dist_m) & (radial_n >= cos_min * r), axis=1)
     b = int(np.argmax(count))
     return Cylinder(tuple(axes[b]), tuple(centres[b]), float(radii[b]))
 

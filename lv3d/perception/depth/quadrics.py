@@ -31,6 +31,7 @@ import numpy as np
 
 from ...cone import Cone
 from ...sphere import Sphere
+from .curved import axis_terms
 from .curved import explained_share as _share
 from .curved import plane_ms
 from .planes import largest_piece_on
@@ -260,10 +261,16 @@ def sample_sphere(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: floa
         return None
     r = r[ok]
     c = 0.5 * (pts[i][ok] - r[:, None] * nrm[i][ok] + pts[j][ok] - r[:, None] * nrm[j][ok])
-    dv = pts[score][None, :, :] - c[:, None, :]
-    rr = np.linalg.norm(dv, axis=2)
-    cos = np.einsum("ksj,sj->ks", dv, nrm[score]) / np.maximum(rr, 1e-12)
-    count = np.count_nonzero((np.abs(rr - r[:, None]) <= dist_m) & (cos >= cos_min), axis=1)
+    # each centre k against each scored point s in (k, s) products (coordinates about the points' mean):
+    # |p - c|^2 = |p|^2 - 2 c . p + |c|^2, and the normal's dot with p - c
+    sp, sn = pts[score], nrm[score]
+    o = sp.mean(axis=0)
+    q, co = sp - o, c - o
+    cq = co @ q.T
+    rr = np.sqrt(np.maximum(np.einsum("sj,sj->s", q, q)[None, :] - 2.0 * cq + np.einsum("kj,kj->k", co, co)[:, None],
+                            0.0))
+    dn = np.einsum("sj,sj->s", q, sn)[None, :] - co @ sn.T
+    count = np.count_nonzero((np.abs(rr - r[:, None]) <= dist_m) & (dn >= cos_min * rr), axis=1)
     b = int(np.argmax(count))
     return Sphere(tuple(float(x) for x in c[b]), float(r[b]))
 
@@ -297,14 +304,13 @@ def sample_cone(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: float,
     if not ok.any():
         return None
     apex, axis, alpha = apex[ok], axis[ok], np.arcsin(s[ok])
-    dv = pts[score][None, :, :] - apex[:, None, :]
-    h = np.einsum("ksj,kj->ks", dv, axis)
-    w = dv - h[:, :, None] * axis[:, None, :]
-    rho = np.linalg.norm(w, axis=2)
+    # each cone k against each scored point s in (k, s) products: h the distance along the axis from the apex,
+    # rho from the axis, wn the dot of the normal with the point's offset from the axis (curved.axis_terms)
+    sp, sn = pts[score], nrm[score]
+    rho, wn, h = axis_terms(sp, sn, apex, axis)
     ca, sa = np.cos(alpha)[:, None], np.sin(alpha)[:, None]
     resid = rho * ca - h * sa
-    cos = (np.einsum("ksj,sj->ks", w, nrm[score]) / np.maximum(rho, 1e-12)) * ca \
-        - np.einsum("kj,sj->ks", axis, nrm[score]) * sa
+    cos = wn / np.maximum(rho, 1e-12) * ca - (axis @ sn.T) * sa
     count = np.count_nonzero((np.abs(resid) <= dist_m) & (cos >= cos_min) & (h > 0), axis=1)
     b = int(np.argmax(count))
     return Cone(tuple(float(x) for x in apex[b]), tuple(float(x) for x in axis[b]), float(np.degrees(alpha[b])),
