@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .plane import row_norms
+
 
 @dataclass(frozen=True)
 class Cone:
@@ -34,7 +36,7 @@ class Cone:
         v = np.asarray(points, float) - np.asarray(self.apex)
         h = v @ a
         w = v - h[:, None] * a
-        rho = np.linalg.norm(w, axis=1)
+        rho = row_norms(w)
         return h, rho, w / np.maximum(rho, 1e-12)[:, None]
 
     def residual(self, points: np.ndarray) -> np.ndarray:

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .plane import row_norms
+
 
 @dataclass(frozen=True)
 class Cylinder:
@@ -19,8 +21,8 @@ class Cylinder:
         """Distances (m,) of ``points`` (m, 3) from the axis, and the unit directions (m, 3) away from it."""
         a, c = np.asarray(self.axis), np.asarray(self.point)
         d = points - c
-        d = d - np.outer(d @ a, a)
-        r = np.linalg.norm(d, axis=1)
+        d = d - (d @ a)[:, None] * a
+        r = row_norms(d)
         return r, d / np.maximum(r, 1e-12)[:, None]
 
     def to_dict(self) -> dict:

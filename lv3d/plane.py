@@ -8,6 +8,14 @@ from dataclasses import dataclass
 import numpy as np
 
 
+def row_norms(v: np.ndarray) -> np.ndarray:
+    """The Euclidean length of each row of ``v`` (m, 3): ``np.linalg.norm(v, axis=1)``, the same numbers (the
+    three squares added in the same order) at a third of its cost, which its generality spends on arrays this
+    narrow."""
+    x, y, z = v[:, 0], v[:, 1], v[:, 2]
+    return np.sqrt(x * x + y * y + z * z)
+
+
 @dataclass(frozen=True)
 class Plane:
     normal: tuple[float, float, float]

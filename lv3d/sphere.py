@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .plane import row_norms
+
 
 @dataclass(frozen=True)
 class Sphere:
@@ -18,7 +20,7 @@ class Sphere:
         """Distances (m,) of ``points`` (m, 3) from the centre, and the unit directions (m, 3) away from it (the
         outward normals of the surface there)."""
         d = np.asarray(points, float) - np.asarray(self.centre)
-        r = np.linalg.norm(d, axis=1)
+        r = row_norms(d)
         return r, d / np.maximum(r, 1e-12)[:, None]
 
     def residual(self, points: np.ndarray) -> np.ndarray:

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...cylinder import Cylinder
+from ...plane import row_norms
 from .planes import largest_piece_on
 
 
@@ -155,7 +156,7 @@ def fan_cylinder(normals: list[np.ndarray], sizes: list[int], adjacency: list[tu
     for i in range(len(normals)):
         groups.setdefault(find(i), []).append(i)
     fans = sorted((g for g in groups.values() if len(g) >= 2), key=lambda g: -sum(sizes[i] for i in g))
-    known = np.linalg.norm(nrm, axis=1) > 0.5
+    known = row_norms(nrm) > 0.5
     cos_min = np.cos(np.radians(settings.normal_deg))
     for fan in fans:
         cells = np.isin(plane_of, fan) & known
@@ -273,7 +274,7 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
     planes leave no room for a curved surface: quadrics.leaves_room), which spares a box the sample consensus."""
     rng = np.random.default_rng(seed)
     n_planes = len(planes)
-    known = np.linalg.norm(nrm, axis=1) > 0.5
+    known = row_norms(nrm) > 0.5
     free = known.copy()
     cos_min = np.cos(np.radians(settings.normal_deg))
     dist = settings.inlier_dists * dist_m

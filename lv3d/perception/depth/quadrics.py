@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...cone import Cone
+from ...plane import row_norms
 from ...sphere import Sphere
 from .curved import axis_terms
 from .curved import explained_share as _share
@@ -130,6 +131,20 @@ DEFAULT = QuadricSettings()
 MAX_EVALS = 80
 
 
+def _last_call(fn):
+    """``fn`` of one parameter vector, remembering its value at the last vector asked: Levenberg-Marquardt asks
+    for the residuals and then the Jacobian at the same parameters, which share every intermediate."""
+    memo: list = [None, None]
+
+    def call(p: np.ndarray):
+        key = p.tobytes()
+        if memo[0] != key:
+            memo[0], memo[1] = key, fn(p)
+        return memo[1]
+
+    return call
+
+
 @dataclass(frozen=True)
 class QuadricFace:
     """A sphere's or cone's face of an object: ``surface`` ('sphere' or 'cone'), the fitted ``sphere`` or
@@ -194,8 +209,10 @@ def cylinder_ms(pts: np.ndarray, axis0: np.ndarray) -> float:
         v = pts - (c0 + p[2] * b1 + p[3] * b2)
         h = v @ a
         w = v - np.outer(h, a)
-        rho = np.linalg.norm(w, axis=1)
+        rho = row_norms(w)
         return q, a, h, w / np.maximum(rho, 1e-12)[:, None], rho
+
+    parts = _last_call(parts)
 
     def res(p: np.ndarray) -> np.ndarray:
         return parts(p)[4] - p[4]
@@ -339,13 +356,17 @@ def refine_sphere(pts: np.ndarray, start: Sphere) -> Sphere | None:
     ``start``; None when it does not converge or its numbers are not finite."""
     from scipy.optimize import least_squares
 
+    @_last_call
+    def parts(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        d = pts - p[:3]
+        return d, row_norms(d)
+
     def res(p: np.ndarray) -> np.ndarray:
-        return np.linalg.norm(pts - p[:3], axis=1) - p[3]
+        return parts(p)[1] - p[3]
 
     def jac(p: np.ndarray) -> np.ndarray:
-        d = pts - p[:3]
-        r = np.maximum(np.linalg.norm(d, axis=1), 1e-12)
-        return np.column_stack([-d / r[:, None], -np.ones(len(pts))])
+        d, r = parts(p)
+        return np.column_stack([-d / np.maximum(r, 1e-12)[:, None], -np.ones(len(pts))])
 
     try:
         fit = least_squares(res, np.array([*start.centre, start.radius]), jac=jac, method="lm", max_nfev=MAX_EVALS)
@@ -396,8 +417,10 @@ def refine_cone(pts: np.ndarray, start: Cone) -> Cone | None:
         v = pts - apex
         h = v @ a
         w = v - np.outer(h, a)
-        rho = np.linalg.norm(w, axis=1)
+        rho = row_norms(w)
         return a, t, v, h, w / np.maximum(rho, 1e-12)[:, None], rho
+
+    parts = _last_call(parts)
 
     def res(p: np.ndarray) -> np.ndarray:
         _, t, _, h, _, rho = parts(p)
@@ -531,7 +554,7 @@ def object_quadrics(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of:
     rng = np.random.default_rng(seed)
     out = QuadricResult()
     n_planes = len(planes)
-    known = np.linalg.norm(nrm, axis=1) > 0.5
+    known = row_norms(nrm) > 0.5
     if np.count_nonzero(known) < max(20, min_cells):
         return out
     free = known.copy()
@@ -634,7 +657,7 @@ def leaves_room(mask: np.ndarray, nrm_box: np.ndarray, rows: np.ndarray, cols: n
     if any(float(planes[i].plane.n @ planes[j].plane.n) >= cos_step for i, j in adjacency):
         return True
     box = mask[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
-    known = np.linalg.norm(nrm_box[box], axis=1) > 0.5
+    known = row_norms(nrm_box[box]) > 0.5
     on_plane = np.zeros_like(known)
     for p in planes:
         on_plane |= p.mask[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1][box]
@@ -643,19 +666,22 @@ def leaves_room(mask: np.ndarray, nrm_box: np.ndarray, rows: np.ndarray, cols: n
 
 def quadric_faces(xyz: np.ndarray, mask: np.ndarray, nrm_box: np.ndarray, planes: list,
                   adjacency: list[tuple[int, int]], cell_rel: float, min_cells: int, seed: int,
-                  settings: QuadricSettings = DEFAULT) -> tuple[list, list[tuple[int, int]], list[QuadricFace], int]:
+                  settings: QuadricSettings = DEFAULT, room: bool | None = None
+                  ) -> tuple[list, list[tuple[int, int]], list[QuadricFace], int]:
     """The depth stage's view of :func:`object_quadrics` for one object: ``xyz`` (h, w, 3) the grid's points,
     ``mask`` (h, w) the object's cells, ``nrm_box`` its normals on its bounding box of the grid, ``planes`` its
     DepthPlanes (each with a grid ``mask`` and a ``plane``) touching in pairs ``adjacency``, ``cell_rel`` a grid
     cell's width as a fraction of the depth, ``min_cells`` the fewest cells of a face. The inlier distance is the
     sensor's noise at the object's median depth (support.noise_threshold), as for cylinders. Returns the planes
     kept and their adjacency, the faces (each one connected piece of cells no kept plane holds) and the count of
-    fits that did not converge."""
+    fits that did not converge. ``room``: :func:`leaves_room` of the object where the caller already asked it."""
     from .planes import largest_piece
     from .support import noise_threshold
 
     rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    if len(rows) == 0 or not leaves_room(mask, nrm_box, rows, cols, planes, adjacency, settings):
+    if len(rows) == 0:
+        return planes, list(adjacency), [], 0
+    if not (leaves_room(mask, nrm_box, rows, cols, planes, adjacency, settings) if room is None else room):
         return planes, list(adjacency), [], 0
     i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
     box = mask[i0:i1, j0:j1]

@@ -156,17 +156,19 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
         ta = time.perf_counter()
         planes = merge_coplanar(planes)
         adj = plane_adjacency(planes)
+        # whether the planes leave room for a curved surface: asked once, of the planes both searches start from
+        room = _room(o.mask, normals(o.mask), planes, adj, settings.quadrics)
         # a sphere or a cone first: the cylinder search would read a cone's side as a cylinder
         planes, adj, quads, failed = quadric_faces(grid.xyz, o.mask, normals(o.mask), planes, adj,
                                                    stride / frame.intrinsics.fx, _plane_need(o, plane_args), seed + k,
-                                                   settings.quadrics)
+                                                   settings.quadrics, room=room)
         unconverged += failed
+        # (a sphere or a cone that replaced planes leaves others: the question is asked again of those)
         planes, adj, curved = _curved(grid, o, planes, adj, settings.curved, normals, stride / frame.intrinsics.fx,
-                                      _plane_need(o, plane_args), seed + k, settings.quadrics)
+                                      _plane_need(o, plane_args), seed + k, settings.quadrics,
+                                      room=None if quads else room)
         curved = quads + [c for c in curved if not any(np.any(c.mask & q.mask) for q in quads)]
-        curved_adj = [(i, j) for j, c in enumerate(curved) for i, p in enumerate(planes)
-                      if np.count_nonzero(cv2.dilate(c.mask.view(np.uint8), np.ones((5, 5), np.uint8)).view(bool)
-                                          & p.mask) >= 4]
+        curved_adj = _touching(planes, curved, o.mask)
         tb = time.perf_counter()
         polys = [mask_polygon(p.mask, stride, (h, w)) for p in planes]
         if planes:
@@ -191,6 +193,24 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
     timings = {"cloud": (t1 - t0) * 1e3, "support": (t2 - t1) * 1e3, "objects": (t3 - t2) * 1e3,
                "planes": t_planes * 1e3, "boundary": t_boundary * 1e3}
     return DepthResult(grid, support, results, timings, dropped, unconverged)
+
+
+def _touching(planes: list[DepthPlane], curved: list, mask: np.ndarray, reach: int = 2, min_contact: int = 4
+              ) -> list[tuple[int, int]]:
+    """The pairs (plane i, curved face j) that touch: at least ``min_contact`` cells of the plane within ``reach``
+    cells (a square of side 2 reach + 1) of the curved face. Worked on the object's box (its cells ``mask``) grown
+    by ``reach``, where every such cell lies, each curved face dilated once."""
+    if not curved or not planes:
+        return []
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    i0, j0 = max(0, rows[0] - reach), max(0, cols[0] - reach)
+    i1, j1 = rows[-1] + 1 + reach, cols[-1] + 1 + reach
+    kernel = np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)
+    out = []
+    for j, c in enumerate(curved):
+        near = cv2.dilate(np.ascontiguousarray(c.mask[i0:i1, j0:j1]).view(np.uint8), kernel).view(bool)
+        out += [(i, j) for i, p in enumerate(planes) if np.count_nonzero(near & p.mask[i0:i1, j0:j1]) >= min_contact]
+    return out
 
 
 class _Normals:
@@ -226,14 +246,21 @@ def _solids(grid: PointGrid, support: Plane | None, objs: list[DepthObject], see
     return out
 
 
+def _room(mask: np.ndarray, nrm_box: np.ndarray, planes: list[DepthPlane], adj: list[tuple[int, int]],
+          settings: QuadricSettings) -> bool:
+    """quadrics.leaves_room of the object whose cells are ``mask``."""
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    return len(rows) > 0 and leaves_room(mask, nrm_box, rows, cols, planes, adj, settings)
+
+
 def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list[tuple[int, int]],
-            settings: CurvedSettings, normals: _Normals, cell_rel: float, min_cells: int, seed: int, room_settings
-            ) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
+            settings: CurvedSettings, normals: _Normals, cell_rel: float, min_cells: int, seed: int, room_settings,
+            room: bool | None = None) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
     """The object's planes and their adjacency with the planes its cylindrical faces replace left out, and those
     faces (curved.object_cylinders); the inputs unchanged when there is none. ``cell_rel``: a grid cell's width as
     a fraction of the depth (stride / fx); ``min_cells``: the fewest cells of a face, as of a plane. The sample
     consensus of cylinders runs only where the planes leave room for a curved surface (quadrics.leaves_room with
-    ``room_settings``); the fan of planes always."""
+    ``room_settings``; ``room``: its answer where already known); the fan of planes always."""
     if not planes:
         return planes, adj, []
     m = o.mask
@@ -247,7 +274,8 @@ def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list
         plane_of[p.mask[i0:i1, j0:j1][box]] = k
     extent = float(np.linalg.norm(np.percentile(pts, 95, axis=0) - np.percentile(pts, 5, axis=0)))
     z = float(np.median(pts[:, 2]))
-    room = leaves_room(m, normals(m), rows, cols, planes, adj, room_settings)
+    if room is None:
+        room = leaves_room(m, normals(m), rows, cols, planes, adj, room_settings)
     found = object_cylinders(pts, nrm, box, plane_of, [p.plane for p in planes], noise_threshold(z), extent, cell_rel * z,
                              min_cells, seed, settings, adj, sample=room)
     if not found:
