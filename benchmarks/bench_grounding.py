@@ -31,8 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.calibration_error import chance_ece, ece, ece_verdict, log_loss, reliability_bins, scene_interval
-from benchmarks.grounding_truth import match_faces, truth_labels, truth_quantities, truth_scene
+from lv3d.calibrate.measures import chance_ece, ece, ece_verdict, log_loss, reliability_bins, scene_interval
+from lv3d.calibrate.truth import match_faces, truth_labels, truth_quantities, truth_scene
 from lv3d.describe import MIN_CONF, ground
 from lv3d.perception import perceive
 from lv3d.render import render_scene

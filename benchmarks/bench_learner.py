@@ -4,9 +4,9 @@
         [--quick | --noise | --few-shot [--draws 16]] [--modality depth|rgb] [--settings '{"extra_literals": 0}']
 
 Data: two DEV data sets (never the study's seed 0), 640x480 like the study, rendered from the same
-seed with the clean and the realsense preset, their pipeline and ground-truth rgbd facts cached by
-benchmarks.dev_facts under <root>/<preset><seed> (made on the first run, ~10 min; reruns take
-a few minutes). Protocol as the study's (lv3d.experiment.folds): 5 stratified folds; a class task
+seed with the clean and the realsense preset, their pipeline and ground-truth facts of ``--modality``
+cached by :func:`make_dev_facts` under <root>/<preset><seed> (made on the first run, ~10 min; reruns take
+a few minutes); bench_pipeline_accuracy learns from the same sets. Protocol as the study's (lv3d.experiment.folds): 5 stratified folds; a class task
 trains on 20 positives + 30 negatives (10 of each other class) and is scored on the held-out fold
 (binary: positive iff the model names the class); the multi-class model learns one program per
 class from 20 scenes of each and names one class per held-out scene ('unknown' counts wrong).
@@ -38,17 +38,48 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.dev_facts import make_dev_facts
 from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stratified_folds
 from lv3d.learn import Model, fit
 from lv3d.learn.engine import LearnError
 from lv3d.truth_facts import truth_facts
 
 CLASSES = ("cube", "square_pyramid", "triangular_prism", "pentagonal_prism")
+MODALITIES = ("rgbd", "depth", "rgb")
+
+
+def make_dev_facts(out: Path, preset: str, seed: int, per_class: int, modalities=MODALITIES) -> Path:
+    """Render the DEV set ``out`` (``per_class`` images of each of ``CLASSES``; resumes) and write
+    ``out/facts_<modality>.pkl`` for each of ``modalities``: {scene id: (label, pipeline SceneFacts or None where
+    the pipeline failed, truth SceneFacts, meta truth)} (scenes already in a file are kept)."""
+    from lv3d.pipeline import scene_facts
+    from lv3d.render import make_dataset
+    from lv3d.rgbd import load_item
+
+    make_dataset(out, list(CLASSES), per_class, preset, seed=seed, progress=False)
+    man = json.loads((out / "manifest.json").read_text())
+    for mod in modalities:
+        path = out / f"facts_{mod}.pkl"
+        res = pickle.loads(path.read_bytes()) if path.exists() else {}
+        t0 = time.time()
+        for it in man["items"]:
+            if it["id"] in res:
+                continue
+            frame = load_item(out / it["dir"])
+            try:
+                pf = scene_facts(frame, it["id"], mod)
+            except Exception as e:  # a failure is data for the benchmark: the scene answers 'unknown'
+                print(it["id"], mod, "pipeline error", repr(e)[:200], flush=True)
+                pf = None
+            tf = truth_facts(frame.meta, it["id"], mod)
+            res[it["id"]] = (it["class"], pf, tf, frame.meta.get("truth"))
+        path.write_bytes(pickle.dumps(res))
+        print(mod, len(res), f"{time.time() - t0:.0f}s", flush=True)
+    return out
 
 
 def dev_set(root: Path, preset: str, seed: int, per_class: int, modality: str = "rgbd") -> Path:
-    """<root>/<preset><seed>, rendered and its ``modality`` facts cached by dev_facts.py if not there yet."""
+    """<root>/<preset><seed>, rendered and its ``modality`` facts cached by :func:`make_dev_facts` if not there
+    yet."""
     out = root / f"{preset}{seed}"
     if not (out / f"facts_{modality}.pkl").is_file():
         print(f"making {out} {modality} facts (render + pipeline facts, minutes) ...", flush=True)
@@ -185,7 +216,7 @@ def main(argv=None) -> int:
     ap.add_argument("--draws", type=int, default=None,
                     help="--few-shot: draws a fold at every task size (default 4, 4, 2)")
     ap.add_argument("--modality", default="rgbd", choices=("rgbd", "depth", "rgb"),
-                    help="whose facts every row learns from (depth, rgb: made with dev_facts.py --modalities depth, rgb)")
+                    help="whose facts every row learns from (made into the DEV sets on first use)")
     ap.add_argument("--settings", type=json.loads, default=None, help="learner settings (JSON) for every fit")
     a = ap.parse_args(argv)
     if a.seed == 0:

@@ -1,8 +1,11 @@
 """Per-class binary and multi-class accuracy of lv3d on a DEV set, per modality, beside the targets (issue 6).
 
-    .venv/bin/python -m benchmarks.dev_facts --preset clean --seed 777 --out runs/dev_clean
-    .venv/bin/python -m benchmarks.dev_facts --preset realsense --seed 778 --out runs/dev_realsense
-    .venv/bin/python -m benchmarks.bench_pipeline_accuracy runs/dev_clean runs/dev_realsense
+    .venv/bin/python -m benchmarks.bench_pipeline_accuracy out/bench/dev/clean778 out/bench/dev/realsense778
+
+The DEV sets are those bench_learner makes (``--root R --seed S``: R/clean<S> and R/realsense<S>, with the facts
+of its ``--modality``; benchmarks.run_all makes them under out/bench/dev before this runs);
+``--make PER_CLASS`` renders a DEV set named <preset><seed> that is not there yet and caches the facts of
+every ``--modalities`` a set lacks (bench_learner.make_dev_facts).
 
 The study's protocol on a smaller DEV set (never the study's data): stratified folds, per class task
 positives + 1.5 negatives per positive spread over the other classes, a multi-class task, tested on
@@ -15,9 +18,12 @@ from __future__ import annotations
 import argparse
 import json
 import pickle
+import re
 from pathlib import Path
 
 import numpy as np
+
+from benchmarks.bench_learner import make_dev_facts
 
 from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stratified_folds
 from lv3d.experiment.runner import score_binary
@@ -58,7 +64,11 @@ def evaluate(data: dict, folds: int, positives: int, seed: int, settings: dict, 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("dev", nargs="+", type=Path, help="DEV data sets written by benchmarks/dev_facts.py")
+    ap.add_argument("dev", nargs="+", type=Path,
+                    help="DEV data sets bench_learner made (<root>/<preset><seed>, e.g. out/bench/dev/clean778)")
+    ap.add_argument("--make", type=int, metavar="PER_CLASS",
+                    help="make what a DEV set lacks: render it (PER_CLASS images a class, preset and seed from its "
+                         "name) and cache the facts of --modalities")
     ap.add_argument("--modalities", default="rgbd,depth,rgb")
     ap.add_argument("--facts", choices=("pipeline", "truth"), default="pipeline")
     ap.add_argument("--folds", type=int, default=3)
@@ -69,13 +79,23 @@ def main() -> None:
     a = ap.parse_args()
     import ast
     settings = {k: ast.literal_eval(v) for k, v in (s.split("=", 1) for s in a.set)}
+    mods = a.modalities.split(",")
     for dev in a.dev:
-        preset = json.loads((dev / "manifest.json").read_text())["noise"]  # the preset dev_facts rendered
+        lacking = [m for m in mods if not (dev / f"facts_{m}.pkl").is_file()]
+        if lacking and a.make is None:
+            ap.error(f"{dev}: no facts of {', '.join(lacking)} (make them with bench_learner, or --make PER_CLASS)")
+        if lacking:
+            named = re.fullmatch(r"([a-z]+)(\d+)", dev.name)
+            if named is None:
+                ap.error(f"{dev}: --make needs a DEV set named <preset><seed>, e.g. clean778")
+            make_dev_facts(dev, named[1], int(named[2]), a.make, lacking)
+    for dev in a.dev:
+        preset = json.loads((dev / "manifest.json").read_text())["noise"]  # the preset the DEV set was rendered with
         target = TARGETS.get(preset)
         goal = f"rgbd mean >= {target:.2f}, " if target is not None else ""
         print(f"== {dev} ({preset}; facts: {a.facts}; target {goal}rgbd >= rgb, depth)")
         rows = {}
-        for mod in a.modalities.split(","):
+        for mod in mods:
             raw = pickle.loads((dev / f"facts_{mod}.pkl").read_bytes())
             col = 1 if a.facts == "pipeline" else 2
             data = {i: (v[0], v[col]) for i, v in raw.items() if v[col] is not None}

@@ -68,7 +68,7 @@ two adjacent faces (a pair in ``SceneObject.adjacency``) with ``perpendicular`` 
 adjacent faces with ``perpendicular`` confidence >= 0.5 (the fact is only emitted between planar faces).
 
 ``perpendicular_ece`` (depth and rgbd): expected calibration error (10 equal-width bins,
-benchmarks/calibration_error.ece) of the ``perpendicular`` confidence over the adjacent face pairs of the
+lv3d.calibrate.measures.ece) of the ``perpendicular`` confidence over the adjacent face pairs of the
 perceived objects of labelled boxes (truth: perpendicular) and of labelled cylinders and bowls (truth: not). A
 pair's confidence is that of its ``perpendicular`` fact (the larger of the two argument orders); a pair without
 one has confidence 0, since facts below grounding's floor are absent, not emitted with a small confidence. Each
@@ -109,31 +109,30 @@ if __name__ == "__main__":  # one core: before numpy, OpenCV, JAX and torch star
     os.environ.setdefault("JAX_PLATFORMS", "cpu")
 
 import argparse
-import csv
 import json
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
 from tqdm import tqdm
 
-from benchmarks.calibration_error import ece
+from lv3d.calibrate.measures import ece
+from lv3d.calibrate.real import BOX_PERP, PRISM_PERP, ROUND, SHAPES, perpendicular_truth
 from lv3d.errors import InputError
-from lv3d.frame_folder import natural_key, read_label_image  # noqa: F401  (calibration_real reads them here)
 from lv3d.facts import MODALITIES, PREDICATES
-from lv3d.object_facts import object_under
+from lv3d.frame_folder import FrameFolder, LabelledObject
+from lv3d.object_facts import HOLD_SHARE, face_cover, held_object, merged_flags, object_under, region_pixels
 
 ROOT = Path(__file__).resolve().parent.parent
 
 REAL = ROOT.parent / "shared" / "data" / "real"
 
+# merged and split: a perceived object holds an object when it holds HOLD_SHARE of its mask (lv3d.object_facts);
+# box_perpendicular and cylinder_as_prism: an adjacent pair at perpendicular confidence >= BOX_PERP, PRISM_PERP
+# (lv3d.calibrate.real, whose figures recompute these two for any calibration)
 IOU_MATCH = 0.5        # recall: a ground-truth object is matched at mask IoU >= this
-HOLD_SHARE = 0.2       # merged and split: a perceived object holds an object when it holds this share of its mask
-BOX_PERP = 0.7         # box_perpendicular: an adjacent pair at perpendicular confidence >= this
-PRISM_PERP = 0.5       # cylinder_as_prism: an adjacent pair at perpendicular confidence >= this
 CYL_READ = 0.7         # cylinder_read: a cylindrical fact at confidence >= this
 BOX_MAX_FACES = 3      # a box shows at most 3 faces
 SUPPORT_TOL_M = 0.02   # support: the least tolerance of an object's bottom, metres
@@ -164,121 +163,20 @@ TARGETS: dict[str, tuple[str, float, tuple[str, ...]] | None] = {
     "labelled_found": None,
     "cpu_ms_median": None,
 }
-SHAPES = ("box", "cylinder", "bowl", "sphere", "other")
-ROUND = ("cylinder", "bowl")
-
-
-@dataclass(frozen=True)
-class Label:
-    """One row of objects.csv."""
-
-    frame: str
-    object: int
-    u: int
-    v: int
-    shape: str
-    partial: bool
-    stacked: bool
 
 
 # ---------------------------------------------------------------------------------------------- input
 
 
-def read_labels(path: Path) -> dict[str, list[Label]]:
-    """objects.csv -> {frame: [Label, ...]}; a malformed file is an InputError naming it."""
-    path = Path(path)
-    out: dict[str, list[Label]] = {}
-    with path.open(newline="") as f:
-        reader = csv.DictReader(f)
-        need = {"frame", "object", "u", "v", "shape", "partial", "stacked"}
-        if reader.fieldnames is None or not need <= set(reader.fieldnames):
-            raise InputError(path, f"needs the columns {', '.join(sorted(need))}")
-        for line, r in enumerate(reader, start=2):
-            try:
-                lab = Label(r["frame"], int(r["object"]), int(r["u"]), int(r["v"]), r["shape"].strip(),
-                            _yes_no(r["partial"]), _yes_no(r["stacked"]))
-            except (TypeError, ValueError) as e:
-                raise InputError(path, f"line {line}: {e}") from None
-            if lab.shape not in SHAPES:
-                raise InputError(path, f"line {line}: shape {lab.shape!r} is not one of {', '.join(SHAPES)}")
-            out.setdefault(lab.frame, []).append(lab)
-    return out
-
-
-def _yes_no(s: str) -> bool:
-    s = (s or "").strip().lower()
-    if s not in ("yes", "no"):
-        raise ValueError(f"expected yes or no, not {s!r}")
-    return s == "yes"
-
-
-def folder_frames(folder: Path) -> list[str]:
-    """The frames of a real-layout folder, in natural order."""
-    from lv3d.rgbd import real_frame_files
-
-    return sorted(real_frame_files(folder), key=natural_key)
-
-
-def check_folder(folder: Path) -> None:
-    """InputError unless ``folder`` is in the real layout with objects.csv and intrinsics.json, and every frame
-    objects.csv names is there."""
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise InputError(folder, "not a folder")
-    for name in ("objects.csv", "intrinsics.json"):
-        if not (folder / name).is_file():
-            raise InputError(folder, f"no {name} (bench_real needs a folder in the layout of "
-                                     f"../shared/data/real/README.md)")
-    frames = folder_frames(folder)
-    if not frames:
-        raise InputError(folder, "no frames (<frame>_rgb.* with <frame>_depth*)")
-    unknown = sorted(set(read_labels(folder / "objects.csv")) - set(frames), key=natural_key)
-    if unknown:
-        raise InputError(folder / "objects.csv", f"names frames that are not in the folder: {', '.join(unknown)}")
+def labelled_folder(folder: Path) -> FrameFolder:
+    """``folder`` opened and its labels read strictly (every row usable, a shape of ``SHAPES``): an InputError
+    naming the file and what is wrong otherwise."""
+    ff = FrameFolder(folder)
+    ff.labels(SHAPES)
+    return ff
 
 
 # ---------------------------------------------------------------------------------------------- figures
-
-
-def face_cover(obj, shape: tuple[int, int]) -> np.ndarray:
-    """(H, W) uint8: 1 on ``obj``'s segment where it has one; else how many of its faces cover each pixel (their
-    polygons rasterised with cv2.fillPoly). The object's pixels are where it is > 0."""
-    if getattr(obj, "mask", None) is not None and obj.mask.shape == shape:
-        return obj.mask.astype(np.uint8)
-    cover = np.zeros(shape, np.uint8)
-    one = np.zeros(shape, np.uint8)
-    for f in obj.faces:
-        poly = np.round(np.asarray(f.polygon, float)).astype(np.int32).reshape(-1, 2)
-        if len(poly) < 3:
-            continue
-        one[:] = 0
-        cv2.fillPoly(one, [poly], 1)
-        cover += one
-    return cover
-
-
-def held_object(covers: list[np.ndarray], u: int, v: int) -> int | None:
-    """Index of the object holding pixel (u, v): the most faces covering it, ties to the first; None if none."""
-    counts = [int(c[v, u]) for c in covers]
-    if not counts or max(counts) == 0:
-        return None
-    return int(np.argmax(counts))
-
-
-def region_pixels(lab: Label, label_img: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """(rows, cols) of a labelled object: its mask where the frame has one (and it is not empty), else its
-    labelled pixel alone."""
-    if label_img is not None:
-        vs, us = np.nonzero(label_img == lab.object)
-        if len(vs):
-            return vs, us
-    return np.array([lab.v]), np.array([lab.u])
-
-
-def holds(mask: np.ndarray, region: tuple[np.ndarray, np.ndarray], share: float = HOLD_SHARE) -> bool:
-    """Whether ``mask`` holds >= ``share`` of ``region``'s pixels (a one-pixel region: holds that pixel)."""
-    vs, us = region
-    return len(vs) > 0 and float(np.mean(mask[vs, us])) >= share
 
 
 def gt_matches(label_img: np.ndarray, masks: list[np.ndarray]) -> tuple[int, int, int]:
@@ -299,16 +197,6 @@ def gt_matches(label_img: np.ndarray, masks: list[np.ndarray]) -> tuple[int, int
         matched += bool(ious) and max(ious) >= IOU_MATCH
         split += holders >= 2
     return n, matched, split
-
-
-def merged_flags(held: list[int | None], masks: list[np.ndarray],
-                 regions: list[tuple[np.ndarray, np.ndarray]]) -> list[bool]:
-    """Per labelled object: its perceived object (``held``, index into ``masks``) also holds another labelled
-    object's region (:func:`holds`). Not found: not merged."""
-    out = []
-    for i, k in enumerate(held):
-        out.append(k is not None and any(holds(masks[k], regions[j]) for j in range(len(regions)) if j != i))
-    return out
 
 
 def axial_noise_m(z: float) -> float:
@@ -379,7 +267,7 @@ def connected_region(depth: np.ndarray, mask: np.ndarray, u: int, v: int) -> np.
     return blocked[1:-1, 1:-1] == 2
 
 
-def evaluate_frame(scene, facts, frame, labels: list[Label], label_img: np.ndarray | None) -> dict:
+def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img: np.ndarray | None) -> dict:
     """Counts of one frame and modality (no perception here: ``scene`` and ``facts`` are given), summed over
     frames by :func:`summarise`. ``frame`` supplies the depth and intrinsics; ``label_img`` the masks or None."""
     shape = frame.depth.shape
@@ -423,10 +311,7 @@ def evaluate_frame(scene, facts, frame, labels: list[Label], label_img: np.ndarr
     row["round"] = len(rounds)
     row["round_prism"] = sum(k is not None and any(c >= PRISM_PERP for c in pairs[k]) for _, k in rounds)
     # calibration pairs: each perceived object once, with one truth; merged objects left out
-    truth: dict[int, set[bool]] = {}
-    for lab, k, mg in zip(labels, held, merged):
-        if k is not None and not mg and (lab.shape == "box" or lab.shape in ROUND):
-            truth.setdefault(k, set()).add(lab.shape == "box")
+    truth = perpendicular_truth(labels, held, merged)
     # curved faces: the object under each labelled pixel, as the learner's example takes it
     cyl_conf: dict[str, float] = {}
     for f in facts.facts:
@@ -443,10 +328,9 @@ def evaluate_frame(scene, facts, frame, labels: list[Label], label_img: np.ndarr
         else:
             row["box_curved"] += obj is not None and any(f.surface == "cylinder" for f in obj.faces)
     row["pairs_p"], row["pairs_y"] = [], []
-    for k, ys in sorted(truth.items()):
-        if len(ys) == 1:
-            row["pairs_p"] += pairs[k]
-            row["pairs_y"] += [float(next(iter(ys)))] * len(pairs[k])
+    for k, y in sorted(truth.items()):
+        row["pairs_p"] += pairs[k]
+        row["pairs_y"] += [float(y)] * len(pairs[k])
     return row
 
 
@@ -569,19 +453,18 @@ def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dic
     to ``overlays/<folder>/<frame>_<modality>.png``. Returns {modality: [rows of this folder]}."""
     from lv3d.describe import describe
     from lv3d.perception import perceive
-    from lv3d.rgbd import load_real
 
-    check_folder(folder)
-    labels = read_labels(folder / "objects.csv")
-    frames = folder_frames(folder)
+    ff = labelled_folder(folder)
+    labels = ff.labels(SHAPES)
+    frames = ff.frames
     frames = frames[:limit] if limit else frames
     mine: dict[str, list[dict]] = {m: [] for m in modalities}
-    first = load_real(folder, frames[0])
+    first = ff.load(frames[0])
     for m in modalities:  # warm-up, not counted: JIT compilation and first-call costs
         describe(perceive(first, m, scene_id="s000000"), first)
     for i, name in enumerate(tqdm(frames, desc=folder.name, unit="frame", disable=None, leave=False)):
-        frame = load_real(folder, name)
-        label_img = read_label_image(folder / f"{name}_label.png", frame.shape)
+        frame = ff.load(name)
+        label_img = ff.label_image(name, frame.shape)
         for m in modalities:
             t, c = time.perf_counter(), time.process_time()
             scene = perceive(frame, m, scene_id=f"s{i:06d}")
@@ -630,7 +513,7 @@ def main(argv=None) -> int:
         if not folders:
             raise InputError(REAL, "no folder with objects.csv (name folders on the command line)")
         for folder in folders:
-            check_folder(folder)
+            labelled_folder(folder)
     except InputError as e:
         print(f"bench_real.py: error: {e}", file=sys.stderr)
         return 2

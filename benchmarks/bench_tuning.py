@@ -3,6 +3,7 @@
     .venv/bin/python -m benchmarks.bench_tuning [--data /tmp/cnndev/data] [--seed 1234] [--system cnn-rgbd]
         [--fold 0] [--mode time|tune] [--widths 8,16,32] [--epochs 20,40] [--augment 0,1] [--sizes 32,64]
         [--inner-folds 3]
+    .venv/bin/python -m benchmarks.bench_tuning --quick    # --mode time over a grid of two short settings
 
 Renders 4 classes x 50 images (realsense noise) with the dev seed unless ``--data`` already holds them,
 deals the study's seeded stratified folds with the dev seed and takes the training folds of ``--fold``.
@@ -12,7 +13,9 @@ of the search's trainings sees), timed (wall and CPU seconds), then the search's
 inner folds x the sum over the grid. ``--mode tune``: the whole search as a study runs it
 (lv3d.experiment.systems.PixelSystem.tune, seeded like the runner), its choice and time, and the
 multi-class accuracy on the held-out outer fold of the chosen setting and of the untuned defaults.
-The machine may be shared: compare CPU seconds.
+The machine may be shared: compare CPU seconds. ``--quick`` (what ``run_all --quick`` runs) times a grid of
+two settings of 3 epochs (widths 8 and 16, no augmentation, 32 px) with 2 inner folds: a smoke test of the
+timing, not the study's grid.
 """
 
 from __future__ import annotations
@@ -29,8 +32,11 @@ def _ints(text: str) -> list[int]:
     return [int(v) for v in text.split(",") if v.strip()]
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser()
+QUICK = {"mode": "time", "widths": "8,16", "epochs": "3", "augment": "0", "sizes": "32", "inner_folds": 2}
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--data", type=Path, default=Path("/tmp/cnndev/data"))
     ap.add_argument("--seed", type=int, default=1234, help="dev seed: data, folds and tuning")
     ap.add_argument("--system", default="cnn-rgbd")
@@ -41,7 +47,12 @@ def main() -> None:
     ap.add_argument("--augment", default="0,1")
     ap.add_argument("--sizes", default="32,64")
     ap.add_argument("--inner-folds", type=int, default=3)
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="--mode time over a grid of two short settings "
+                                                          "(overrides the grid options)")
+    args = ap.parse_args(argv)
+    if args.quick:
+        for k, v in QUICK.items():
+            setattr(args, k, v)
 
     from lv3d.baselines import CNNClassifier
     from lv3d.baselines.tuning import area_downsample, grid, inner_folds

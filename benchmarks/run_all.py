@@ -14,6 +14,7 @@
 | bench_learner | learner accuracy, clean against realsense, and speed | 8 scenes a class | 30 a class |
 | bench_pipeline_accuracy | per-class accuracy of each modality on bench_learner's DEV sets | rgbd, 2 folds | 3 modalities |
 | bench_baselines | CNN and decision tree: accuracy and seconds per training | one fold, cnn-rgbd (3 epochs) and tree-rgbd | 5 systems |
+| bench_tuning | what tuning the CNN baseline costs (seconds per grid setting and per search) | 2 settings of 3 epochs, 2 inner folds | the study's grid |
 | bench_metagol | lv3d mil against Metagol on Metagol's example files (../shared/reference/metagol) | the quick files, 10 s | every file, 60 s |
 
 Each runs as ``python -m benchmarks.NAME`` in a process of its own, from the repository root; rendered data
@@ -52,6 +53,7 @@ def commands(quick: bool, work: Path, json_dir: Path | None) -> list[tuple[str, 
          + (["--modalities", "rgbd", "--folds", "2", "--positives", "4"] if quick else ["--modalities", "rgbd"])),
         ("bench_baselines", ["--data", str(work / "baselines_data")]
          + (["--systems", "cnn-rgbd,tree-rgbd", "--folds", "1", "--epochs", "3"] if quick else [])),
+        ("bench_tuning", ["--data", str(work / "tuning_data")] + (["--quick"] if quick else [])),
         ("bench_metagol", (["--quick"] if quick else []) + (["--json", str(json_dir / "bench_metagol.json")] if json_dir else [])),
     ]
 

@@ -3,11 +3,11 @@
 The maps turn grounding's raw probability of each candidate fact into a calibrated confidence
 (grounding.Calibration; docs/grounding.md). They are fitted, and the file written, by
 
-    .venv/bin/python benchmarks/fit_calibration.py ROWS.pkl ... --real REAL.pkl ...
+    lv3d calibrate fit ROWS.pkl ... --real REAL.pkl ...
 
-on candidate facts of perceived rendered dev scenes (benchmarks/calibration_data.py) and labelled real frames
-(benchmarks/calibration_real.py); the file's ``provenance`` names the command, the data (file, rows, scenes,
-sha256, the command that made it), the code version (git commit and the files that differed from it) and a
+on candidate facts of perceived rendered dev scenes (``lv3d calibrate rows``) and labelled real frames
+(``lv3d calibrate real``; lv3d.calibrate makes them, and nothing at run time imports it); the file's
+``provenance`` names the command, the data (file, rows, scenes, sha256, the command that made it), the code version (git commit and the files that differed from it) and a
 sha256 of each group of sources the raw probabilities and measurements depend on (``SOURCES``).
 :func:`stale_sources` compares those with the code in use: a map fitted on another perception reads its inputs
 from another distribution, and the fit should be rerun.
@@ -63,7 +63,7 @@ def read(path: str | Path = DATA) -> dict:
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         got = data.get("format") if isinstance(data, dict) else None
         raise InputError(path, f"calibration file of format {got!r}, this code reads format {FORMAT} "
-                               "(refit with benchmarks/fit_calibration.py)")
+                               "(refit with lv3d calibrate fit)")
     for part in ("table", "final", "provenance"):
         if not isinstance(data.get(part), dict):
             raise InputError(path, f"calibration file without its {part!r} part")

@@ -12,7 +12,9 @@ which is also how users bring their own frames to lv3d.
 A row that cannot be used (a malformed number, an unknown frame, a pixel outside the image, a class name
 that is not a lower-case word) is not fatal: :meth:`FrameFolder.objects` returns it as a :class:`Problem`
 naming the file and line, so that a study leaves it out and counts it. A folder that is not in this layout
-at all (no objects.csv, no frames, no usable row) is an :class:`~lv3d.errors.InputError`.
+at all (no objects.csv, no frames, no usable row) is an :class:`~lv3d.errors.InputError`. Measurements that
+must see every labelled object (benchmarks/bench_real.py, lv3d.calibrate.real) read the folder strictly:
+:meth:`FrameFolder.labels` makes the first row left out an InputError.
 """
 
 from __future__ import annotations
@@ -40,7 +42,7 @@ _CLASS = re.compile(r"^[a-z][a-z0-9_]*$")
 class LabelledObject:
     """One row of objects.csv: the object ``object`` of ``frame``, whose pixel (u, v) (column, row) lies
     inside it, of class ``shape``; ``partial``/``stacked`` as the README defines them (False when absent).
-    ``line``: its line in objects.csv."""
+    ``line``: its line in objects.csv (0: not read from a file)."""
 
     frame: str
     object: int
@@ -49,7 +51,7 @@ class LabelledObject:
     shape: str
     partial: bool
     stacked: bool
-    line: int
+    line: int = 0
 
     @property
     def key(self) -> str:
@@ -188,6 +190,20 @@ class FrameFolder:
         """Every usable labelled object (in file order) and the rows left out."""
         objects, problems = self._read
         return list(objects), list(problems)
+
+    def labels(self, shapes: tuple[str, ...] | None = None) -> dict[str, list[LabelledObject]]:
+        """{frame: its labelled objects in file order}, strictly: the first row :meth:`objects` leaves out, or
+        of a shape not in ``shapes`` (when given), is an InputError naming the file and line."""
+        objects, problems = self._read
+        if problems:
+            raise InputError(problems[0].path, f"line {problems[0].line}: {problems[0].why}")
+        out: dict[str, list[LabelledObject]] = {}
+        for obj in objects:
+            if shapes is not None and obj.shape not in shapes:
+                raise InputError(self.path / "objects.csv", f"line {obj.line}: shape {obj.shape!r} is not one of "
+                                                            f"{', '.join(shapes)}")
+            out.setdefault(obj.frame, []).append(obj)
+        return out
 
     def load(self, frame: str) -> RGBD:
         return load_real(self.path, frame)

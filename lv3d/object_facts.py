@@ -6,6 +6,11 @@ only, renamed to the example's id (:func:`example_facts`) so that two labelled o
 two labels that fall on one merged object, are separate examples. A label on no perceived object gives
 an example with no target: the learner leaves it out of training and answers "unknown" on it, and the
 study counts it.
+
+Measurements of perception on labelled frames (benchmarks/bench_real.py, lv3d.calibrate.real) match a label
+to a perceived object by another rule, which counts faces: :func:`held_object` (the most faces covering the
+pixel, over :func:`face_cover`), and flag a perceived object that holds another label's region as merged
+(:func:`merged_flags`).
 """
 
 from __future__ import annotations
@@ -24,18 +29,64 @@ from .scene import Scene, SceneObject
 # names it when the object comes within this fraction of the image diagonal (8 px at 640x480): labels are
 # given by eye, and a segment's border is uncertain by a few pixels.
 LABEL_REACH = 0.01
+HOLD_SHARE = 0.2  # a perceived object holds a labelled object when it holds this share of its mask
+
+
+def face_cover(obj: SceneObject, shape: tuple[int, int]) -> np.ndarray:
+    """(H, W) uint8: 1 on ``obj``'s segment where it has one; else how many of its faces cover each pixel (their
+    polygons rasterised with cv2.fillPoly). The object's pixels are where it is > 0."""
+    if getattr(obj, "mask", None) is not None and obj.mask.shape == shape:
+        return obj.mask.astype(np.uint8)
+    cover = np.zeros(shape, np.uint8)
+    one = np.zeros(shape, np.uint8)
+    for f in obj.faces:
+        poly = np.round(np.asarray(f.polygon, float)).astype(np.int32).reshape(-1, 2)
+        if len(poly) < 3:
+            continue
+        one[:] = 0
+        cv2.fillPoly(one, [poly], 1)
+        cover += one
+    return cover
 
 
 def _object_pixels(obj: SceneObject, shape: tuple[int, int]) -> np.ndarray:
     """(H, W) bool: the object's segment, or where it has none (colour alone), the union of its faces."""
-    if obj.mask is not None and obj.mask.shape == shape:
-        return obj.mask
-    out = np.zeros(shape, np.uint8)
-    for f in obj.faces:
-        poly = np.round(np.asarray(f.polygon, float)).astype(np.int32).reshape(-1, 2)
-        if len(poly) >= 3:
-            cv2.fillPoly(out, [poly], 1)
-    return out.astype(bool)
+    return face_cover(obj, shape) > 0
+
+
+def held_object(covers: list[np.ndarray], u: int, v: int) -> int | None:
+    """Index of the object holding pixel (u, v) (``covers``: :func:`face_cover` of each): the most faces covering
+    it, ties to the first; None if none."""
+    counts = [int(c[v, u]) for c in covers]
+    if not counts or max(counts) == 0:
+        return None
+    return int(np.argmax(counts))
+
+
+def region_pixels(lab, label_img: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """(rows, cols) of a labelled object (lv3d.frame_folder.LabelledObject): its mask where the frame has one
+    (and it is not empty), else its labelled pixel alone."""
+    if label_img is not None:
+        vs, us = np.nonzero(label_img == lab.object)
+        if len(vs):
+            return vs, us
+    return np.array([lab.v]), np.array([lab.u])
+
+
+def holds(mask: np.ndarray, region: tuple[np.ndarray, np.ndarray], share: float = HOLD_SHARE) -> bool:
+    """Whether ``mask`` holds >= ``share`` of ``region``'s pixels (a one-pixel region: holds that pixel)."""
+    vs, us = region
+    return len(vs) > 0 and float(np.mean(mask[vs, us])) >= share
+
+
+def merged_flags(held: list[int | None], masks: list[np.ndarray],
+                 regions: list[tuple[np.ndarray, np.ndarray]]) -> list[bool]:
+    """Per labelled object: its perceived object (``held``, index into ``masks``) also holds another labelled
+    object's region (:func:`holds`). Not found: not merged."""
+    out = []
+    for i, k in enumerate(held):
+        out.append(k is not None and any(holds(masks[k], regions[j]) for j in range(len(regions)) if j != i))
+    return out
 
 
 def object_under(scene: Scene, u: int, v: int, shape: tuple[int, int]) -> tuple[SceneObject | None, np.ndarray | None]:

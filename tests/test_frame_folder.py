@@ -57,6 +57,15 @@ def test_rows_that_cannot_be_used_are_named_by_file_and_line_and_the_rest_are_re
     assert [p.line for p in problems] == [8, 9, 10, 11, 12]
     assert all(str(p).startswith(f"{folder / 'objects.csv'}: line ") for p in problems)
     assert "outside the 320x240 frame" in str(problems[2]) and "twice" in str(problems[4])
+    # read strictly (what the real-frame measurements need), the first such row is the error
+    from lv3d.errors import InputError
+
+    with pytest.raises(InputError, match=r"objects.csv: line 8: object: expected a whole number"):
+        FrameFolder(folder).labels()
+    by_frame = FrameFolder(frames).labels(("box", "prism"))
+    assert sorted(by_frame) == FrameFolder(frames).frames and all(len(v) == 1 for v in by_frame.values())
+    with pytest.raises(InputError, match=r"line 3: shape 'prism' is not one of box"):
+        FrameFolder(frames).labels(("box",))
 
 
 def test_a_folder_not_in_the_layout_is_one_clear_error(tmp_path):

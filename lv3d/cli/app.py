@@ -17,6 +17,7 @@ COMMANDS = {
     "learn": "lv3d.cli.learn:learn",
     "experiment": "lv3d.cli.experiment:experiment",
     "demo": "lv3d.cli.demo:demo",
+    "calibrate": "lv3d.cli.calibrate:calibrate",
 }
 
 

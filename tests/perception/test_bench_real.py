@@ -9,6 +9,8 @@ import pytest
 import benchmarks.bench_real as bench
 from lv3d.camera import Intrinsics
 from lv3d.facts import Fact, SceneFacts
+from lv3d.frame_folder import FrameFolder, LabelledObject, natural_key
+from lv3d.object_facts import face_cover, held_object, merged_flags
 from lv3d.plane import Plane
 from lv3d.rgbd import RGBD
 from lv3d.scene import Face, Scene, SceneObject
@@ -30,7 +32,7 @@ def _obj(oid, rects, adjacency=()):
 
 
 def _lab(obj, u, v, shape="box", partial=False, stacked=False, frame="f0"):
-    return bench.Label(frame, obj, u, v, shape, partial, stacked)
+    return LabelledObject(frame, obj, u, v, shape, partial, stacked)
 
 
 def _mask(u0, v0, u1, v1):
@@ -40,19 +42,19 @@ def _mask(u0, v0, u1, v1):
 
 
 def test_frames_sort_naturally():
-    assert sorted(["learn10", "learn2", "learn1", "learn0"], key=bench.natural_key) == \
+    assert sorted(["learn10", "learn2", "learn1", "learn0"], key=natural_key) == \
         ["learn0", "learn1", "learn2", "learn10"]
 
 
 def test_the_object_under_a_pixel_is_the_one_with_most_faces_there_ties_to_the_first():
     a = _obj("o1", [(0, 0, 40, 40)])
     b = _obj("o2", [(20, 20, 60, 50), (30, 30, 60, 50)])
-    covers = [bench.face_cover(o, (H, W)) for o in (a, b)]
+    covers = [face_cover(o, (H, W)) for o in (a, b)]
     assert covers[1][35, 35] == 2 and covers[0][35, 35] == 1
-    assert bench.held_object(covers, 35, 35) == 1   # two of o2's faces cover it, one of o1's
-    assert bench.held_object(covers, 25, 25) == 0   # one face each: the first listed
-    assert bench.held_object(covers, 5, 5) == 0
-    assert bench.held_object(covers, 75, 55) is None
+    assert held_object(covers, 35, 35) == 1   # two of o2's faces cover it, one of o1's
+    assert held_object(covers, 25, 25) == 0   # one face each: the first listed
+    assert held_object(covers, 5, 5) == 0
+    assert held_object(covers, 75, 55) is None
 
 
 def test_recall_needs_iou_one_half_and_split_needs_two_holders_of_a_fifth():
@@ -73,11 +75,11 @@ def test_merged_with_masks_needs_a_fifth_of_the_other_and_without_masks_its_pixe
     regions = [np.nonzero(_mask(0, 0, 9, 9)), np.nonzero(_mask(20, 0, 29, 9))]  # 100 px each
     big = _mask(0, 0, 21, 9)    # all of the first, 20 % of the second
     small = _mask(0, 0, 20, 9)  # 10 % of the second
-    assert bench.merged_flags([0, None], [big], regions) == [True, False]  # not found: not merged
-    assert bench.merged_flags([0, None], [small], regions) == [False, False]
+    assert merged_flags([0, None], [big], regions) == [True, False]  # not found: not merged
+    assert merged_flags([0, None], [small], regions) == [False, False]
     pixels = [(np.array([5]), np.array([5])), (np.array([5]), np.array([21]))]  # (rows, cols) of (u, v)
-    assert bench.merged_flags([0, 0], [big], pixels) == [True, True]
-    assert bench.merged_flags([0, 0], [small], pixels) == [False, True]
+    assert merged_flags([0, 0], [big], pixels) == [True, True]
+    assert merged_flags([0, 0], [small], pixels) == [False, True]
 
 
 def _standing(h0, h1, n=400, seed=0):
@@ -225,10 +227,20 @@ def test_objects_csv_naming_a_missing_frame_stops_before_any_work(tmp_path, caps
     assert len(err) == 1 and "objects.csv" in err[0] and "f1" in err[0]
 
 
-def test_a_malformed_objects_csv_row_is_named(tmp_path):
-    (tmp_path / "objects.csv").write_text("frame,object,u,v,shape,partial,stacked\nf0,1,5,5,cone,no,no\n")
-    with pytest.raises(bench.InputError, match="line 2"):
-        bench.read_labels(tmp_path / "objects.csv")
+def test_an_objects_csv_row_of_an_unknown_shape_or_unusable_is_named(tmp_path, capsys):
+    (tmp_path / "f0_rgb.png").write_bytes(b"")
+    (tmp_path / "f0_depth_mm.png").write_bytes(b"")
+    (tmp_path / "intrinsics.json").write_text(json.dumps({"width": W, "height": H, "frames": {
+        "f0": {"fx": 100.0, "fy": 100.0, "cx": 39.5, "cy": 29.5, "depth_scale_m": 0.001}}}))
+    csv = tmp_path / "objects.csv"
+    csv.write_text("frame,object,u,v,shape,partial,stacked\nf0,1,5,5,box,no,no\nf0,2,6,6,cone,no,no\n")
+    with pytest.raises(bench.InputError, match="line 3: shape 'cone'"):
+        bench.labelled_folder(tmp_path)
+    csv.write_text("frame,object,u,v,shape,partial,stacked\nf0,1,5,5,box,no,no\nf0,2,5,500,box,no,no\n")
+    assert len(FrameFolder(tmp_path).objects()[0]) == 1          # a study leaves the row out and counts it ...
+    assert bench.main([str(tmp_path)]) == 2                        # ... the benchmark stops, before any work
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "objects.csv: line 3: pixel (5, 500) lies outside" in err[0]
 
 
 def test_without_masks_the_support_reads_only_the_surface_connected_to_the_labelled_pixel():

@@ -2,27 +2,28 @@
 
 The fit reads candidate facts with their truth from two kinds of data:
 
-- rendered dev scenes (benchmarks/calibration_data.py): every fact type, truth from the renderer;
-- labelled real frames (benchmarks/calibration_real.py, ``--real``): ``perpendicular`` only, truth from the
-  labelled shape (adjacent faces of a box are perpendicular, of a cylinder or bowl not; bench_real.py's
-  definition). A real sensor's errors are larger than the renderer's, and real scenes hold curved solids the
-  renderer has none of; the real rows teach the maps both.
+- rendered dev scenes (lv3d.calibrate.rows, ``lv3d calibrate rows``): every fact type, truth from the renderer;
+- labelled real frames (lv3d.calibrate.real, ``lv3d calibrate real``, ``--real``): ``perpendicular`` only, truth
+  from the labelled shape (adjacent faces of a box are perpendicular, of a cylinder or bowl not;
+  benchmarks/bench_real.py's definition). A real sensor's errors are larger than the renderer's, and real scenes
+  hold curved solids the renderer has none of; the real rows teach the maps both.
 
 The whole fit, from the repository root (each rendered set of 840 scenes ~15 min on one core for both
 modalities, the two real folders ~4 min, the fit with its checks ~10 min)::
 
     for a in "30000 s30000" "40000 s40000" "60000 s60000" "100000 chk100000"; do set -- $a
-        .venv/bin/python -m benchmarks.calibration_data --fresh --seed $1 --per-class 120 --modalities rgbd,depth \
+        OMP_NUM_THREADS=1 .venv/bin/lv3d calibrate rows --fresh --seed $1 --per-class 120 --modalities rgbd,depth \
             --out out/calib/$2.pkl
     done
     for f in osd-learn ycb-realsense; do
-        .venv/bin/python -m benchmarks.calibration_real ../shared/data/real/$f --out out/calib/real_$f.pkl
+        OMP_NUM_THREADS=1 .venv/bin/lv3d calibrate real ../shared/data/real/$f --out out/calib/real_$f.pkl
     done
-    .venv/bin/python -m benchmarks.fit_calibration out/calib/s{30000,40000,60000}.pkl \
-        --real out/calib/real_osd-learn.pkl out/calib/real_ycb-realsense.pkl --check out/calib/chk100000.pkl --holdout
+    OMP_NUM_THREADS=1 .venv/bin/lv3d calibrate fit out/calib/s{30000,40000,60000}.pkl \
+        --real out/calib/real_osd-learn.pkl --real out/calib/real_ycb-realsense.pkl \
+        --check out/calib/chk100000.pkl --holdout
 
 Rows come from dev seeds only, never the study's data. After perception or grounding changed, all of it is rerun
-(lv3d.calibration.stale_sources names what changed since the shipped fit; calibration_check.py prints it).
+(lv3d.calibration.stale_sources names what changed since the shipped fit; ``lv3d calibrate check`` prints it).
 
 The maps. For each (modality, key) (``grounding.calibration_key``: the predicate, or a kind filed apart) several
 maps compete by scene-grouped 5-fold cross-validated log loss (a scene's or real frame's facts share its view and
@@ -49,30 +50,31 @@ the figures of each frame's out-of-fold confidences (new frames of the sensors i
 pooled. ``--check`` prints per-key ECE on other rendered dev sets (facts with confidence >= 0.05, as they are
 emitted) for the raw probabilities, the shipped maps and the new ones. The figures of the final fit on the real
 frames are in-sample. The written file holds the maps, these figures (``checks``) and the provenance
-(lv3d.calibration).
+(lv3d.calibration; its ``command`` is the ``lv3d calibrate fit`` command line).
 """
 
 from __future__ import annotations
 
-import argparse
 import datetime
 import hashlib
 import json
-import pickle
 import subprocess
-import sys
 from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-
-from benchmarks.calibration_error import chance_ece, ece, log_loss
 from grounding._calibration import (SHARED_SIDE_PREDS, TOL_FRAC_PREDS, calibrate_with, calibration_key, factors,
                                     inputs, is_slope, logit)
-from lv3d.describe import SIDE_NAMES
-from lv3d.facts import PREDICATES
+
+from ..describe import SIDE_NAMES
+from ..errors import InputError
+from ..facts import PREDICATES
+from ..output import write_atomic
+from . import real as real_rows, rows as rendered_rows
+from .measures import chance_ece, ece, log_loss
+
+ROOT = Path(__file__).resolve().parents[2]  # the checkout, where there is one: the provenance's git commit
 
 MODALITIES = ("rgbd", "depth")  # rgb is left raw: its facts' truth needs a look first (docs/grounding.md)
 FEATURES = ["support", "log_area_px", "min_turn_z", "min_side_px"]
@@ -387,7 +389,7 @@ def fit(rows: list[dict], modalities, real_share: float = REAL_SHARE, log=print,
 
 def rendered_ece(rows: list[dict], maps: tuple) -> dict:
     """{modality: {predicate: (ECE, facts)}} of the facts emitted under ``maps`` (table, final) (confidence >=
-    MIN_CONF), grouped by predicate as calibration_check.py groups them, and "all" over every fact."""
+    MIN_CONF), grouped by predicate as lv3d.calibrate.check groups them, and "all" over every fact."""
     facts = defaultdict(list)
     for r in rows:
         if r["modality"] not in MODALITIES or not r["p"] > 0:
@@ -443,13 +445,11 @@ def report_rendered(rows: list[dict], table: tuple, title: str, shipped: tuple |
 
 
 def real_figures(frames: list[dict], maps: tuple | None = None, conf: dict | None = None) -> dict:
-    """bench_real's box and calibration figures (calibration_real.figures) of real frame entries under ``maps``
+    """bench_real's box and calibration figures (lv3d.calibrate.real.figures) of real frame entries under ``maps``
     (table, final), or with each candidate's confidence looked up in ``conf`` {id(row): confidence}."""
-    from benchmarks.calibration_real import figures
-
     if conf is not None:
-        return figures(frames, lambda r: conf[id(r)])
-    return figures(frames, lambda r: calibrate_with(maps[0], r["modality"], r["key"], r["p"], r, maps[1]))
+        return real_rows.figures(frames, lambda r: conf[id(r)])
+    return real_rows.figures(frames, lambda r: calibrate_with(maps[0], r["modality"], r["key"], r["p"], r, maps[1]))
 
 
 def frame_folds(real: list[tuple[Path, dict, str]], k: int = 5, seed: int = 0) -> dict[str, int]:
@@ -501,15 +501,20 @@ def _git(*args: str) -> str | None:
         return None
 
 
-def provenance(argv: list[str], data: list[tuple[Path, dict, str]]) -> dict:
-    """Who made the file: the command, the code version (git commit, the files that differed from it among the
-    fit's sources and this script's), the sources' digests (lv3d.calibration.source_digests) and each data
-    file (name, sha256, rows, scenes, the command that made it, its kind)."""
-    from lv3d.calibration import source_digests
+# the fit's sources and the code that makes its data: files that differ from the git commit are named
+CODE = ("grounding", "lv3d/perception", "lv3d/describe.py", "lv3d/calibrate", "lv3d/object_facts.py",
+        "lv3d/frame_folder.py")
 
-    dirty = _git("status", "--porcelain", "--", "grounding", "lv3d/perception", "lv3d/describe.py", "benchmarks")
+
+def provenance(command: str, data: list[tuple[Path, dict, str]]) -> dict:
+    """Who made the file: the command (the ``lv3d calibrate fit`` command line), the code version (git commit,
+    the files of ``CODE`` that differed from it), the sources' digests (lv3d.calibration.source_digests) and each
+    data file (name, sha256, rows, scenes, the command that made it, its kind)."""
+    from ..calibration import source_digests
+
+    dirty = _git("status", "--porcelain", "--", *CODE)
     return {
-        "command": " ".join(["python -m benchmarks.fit_calibration", *argv]),
+        "command": command,
         "git_commit": _git("rev-parse", "HEAD"),
         "uncommitted": sorted(line[3:] for line in (dirty or "").splitlines()),
         "sources_sha256": source_digests(),
@@ -530,39 +535,29 @@ def to_json(doc: dict) -> str:
                   text) + "\n"
 
 
-def _read(path: Path, what: str) -> dict:
-    try:
-        d = pickle.loads(path.read_bytes())
-        if not isinstance(d, dict) or "rows" not in d:
-            raise KeyError("rows")
-        return d
-    except (OSError, pickle.UnpicklingError, KeyError, EOFError) as e:
-        raise SystemExit(f"fit_calibration.py: error: {path}: not a {what} pickle ({e!r})") from None
+def run(data: list[Path], real: list[Path] = (), check: list[Path] = (), holdout: bool = False,
+        real_share: float = REAL_SHARE, out: Path | None = None, dry_run: bool = False,
+        modalities: tuple[str, ...] = MODALITIES, command: str = "") -> Path | None:
+    """The whole fit: read the rendered pickles ``data`` (lv3d.calibrate.rows), the real ones ``real``
+    (lv3d.calibrate.real) and the rendered check sets ``check``; with ``holdout``, first the held-out checks;
+    fit on every set; print the figures and, unless ``dry_run``, write the calibration file ``out`` (default:
+    the shipped one) with its provenance (``command``: the command line). Returns the file written."""
+    from ..calibration import DATA, FORMAT, read
 
-
-def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
-    from lv3d.calibration import DATA, FORMAT, read
-
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("data", type=Path, nargs="+", help="pickles from benchmarks/calibration_data.py (rendered)")
-    ap.add_argument("--real", type=Path, nargs="*", default=[], help="pickles from benchmarks/calibration_real.py")
-    ap.add_argument("--check", type=Path, nargs="*", default=[], help="rendered dev sets to report ECE on")
-    ap.add_argument("--holdout", action="store_true",
-                    help="first check on real frames left out of the fit: each --real pickle in turn, then the real "
-                         f"frames in {HOLDOUT_FOLDS} frame-grouped folds")
-    ap.add_argument("--real-share", type=float, default=REAL_SHARE,
-                    help=f"share of a key's fit weight its real rows carry (default {REAL_SHARE})")
-    ap.add_argument("--out", type=Path, default=DATA)
-    ap.add_argument("--dry-run", action="store_true", help="fit and report, write nothing")
-    ap.add_argument("--modalities", default=",".join(MODALITIES))
-    a = ap.parse_args(argv)
-    mods = a.modalities.split(",")
-    if not set(mods) <= set(MODALITIES):
-        ap.error(f"--modalities: choose from {', '.join(MODALITIES)}")
-    rendered = [(p, _read(p, "calibration_data.py"), "rendered") for p in a.data]
-    real = [(p, _read(p, "calibration_real.py"), "real") for p in a.real]
-    checks = [(p, _read(p, "calibration_data.py"), "rendered check") for p in a.check]
+    out = DATA if out is None else Path(out)
+    bad = [m for m in modalities if m not in MODALITIES]
+    if bad or not modalities:
+        raise InputError("--modalities", f"choose among {', '.join(MODALITIES)}, not {','.join(modalities)!r}")
+    if not 0.0 <= real_share <= 1.0:
+        raise InputError("--real-share", f"a share within [0, 1], not {real_share}")
+    if not data:
+        raise InputError("DATA", "no rendered rows given (lv3d calibrate rows makes them)")
+    if not dry_run:
+        _check_out(out)
+    mods = list(modalities)
+    rendered = [(Path(p), rendered_rows.read(p), "rendered") for p in data]
+    reals = [(Path(p), real_rows.read(p), "real") for p in real]
+    checks = [(Path(p), rendered_rows.read(p), "rendered check") for p in check]
     shipped_file = read(DATA) if DATA.is_file() else None
     shipped = None if shipped_file is None else (shipped_file["table"], shipped_file["final"])
     render_rows = [r for _, d, _ in rendered for r in d["rows"]]
@@ -573,58 +568,66 @@ def main(argv=None) -> int:
         return None
 
     memo: dict = {}
-    before = real_sets(real, maps=shipped) if shipped and real else None
-    if a.holdout and real:
+    before = real_sets(reals, maps=shipped) if shipped and reals else None
+    if holdout and reals:
         # 1. a new sensor: fit without each real pickle, figures on the one left out
         held = {}
-        for i, (path, d, _) in enumerate(real):
-            others = [r for j, (_, e, _) in enumerate(real) if j != i for r in e["rows"]]
-            maps = fit(render_rows + others, mods, a.real_share, log=quiet, memo=memo)
+        for i, (path, d, _) in enumerate(reals):
+            others = [r for j, (_, e, _) in enumerate(reals) if j != i for r in e["rows"]]
+            maps = fit(render_rows + others, mods, real_share, log=quiet, memo=memo)
             name = d["folders"][0] if len(d.get("folders", [])) == 1 else path.name
             held[name] = real_figures(d["frames"], maps)
         print_real("each real set left out of the fit (fitted on the rendered rows and the other real sets)"
                    + ("; shipped -> held out" if before else ""), held, before)
         out_checks["real_held_out"] = held
         # 2. new frames of the same sensors: frame-grouped folds over every real set
-        folds = frame_folds(real, HOLDOUT_FOLDS)
+        folds = frame_folds(reals, HOLDOUT_FOLDS)
         conf = {}
         for k in range(HOLDOUT_FOLDS):
-            train = [r for _, d, _ in real for r in d["rows"] if folds[r["scene"]] != k]
-            maps = fit(render_rows + train, mods, a.real_share, log=quiet, memo=memo)
-            for _, d, _ in real:
+            train = [r for _, d, _ in reals for r in d["rows"] if folds[r["scene"]] != k]
+            maps = fit(render_rows + train, mods, real_share, log=quiet, memo=memo)
+            for _, d, _ in reals:
                 for e in d["frames"]:
                     if folds[f"{e['folder']}/{e['frame']}"] == k:
                         for r in e["cands"]:
                             conf[id(r)] = calibrate_with(maps[0], r["modality"], r["key"], r["p"], r, maps[1])
-        cv = real_sets(real, conf=conf)
+        cv = real_sets(reals, conf=conf)
         print_real(f"real frames in {HOLDOUT_FOLDS} frame-grouped folds, each fold's confidences from a fit without "
                    "it" + ("; shipped -> out of fold" if before else ""), cv, before)
         out_checks["real_frame_folds"] = cv
     print("== fit on every set")
-    maps = fit(render_rows + [r for _, d, _ in real for r in d["rows"]], mods, a.real_share, memo=memo)
+    maps = fit(render_rows + [r for _, d, _ in reals for r in d["rows"]], mods, real_share, memo=memo)
     for m in MODALITIES:  # a modality not refitted keeps the shipped maps
         if m not in mods and shipped is not None:
             maps[0][m], maps[1][m] = shipped[0].get(m, {}), shipped[1].get(m, {})
-    if real:
-        in_fit = real_sets(real, maps=maps)
+    if reals:
+        in_fit = real_sets(reals, maps=maps)
         print_real("real sets in the fit" + ("; shipped -> calibrated" if before else ""), in_fit, before)
         out_checks["real_in_fit"] = in_fit
-    report_rendered(render_rows, maps, f"fit rows ({', '.join(p.name for p in a.data)})")
+    report_rendered(render_rows, maps, f"fit rows ({', '.join(Path(p).name for p in data)})")
     if check_rows:
-        report_rendered(check_rows, maps, f"check rows ({', '.join(p.name for p in a.check)})", shipped)
-        out_checks["rendered_check"] = {"sets": [p.name for p in a.check], "ece": rendered_ece(check_rows, maps)}
-    if a.dry_run:
-        return 0
+        report_rendered(check_rows, maps, f"check rows ({', '.join(Path(p).name for p in check)})", shipped)
+        out_checks["rendered_check"] = {"sets": [Path(p).name for p in check], "ece": rendered_ece(check_rows, maps)}
+    if dry_run:
+        return None
     doc = {"format": FORMAT,
            "about": "Confidence calibration maps of lv3d (lv3d/calibration.py, grounding.Calibration); written by "
-                    "benchmarks/fit_calibration.py, not to be edited by hand.",
-           "provenance": provenance(argv, rendered + real + checks), "checks": out_checks,
+                    "lv3d calibrate fit, not to be edited by hand.",
+           "provenance": provenance(command, rendered + reals + checks), "checks": out_checks,
            "table": maps[0], "final": maps[1]}
-    a.out.parent.mkdir(parents=True, exist_ok=True)
-    a.out.write_text(to_json(doc))
-    print(f"wrote {a.out}")
-    return 0
+    write_atomic(out, to_json(doc))
+    print(f"wrote {out}")
+    return out
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+def _check_out(out: Path) -> None:
+    """A calibration file may replace only a calibration file (or nothing): a one-line InputError otherwise."""
+    if out.is_dir():
+        raise InputError(out, "is a folder; --out names a calibration file")
+    if out.exists():
+        try:
+            doc = json.loads(out.read_text())
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+            doc = None
+        if not (isinstance(doc, dict) and "format" in doc and "provenance" in doc):
+            raise InputError(out, "exists and is not a calibration file; lv3d calibrate fit replaces only its own")

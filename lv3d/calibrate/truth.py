@@ -1,5 +1,6 @@
-"""Ground truth for bench_grounding: which perceived face is which true face, what each candidate fact
-should have been, and the errors of the quantities facts are read from (docs/dataset.md truth layout)."""
+"""Ground truth of rendered scenes for the calibration rows (lv3d.calibrate.rows) and bench_grounding: which
+perceived face is which true face, what each candidate fact should have been, and the errors of the quantities
+facts are read from (docs/dataset.md truth layout)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 
 from grounding._confidence import (ACUTE_BELOW_DEG, EQUAL_CORNERS_DEG, EQUAL_SIDES_RATIO, OBTUSE_ABOVE_DEG,
                                    PARALLEL_SIDES_DEG, PERPENDICULAR_DEG, PLANE_ANGLE_DEG, RIGHT_ANGLE_DEG)
-from lv3d.perception.polygons import rasterize
+from ..perception.polygons import rasterize
 
 NGONS = {"triangle": 3, "quadrilateral": 4, "pentagon": 5, "hexagon": 6}
 
@@ -175,8 +176,8 @@ def truth_scene(frame, faces_mask: np.ndarray, scene_id: str, rng: np.random.Gen
     true face mask (eroded by 2 px, away from flying pixels), true adjacency and support plane."""
     import cv2
 
-    from lv3d.plane import Plane
-    from lv3d.scene import Face, Scene, SceneObject
+    from ..plane import Plane
+    from ..scene import Face, Scene, SceneObject
 
     truth = frame.meta["truth"]
     k = frame.intrinsics

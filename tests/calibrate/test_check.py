@@ -1,11 +1,12 @@
-"""benchmarks/calibration_check: per-type ECE of calibrated rows per set and pooled, grouped by predicate."""
+"""lv3d.calibrate.check (``lv3d calibrate check``): per-type ECE of calibrated rows per set and pooled, grouped by
+predicate; a missing or foreign pickle is one line naming it."""
 
 import pickle
 
 import numpy as np
-import pytest
 
-from benchmarks.calibration_check import main, score
+from lv3d.calibrate.check import score
+from lv3d.cli import main
 
 
 def _rows(seed0: int, n: int = 40) -> list[dict]:
@@ -33,7 +34,7 @@ def test_each_set_alone_then_pooled(tmp_path, capsys):
     for s in (1000, 2000):
         paths.append(tmp_path / f"rows{s}.pkl")
         paths[-1].write_bytes(pickle.dumps({"rows": _rows(s), "scenes": []}))
-    assert main([str(p) for p in paths] + ["--draws", "20"]) == 0
+    assert main(["calibrate", "check", *map(str, paths), "--draws", "20"]) == 0
     out = capsys.readouterr().out
     assert "== rows1000.pkl: 40 scenes" in out and "== rows2000.pkl: 40 scenes" in out
     assert "== all pooled: 80 scenes" in out
@@ -41,11 +42,15 @@ def test_each_set_alone_then_pooled(tmp_path, capsys):
 
 
 def test_a_missing_or_foreign_file_is_named(tmp_path, capsys):
-    with pytest.raises(SystemExit):
-        main([str(tmp_path / "absent.pkl")])
-    assert "absent.pkl: no such file" in capsys.readouterr().err
+    assert main(["calibrate", "check", str(tmp_path / "absent.pkl")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "absent.pkl: no such file" in err[0]
     bad = tmp_path / "bad.pkl"
     bad.write_bytes(pickle.dumps({"other": 1}))
-    with pytest.raises(SystemExit):
-        main([str(bad)])
-    assert "bad.pkl: not a calibration_data.py pickle" in capsys.readouterr().err
+    assert main(["calibrate", "check", str(bad)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bad.pkl: not a pickle of lv3d calibrate rows" in err[0]
+    bad.write_bytes(b"not a pickle at all")
+    assert main(["calibrate", "fit", str(bad), "--dry-run"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bad.pkl: not a pickle of lv3d calibrate rows" in err[0]

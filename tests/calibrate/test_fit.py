@@ -1,9 +1,9 @@
-"""benchmarks/fit_calibration: fit_final's choice per type of the final map with the best scene-grouped CV log
+"""lv3d.calibrate.fit: fit_final's choice per type of the final map with the best scene-grouped CV log
 loss among none, the pooled isotonic map and the type's own; the scene-grouped folds."""
 
 import numpy as np
 
-from benchmarks.fit_calibration import fit_final
+from lv3d.calibrate.fit import fit_final
 
 
 def test_fit_final_gives_a_miscalibrated_type_its_own_map_and_leaves_a_calibrated_one():
@@ -23,7 +23,7 @@ def test_fit_final_gives_a_miscalibrated_type_its_own_map_and_leaves_a_calibrate
 
 
 def test_cross_validation_keeps_every_fact_of_a_scene_in_one_fold():
-    from benchmarks.fit_calibration import _scene_fold_of
+    from lv3d.calibrate.fit import _scene_fold_of
 
     seeds = np.repeat([30001, 30002, 31005, 40000, 40007, 40009, 50000], 9)
     fold = _scene_fold_of(seeds.tolist(), 0)
@@ -33,7 +33,7 @@ def test_cross_validation_keeps_every_fact_of_a_scene_in_one_fold():
 
 
 def test_scene_interval_widens_when_a_scene_s_facts_go_together():
-    from benchmarks.calibration_error import ece, scene_interval
+    from lv3d.calibrate.measures import ece, scene_interval
 
     rng = np.random.default_rng(1)
     n_scenes, per = 60, 8

@@ -1,11 +1,12 @@
-"""Expected calibration error of fact confidences, and the level sampling alone produces (used by
-bench_grounding.py, calibration_check.py and fit_calibration.py)."""
+"""Expected calibration error of fact confidences, the level sampling alone produces, its spread over scenes,
+and the log loss: the measures the fit (lv3d.calibrate.fit), the check (lv3d.calibrate.check) and
+benchmarks/bench_grounding.py print."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from lv3d.experiment.stats import ece, reliability_bins  # noqa: F401  (the benchmarks' ECE is the studies')
+from ..experiment.stats import ece, reliability_bins  # noqa: F401  (the calibration's ECE is the studies')
 
 ECE_TARGET = 0.05  # issue 4: per fact type, at the realsense preset
 

@@ -1,12 +1,12 @@
-"""benchmarks/calibration_real: bench_real's box and calibration figures recomputed from stored candidates for any
-calibration; fit_calibration's weights of real rows and its predictions as grounding applies a map."""
+"""lv3d.calibrate.real: bench_real's box and calibration figures recomputed from stored candidates for any
+calibration; the fit's weights of real rows and its predictions as grounding applies a map."""
 
 import math
 
 import numpy as np
 
-from benchmarks.calibration_real import figures
-from benchmarks.fit_calibration import predict_rows, row_weights
+from lv3d.calibrate.fit import predict_rows, row_weights
+from lv3d.calibrate.real import figures
 from grounding import calibrate_with
 
 
