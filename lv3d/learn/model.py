@@ -107,6 +107,18 @@ def few_negatives(n_neg: int) -> int:
     return max(1, math.ceil(2 * n_neg / 3))
 
 
+def precision(score: dict) -> float:
+    """How often a program's proof named its class on the training examples: (tp + 1) / (tp + fp + 2), the
+    Laplace estimate, so that one or two examples move it little; 1 for a program saved without its counts.
+    Several programs may prove one object (a triangle face proves an over-general tetrahedron program on a
+    triangular prism, whose own program proves it too); their proofs are weighed by it, as the chance that
+    the class is right given its program holds."""
+    tp, fp = score.get("tp"), score.get("fp")
+    if not isinstance(tp, (int, float)) or not isinstance(fp, (int, float)):
+        return 1.0
+    return (tp + 1) / (tp + fp + 2)
+
+
 def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: dict | None = None,
         seed: int = 0) -> Program:
     """Learn ``target(O)`` from the scenes' target objects: positives where label == target,
@@ -181,7 +193,8 @@ class Explanation:
 
 class Model:
     """One program per class. ``predict`` names the class whose program proves the scene's target
-    with the highest confidence (ties: the program with the higher training J). When none proves
+    with the highest confidence times the program's training :func:`precision` (ties: the program with
+    the higher training J), answering with the proof's confidence. When none proves
     it: with one program, "unknown" (the negative answer of a class task); with several, the class
     whose program it misses by least (the highest per-fact confidence, absent facts at NEAR_MISS),
     with that near proof's confidence, which is below the coverage threshold."""
@@ -233,6 +246,9 @@ class Model:
                 n = sum(k in ("fact", "missing") for k, _, _ in trace) if near else 1
                 out.append({"label": label, "conf": conf, "trace": trace, "rank": conf ** (1 / max(n, 1))})
         j = {k: p.score.get("j", 0.0) for k, p in self.programs.items()}
+        prec = {k: precision(p.score) for k, p in self.programs.items()}
+        for r in out:
+            r["rank"] *= prec.get(r["label"], 1.0)
         out.sort(key=lambda r: (r["rank"], j.get(r["label"], 0.0)), reverse=True)
         return out
 

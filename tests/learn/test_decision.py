@@ -5,6 +5,7 @@ import pytest
 
 from lv3d.facts import Fact, SceneFacts
 from lv3d.learn import LearnError, Model, Program, fit
+from lv3d.learn.model import precision
 
 
 def _scene(k: int, faces: list[list[tuple[str, float]]], pairs=()) -> SceneFacts:
@@ -74,6 +75,24 @@ def test_proved_class_wins_over_near_misses():
     scene = _scene(4, [[("pentagon", 0.9), ("regular", 0.9)], [("triangle", 1.0)]])
     label, conf = _model().predict(scene)
     assert label == "pent" and abs(conf - 0.81) < 1e-6
+
+
+def test_a_program_that_covered_negatives_yields_to_a_precise_one():
+    # a triangle face proves an over-general "any triangle" program as surely as the prism's own program
+    # (triangle next to a square at a right angle); on its training examples the general one also proved
+    # five negatives, so the prism's program names the object
+    scene = _scene(7, [[("triangle", 1.0)], [("square", 1.0)]], pairs=[("perpendicular", 1, 2, 1.0)])
+    general = Program("tetra", ("tetra(A) :- face_of(A, B), triangle(B).",), {"j": 0.95, "tp": 4, "fp": 5})
+    prism = Program("tri", ("tri(A) :- face_of(A, B), triangle(B), perpendicular(B, C), square(C).",),
+                    {"j": 0.9, "tp": 4, "fp": 0})
+    model = Model({"tetra": general, "tri": prism})
+    assert {p["label"] for p in model._proofs(scene)} == {"tetra", "tri"}
+    assert model.predict(scene) == ("tri", 1.0)  # the answer's confidence is its proof's
+    assert precision({"tp": 4, "fp": 5}) == 5 / 11 and precision({"j": 0.9}) == 1.0
+    # without the counts (a model saved by hand) the tie goes to the higher training J, as before
+    bare = Model({"tetra": Program("tetra", general.clauses, {"j": 0.95}), "tri": Program("tri", prism.clauses,
+                                                                                          {"j": 0.9})})
+    assert bare.predict(scene)[0] == "tetra"
 
 
 def _task(conf_pos: float):
