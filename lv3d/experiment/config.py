@@ -26,6 +26,7 @@ from typing import Any, Callable
 import yaml
 
 from ..errors import InputError
+from ..frame_folder import check_folders
 from ..limits import MAX_DATASET_IMAGES
 
 LOGIC_SYSTEMS = ("lv3d-rgb", "lv3d-depth", "lv3d-rgbd")
@@ -368,9 +369,7 @@ def from_dict(cfg: dict, where: str) -> StudyConfig:
     study = StudyConfig(**top)
     d, b = study.data, study.baselines
     if d.folders is not None:
-        from .real_data import check_folders
-
-        check_folders(d, study.folds, where)
+        check_folders(d.folders, d.classes, study.folds, where)
     else:
         known = _classes()
         for c in d.classes:

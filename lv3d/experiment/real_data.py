@@ -37,24 +37,6 @@ FALLBACK_CROP = 0.25
 CROP_MARGIN = 0.15
 
 
-def check_folders(data, folds: int, where: str) -> None:
-    """InputError (naming the config and key) unless every folder is a labelled-frame folder and every study
-    class has at least ``folds`` examples in them."""
-    counts: dict[str, int] = {}
-    for path in data.folders:
-        try:
-            objects, _ = FrameFolder(Path(path).expanduser()).objects()
-        except InputError as e:
-            raise InputError(where, f"data.folders: {e}") from None
-        for o in objects:
-            counts[o.shape] = counts.get(o.shape, 0) + 1
-    for c in data.classes:
-        if counts.get(c, 0) < folds:
-            have = ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "none"
-            raise InputError(where, f"data.classes: {c!r} has {counts.get(c, 0)} labelled objects in data.folders, "
-                                    f"fewer than folds ({folds}); the folders hold: {have}")
-
-
 @dataclass
 class RealData:
     """The examples of ``data.folders``: items (id, class, frame atom, group = frame atom), where each frame
