@@ -44,6 +44,7 @@ SECTIONS = {
     "### Few-shot": ("few_shot", "positives"),
     "### Ablations": ("ablations", "condition"),
     "### Real objects": ("real_objects", "positives"),
+    "### Ten classes": ("ten_classes", "noise"),
 }
 REPLICATES = "### Seed protocol: replicates"
 NOISE = {"k": "noise_depth", "p": "noise_occlusion", "colour sigma": "noise_color",
