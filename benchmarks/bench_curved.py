@@ -32,6 +32,11 @@ With ``--polyhedra``, the same share for each other polyhedron, split by surface
 ``unconverged``: sphere and cone least-squares fits that did not converge (lv3d.scene.Scene.unconverged_fits;
 no face came of them), over all scenes; ``nan``: faces whose parameters are not finite (must be 0).
 ``ms``: median wall-clock time of perceive per frame (a machine shared with other jobs).
+
+Colour alone (``--modalities rgb``) finds no curved surface; what it says instead is ``elliptical``, a face whose
+outline is an ellipse (lv3d/perception/rgb/ellipse.py; the facts from lv3d.describe). ``elliptical``: per class,
+the share of scenes whose target (Scene.target) has a face with an ``elliptical`` fact of confidence >= 0.5
+(a ball, a lid; target 0 for the polyhedra), and ``elliptical_any``: the same for any object of the scene.
 """
 
 from __future__ import annotations
@@ -46,7 +51,7 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
-from lv3d.describe import curved_evidence
+from lv3d.describe import curved_evidence, describe
 from lv3d.perception import perceive
 from lv3d.perception.depth.quadrics import cone_evidence, sphere_evidence
 from lv3d.render import render_scene
@@ -136,6 +141,18 @@ def evaluate(cls: str, seed: int, scene, frame, faces_mask: np.ndarray, min_face
     return out
 
 
+ELLIPTICAL_CONF = 0.5  # an elliptical face counts at this confidence or more
+
+
+def elliptical_faces(scene, frame) -> tuple[bool, bool]:
+    """Whether the scene's target, and whether any of its objects, has a face with an ``elliptical`` fact of
+    confidence >= ELLIPTICAL_CONF (colour alone)."""
+    facts = describe(scene, frame)
+    owner = {f.args[1]: f.args[0] for f in facts.facts if f.pred == "face_of"}
+    objs = {owner.get(f.args[0]) for f in facts.facts if f.pred == "elliptical" and f.conf >= ELLIPTICAL_CONF}
+    return facts.target in objs, bool(objs)
+
+
 def summarise(rows: list[dict], classes: list[str]) -> dict:
     med = lambda xs: float(np.median(xs)) if xs else float("nan")  # noqa: E731
     out = {}
@@ -155,6 +172,9 @@ def summarise(rows: list[dict], classes: list[str]) -> dict:
             n = max(1, len(rs))
             out[cls] = {"scenes": len(rs), "any_curved": sum(any(r["curved_faces"].values()) for r in rs) / n,
                         **{s: sum(r["curved_faces"][s] > 0 for r in rs) / n for s in CURVED}}
+        if rs and all("elliptical" in r for r in rs):
+            out[cls]["elliptical"] = sum(r["elliptical"] for r in rs) / len(rs)
+            out[cls]["elliptical_any"] = sum(r["elliptical_any"] for r in rs) / len(rs)
     gts = [r for r in rows if r["cls"] in CURVED and r.get("gt")]
     found = [r for r in gts if r["found"]]
     boxes = [r for r in rows if r["cls"] in BOXES]
@@ -200,6 +220,8 @@ def main(argv=None) -> int:
                     scene = perceive(frame, m, scene_id=f"s{i:06d}")
                     ms[m].append((time.perf_counter() - t) * 1e3)
                     rows[m].append(evaluate(cls, args.seed + i, scene, frame, faces_mask, args.min_face_px))
+                    if m == "rgb":
+                        rows[m][-1]["elliptical"], rows[m][-1]["elliptical_any"] = elliptical_faces(scene, frame)
         print(f"\n== preset {preset}: {per_class} scenes a class, seeds {args.seed}-{args.seed + per_class - 1} "
               f"({time.perf_counter() - t0:.0f} s)")
         report[preset] = {}
@@ -228,6 +250,11 @@ def main(argv=None) -> int:
             print(f"{'unconverged fits':22} {a['unconverged']:7d}   -")
             print(f"{'nan parameters':22} {a['nan']:7d}   = 0 {'ok' if a['nan'] == 0 else 'MISS'}")
             print(f"{'ms per frame, median':22} {np.median(ms[m]):7.0f}   -")
+            if m == "rgb":
+                print(f"{'elliptical (target / any object), confidence >= 0.5':52}   target")
+                for c in classes:
+                    goal = "-" if c in CURVED else "0 " + ("ok" if s[c]["elliptical"] == 0 else "MISS")
+                    print(f"  {c:20} {s[c]['elliptical']:7.3f} {s[c]['elliptical_any']:7.3f}   {goal}")
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps(report, indent=1))

@@ -14,9 +14,10 @@ folders (pooled = counts added over all frames, not an average of the folders' f
 writes them as ``{"pooled": {MODALITY: {...}}, "folders": {NAME: {MODALITY: {...}}}}`` with the keys
 object_recall, merged_frac, split_frac, support_ok_frac, box_perpendicular_frac, box_overfaced_frac,
 cylinder_as_prism_frac, perpendicular_ece, cylinder_read_frac, box_curved_frac, ms_median, ms_p90 and the extra
-labelled_found and cpu_ms_median; a figure a folder or modality cannot measure is null (recall and split without
-masks; support, every ``perpendicular`` figure and both curved-face figures under rgb, which has no planes and no
-curved faces).
+labelled_found, cpu_ms_median, cylinder_elliptical_frac and box_elliptical_frac; a figure a folder or modality
+cannot measure is null (recall and split without masks; support, every ``perpendicular`` figure and both
+curved-face figures under rgb, which has no planes and no curved faces; both elliptical figures under depth and
+rgbd, which do not say ``elliptical``).
 
 Definitions
 -----------
@@ -83,6 +84,11 @@ pixel, else the nearest within 1 % of the image diagonal), so that this figure r
 ``box_curved_frac`` (depth and rgbd): share of labelled boxes (partial or not) whose object under the labelled
 pixel (as above) has any cylindrical face (``Face.surface == "cylinder"``), whatever its fact's confidence.
 
+``cylinder_elliptical_frac`` (rgb, an extra figure, no target): share of labelled cylinders with partial = no
+whose object under the labelled pixel has an ``elliptical`` fact (colour alone: a face whose outline is an
+ellipse, a lid) with confidence >= 0.5. ``box_elliptical_frac`` (rgb): share of labelled boxes (partial or not)
+whose object under the labelled pixel has one (target 0.05 or less: a box has no elliptical face).
+
 ``ms_median``, ``ms_p90``: median and 90th percentile of the wall-clock time (ms) of perception + grounding of
 one frame, on one core (OMP, MKL, OpenBLAS, XLA, OpenCV and torch are held to one thread), warm: each
 folder's first frame is run once per modality before the timed frames and not counted, so that JIT compilation
@@ -134,6 +140,7 @@ REAL = ROOT.parent / "shared" / "data" / "real"
 # (lv3d.calibrate.real, whose figures recompute these two for any calibration)
 IOU_MATCH = 0.5        # recall: a ground-truth object is matched at mask IoU >= this
 CYL_READ = 0.7         # cylinder_read: a cylindrical fact at confidence >= this
+ELL_READ = 0.5         # the elliptical figures: an elliptical fact at confidence >= this
 BOX_MAX_FACES = 3      # a box shows at most 3 faces
 SUPPORT_TOL_M = 0.02   # support: the least tolerance of an object's bottom, metres
 SUPPORT_NOISE_K = 3.0  # ... or this many times the sensor's axial noise at the object's depth
@@ -145,7 +152,7 @@ MASK_ERODE_PX = 1      # a ground-truth mask is shrunk by this much before its d
 KEYS = ("object_recall", "merged_frac", "split_frac", "support_ok_frac", "box_perpendicular_frac",
         "box_overfaced_frac", "cylinder_as_prism_frac", "perpendicular_ece", "cylinder_read_frac", "box_curved_frac",
         "ms_median", "ms_p90")
-EXTRA_KEYS = ("labelled_found", "cpu_ms_median")
+EXTRA_KEYS = ("labelled_found", "cpu_ms_median", "cylinder_elliptical_frac", "box_elliptical_frac")
 # figure -> (comparison, target, modalities the target is for); None: no target
 TARGETS: dict[str, tuple[str, float, tuple[str, ...]] | None] = {
     "object_recall": (">=", 0.90, ("depth", "rgbd")),
@@ -162,6 +169,8 @@ TARGETS: dict[str, tuple[str, float, tuple[str, ...]] | None] = {
     "ms_p90": None,
     "labelled_found": None,
     "cpu_ms_median": None,
+    "cylinder_elliptical_frac": None,
+    "box_elliptical_frac": ("<=", 0.05, ("rgb",)),
 }
 
 
@@ -317,7 +326,11 @@ def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img:
     for f in facts.facts:
         if f.pred == "cylindrical":
             cyl_conf[f.args[0]] = max(cyl_conf.get(f.args[0], 0.0), f.conf)
-    row["cyl_unocc"] = row["cyl_read"] = row["box_curved"] = 0
+    ell_conf: dict[str, float] = {}
+    for f in facts.facts:
+        if f.pred == "elliptical":
+            ell_conf[f.args[0]] = max(ell_conf.get(f.args[0], 0.0), f.conf)
+    row["cyl_unocc"] = row["cyl_read"] = row["box_curved"] = row["cyl_ellipse"] = row["box_ellipse"] = 0
     for lab in labels:
         if lab.shape not in ("cylinder", "box") or (lab.shape == "cylinder" and lab.partial):
             continue
@@ -327,6 +340,8 @@ def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img:
             row["cyl_read"] += obj is not None and any(cyl_conf.get(f.id, 0.0) >= CYL_READ for f in obj.faces)
         else:
             row["box_curved"] += obj is not None and any(f.surface == "cylinder" for f in obj.faces)
+        ellipse = obj is not None and any(ell_conf.get(f.id, 0.0) >= ELL_READ for f in obj.faces)
+        row["cyl_ellipse" if lab.shape == "cylinder" else "box_ellipse"] += ellipse
     row["pairs_p"], row["pairs_y"] = [], []
     for k, y in sorted(truth.items()):
         row["pairs_p"] += pairs[k]
@@ -345,6 +360,7 @@ def summarise(rows: list[dict], modality: str) -> dict:
     modality; None where nothing could be measured."""
     planes = modality in PREDICATES["perpendicular"][1]  # the modality can say perpendicular at all
     curved = modality in PREDICATES["cylindrical"][1]  # ... and cylindrical
+    elliptical = modality in PREDICATES["elliptical"][1]  # ... and elliptical (colour alone)
     support = [r["support"] for r in rows if r.get("support") is not None]
     p = [c for r in rows for c in r["pairs_p"]]
     y = [t for r in rows for t in r["pairs_y"]]
@@ -365,6 +381,8 @@ def summarise(rows: list[dict], modality: str) -> dict:
         "ms_p90": float(np.percentile(ms, 90)) if ms else None,
         "labelled_found": _ratio(rows, "found", "labelled"),
         "cpu_ms_median": float(np.median(cpu)) if cpu else None,
+        "cylinder_elliptical_frac": _ratio(rows, "cyl_ellipse", "cyl_unocc") if elliptical else None,
+        "box_elliptical_frac": _ratio(rows, "box_ellipse", "boxes") if elliptical else None,
     }
     return {k: (None if v is None else round(float(v), 4)) for k, v in out.items()}
 

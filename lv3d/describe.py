@@ -272,7 +272,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                     p_curved = curved_evidence(f.points, f.cylinder)
                     if p_curved is not None:
                         curved.append(("cylindrical", (f.id,), p_curved, float(f.cylinder.radius)))
-                curved += quadric_candidates(f)
+                curved += quadric_candidates(f) + ellipse_candidates(f)
                 if has_plane[i]:
                     if n == 4:
                         cands.append(("square", (f.id,), c["p_square"][i], c["side_ratio"][i]))
@@ -384,6 +384,18 @@ def quadric_candidates(face: Face) -> list[tuple[str, tuple[str, ...], float, fl
         p = cone_evidence(face.points, face.cone)
         return [] if p is None else [("conical", (face.id,), p, float(face.cone.half_angle_deg))]
     return []
+
+
+def ellipse_candidates(face: Face) -> list[tuple[str, tuple[str, ...], float, float | None]]:
+    """The ``elliptical`` fact of a colour face whose outline an ellipse fits better than its polygon (a lid, a
+    ball; perception/rgb/ellipse.py), as (pred, args, conf, value) with no calibration map (yet): the product of
+    the logistics of the two residuals' log ratio and of the ellipse's residual over its semi-minor axis
+    (ellipse.elliptical_probability); value the log ratio ln(polygon residual / ellipse residual). None for a
+    face without a measured outline."""
+    from .perception.rgb.ellipse import elliptical_probability
+
+    p = elliptical_probability(face.ellipse)
+    return [] if p is None else [("elliptical", (face.id,), p, round(face.ellipse.log_ratio, 4))]
 
 
 @functools.cache

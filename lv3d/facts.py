@@ -15,7 +15,7 @@ from typing import Iterable
 
 from .errors import InputError
 
-SCHEMA = "lv3d.facts/2"
+SCHEMA = "lv3d.facts/3"
 
 # predicate name -> (arity, modalities that may emit it). The same table drives the learner's
 # body predicates, so all three systems share one vocabulary and differ only in what they see.
@@ -35,6 +35,8 @@ PREDICATES: dict[str, tuple[int, frozenset[str]]] = {
     "spherical": (1, frozenset({"depth", "rgbd"})),
     # a planar face bounded by a circle (an ellipse in the image): a can's lid, a cone's base
     "circular": (1, frozenset({"rgb", "depth", "rgbd"})),
+    # colour alone: the face's outline in the image is an ellipse rather than a polygon (a lid, a ball)
+    "elliptical": (1, frozenset({"rgb"})),
     # 2D shape of the image polygon
     "parallelogram": (1, frozenset({"rgb", "rgbd"})),
     # metric shape of the face on its plane (depth, rgbd); for colour alone, the same tests on the image

@@ -7,6 +7,7 @@ Units: polygons in pixels (u right, v down); planes and points in the camera fra
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -15,6 +16,9 @@ from .cone import Cone
 from .cylinder import Cylinder
 from .plane import Plane
 from .sphere import Sphere
+
+if TYPE_CHECKING:  # the colour path's measurement; scene.py imports nothing of perception at run time
+    from .perception.rgb.ellipse import OutlineEllipse
 
 PROVENANCE = ("rgb", "depth", "rgbd")
 
@@ -38,6 +42,7 @@ class Face:
     cylinder: Cylinder | None = None  # the fitted cylinder of a cylindrical face (then ``plane`` is None)
     sphere: Sphere | None = None      # the fitted sphere of a spherical face
     cone: Cone | None = None          # the fitted cone of a conical face
+    ellipse: OutlineEllipse | None = None  # colour alone: the ellipse fitted to the outline (perception/rgb/ellipse.py)
 
     @property
     def sides(self) -> int:
@@ -51,7 +56,8 @@ class Face:
                 "edge_support": self.edge_support, "plane_rms_m": self.plane_rms_m, "surface": self.surface,
                 "cylinder": self.cylinder.to_dict() if self.cylinder is not None else None,
                 "sphere": self.sphere.to_dict() if self.sphere is not None else None,
-                "cone": self.cone.to_dict() if self.cone is not None else None}
+                "cone": self.cone.to_dict() if self.cone is not None else None,
+                "ellipse": self.ellipse.to_dict() if self.ellipse is not None else None}
 
 
 @dataclass

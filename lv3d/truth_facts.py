@@ -75,8 +75,8 @@ def _exact_facts(truth: dict, k: dict, scene_id: str, modality: str = "rgbd") ->
     its radius, as perception gives it), a cone's side ``conical`` (value: its half-angle in degrees), a
     sphere ``spherical`` (value: its radius); they have no plane, so no plane facts. Their ``sides`` is 0:
     a circular cap or base is planar (``horizontal`` / ``vertical`` and the plane pairs hold) and
-    ``circular``, but has no side count, no corners and no polygon shape (its outline is sampled along a
-    curve, not a polygon)."""
+    ``circular``, and ``elliptical`` (its outline in the image; so is a sphere's), but has no side count, no
+    corners and no polygon shape (its outline is sampled along a curve, not a polygon)."""
     o = object_id(scene_id, 1)
     facts = [Fact("object", (o,), 1.0)]
     up = np.asarray(truth["support_plane"]["normal"], float)
@@ -94,10 +94,12 @@ def _exact_facts(truth: dict, k: dict, scene_id: str, modality: str = "rgbd") ->
             facts.append(Fact("conical", (fid,), 1.0, float(surface["half_angle_deg"])))
         elif surface["type"] == "sphere":
             facts.append(Fact("spherical", (fid,), 1.0, float(surface["radius"])))
+            facts.append(Fact("elliptical", (fid,), 1.0))  # its silhouette: a circle, an ellipse in the image
         if surface["type"] != "plane":
             continue
         if int(f["sides"]) == 0:  # a planar face bounded by a circle: a cap or a cone's base
             facts.append(Fact("circular", (fid,), 1.0))
+            facts.append(Fact("elliptical", (fid,), 1.0))  # the circle seen in the image: an ellipse
         n = np.asarray(f["plane"]["normal"], float)
         normals[int(f["id"])] = n
         if int(f["sides"]) in SIDES:

@@ -43,7 +43,7 @@ FIT_MODULE, SCENE_MODULE = "lv3d_fit", "lv3d_scene"
 # found wins): what a face is (sides, metric shape), what faces it meets, at which angles, then
 # the 2D outline, and last the face's orientation to the table, which depends on how the solid
 # happens to rest and so generalises worst from one view.
-BODY_ORDER = ("face_of", "cylindrical", "conical", "spherical", "circular", "triangle", "quadrilateral", "pentagon", "hexagon", "square", "rectangle", "regular",
+BODY_ORDER = ("face_of", "cylindrical", "conical", "spherical", "circular", "elliptical", "triangle", "quadrilateral", "pentagon", "hexagon", "square", "rectangle", "regular",
               "triangle_neighbour", "quadrilateral_neighbour", "square_neighbour",
               "perpendicular_neighbour", "acute_neighbour", "obtuse_neighbour", "right_corner",
               "adjacent", "perpendicular", "acute", "obtuse", "parallel", "parallelogram", "horizontal", "vertical")

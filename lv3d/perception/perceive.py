@@ -84,7 +84,8 @@ def _rgb_objects(scene_id: str, faces: list[RGBFace], groups: list[list[int]],
     for k, idx in enumerate(groups, start=1):
         oid = object_id(scene_id, k)
         ids = {i: face_id(scene_id, k, j) for j, i in enumerate(idx, start=1)}
-        obj_faces = [Face(ids[i], faces[i].polygon, "rgb", edge_support=faces[i].edge_support) for i in idx]
+        obj_faces = [Face(ids[i], faces[i].polygon, "rgb", edge_support=faces[i].edge_support,
+                          ellipse=faces[i].ellipse) for i in idx]
         adj = [(ids[a], ids[b]) for a, b in adjacency if a in ids and b in ids]
         out.append(SceneObject(oid, obj_faces, adj, int(round(sum(faces[i].area_px for i in idx))),
                                _centroid([faces[i].polygon for i in idx])))

@@ -95,3 +95,10 @@ def test_logical_vision_concepts_are_learnable_from_colour_alone():
     assert "has_right_angle(B)" in right.clauses[0] and right.score["tp"] == 3 and right.score["fp"] == 0
     regular = fit(scenes, labels, "regular", settings={"disjunctions": 0})
     assert "regular(B)" in regular.clauses[0] and regular.score["tp"] == 3 and regular.score["fp"] == 0
+
+
+def test_elliptical_is_in_the_colour_vocabulary_only():
+    from lv3d.learn.model import body_preds
+
+    assert ("elliptical", 1) in body_preds("rgb")
+    assert ("elliptical", 1) not in body_preds("depth") and ("elliptical", 1) not in body_preds("rgbd")

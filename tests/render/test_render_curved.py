@@ -224,6 +224,9 @@ def test_truth_facts_of_curved_faces():
     assert "conical" in preds[("cone", "depth")] and "conical" not in preds[("cone", "rgb")]
     assert preds[("sphere", "rgbd")] == {"object", "face_of", "spherical"}
     assert "circular" in preds[("cylinder", "rgb")]  # a visible cap: a planar face bounded by a circle
+    # a cap's and a ball's outline in the image is an ellipse; colour alone says so
+    assert "elliptical" in preds[("cylinder", "rgb")] and "elliptical" in preds[("sphere", "rgb")]
+    assert "elliptical" not in preds[("cylinder", "depth")] | preds[("sphere", "rgbd")]
 
 
 def test_old_class_lists_keep_their_ids(tmp_path):

@@ -4,6 +4,7 @@ silhouettes that no face covers (untraced.py), grouped into objects by shared ed
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from dataclasses import dataclass
 
@@ -12,6 +13,7 @@ import numpy as np
 
 from .background import background_faces, chromaticity, face_chromaticity, log_gradient, smooth_faces
 from ..edges import channel_edges, channels, edge_distance, edge_support
+from .ellipse import OutlineEllipse, measure_face
 from .faces import bounded_faces, build_graph
 from .gaps import close_gaps
 from ..polygons import (KEEP_AREA, area, clockwise, drop_short_sides, is_simple, mean_width, outline_distance, perimeter,
@@ -28,12 +30,14 @@ from .untraced import untraced_faces
 @dataclass(frozen=True)
 class RGBFace:
     """A validated colour face: ``polygon`` (n, 2) pixels, clockwise, simplified to its corners;
-    ``edges``: the planar-graph edges it is bounded by (for adjacency); ``edge_support`` in [0, 1]."""
+    ``edges``: the planar-graph edges it is bounded by (for adjacency); ``edge_support`` in [0, 1]; ``ellipse``:
+    the ellipse fitted to its outline's edge pixels beside its polygon (ellipse.py), None where none fits."""
 
     polygon: np.ndarray
     edges: frozenset[tuple[int, int]]
     edge_support: float
     area_px: float
+    ellipse: OutlineEllipse | None = None
 
 
 @dataclass(frozen=True)
@@ -117,7 +121,8 @@ def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: floa
     Faces are grouped into solids by the edges they share and the silhouettes they lie in, never by their hue
     (solids.group_solids: the graph joins solids that nearly touch or overlap, and a side of one ending on the
     other's outline parts them), and the parts of one face cut apart by a line drawn across it are made one face
-    again (solids.one_face_parts: a print's edge, a label). (rgbd does not trace colour faces: fuse.py.)"""
+    again (solids.one_face_parts: a print's edge, a label). Last, each face's outline is fitted with an ellipse and
+    compared with its polygon (ellipse.measure_face: a lid, a ball). (rgbd does not trace colour faces: fuse.py.)"""
     import time
 
     t0 = time.perf_counter()
@@ -249,7 +254,8 @@ def rgb_faces(color: np.ndarray, min_area_px: float = 150.0, max_area_frac: floa
     order = sorted(range(len(faces)), key=lambda i: (-faces[i].area_px, float(faces[i].polygon[0, 0]),
                                                      float(faces[i].polygon[0, 1])))
     rank = {i: k for k, i in enumerate(order)}
-    faces = [faces[i] for i in order]
+    # each face's outline measured against an ellipse (a lid, a ball: ellipse.py)
+    faces = [dataclasses.replace(faces[i], ellipse=measure_face(faces[i].polygon, edges)) for i in order]
     groups = [sorted(rank[i] for i in g) for g in groups.values()]
     adjacency = sorted((i, j) for g in groups for i in g for j in g if i < j and faces[i].edges & faces[j].edges)
     ordered = sorted(groups, key=lambda idx: (-sum(faces[i].area_px for i in idx), idx[0]))
