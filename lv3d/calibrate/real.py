@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, read_pickle
 from ..frame_folder import FrameFolder
 from ..object_facts import face_cover, held_object, merged_flags, region_pixels
 from ..output import write_atomic
@@ -159,16 +159,7 @@ def figures(frames: list[dict], conf) -> dict[str, dict]:
 
 def read(path: Path) -> dict:
     """A pickle of :func:`make`, or a one-line InputError naming the file."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(path, "no such file (make it with lv3d calibrate real)")
-    try:
-        data = pickle.loads(path.read_bytes())
-    except Exception as e:  # noqa: BLE001 - whatever a foreign file raises, the answer is one line
-        raise InputError(path, f"not a pickle of lv3d calibrate real ({type(e).__name__})") from None
-    if not isinstance(data, dict) or not isinstance(data.get("frames"), list) or "rows" not in data:
-        raise InputError(path, "not a pickle of lv3d calibrate real (no rows and frames)")
-    return data
+    return read_pickle(path, "lv3d calibrate real", ("rows", "frames"))
 
 
 def make(folders: list[Path], out: Path, modalities: tuple[str, ...] = MODALITIES, limit: int | None = None,

@@ -19,7 +19,7 @@ import pickle
 import time
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, read_pickle
 from ..output import write_atomic
 from .truth import truth_labels
 
@@ -50,16 +50,7 @@ def scene_rows(cls: str, seed: int, preset: str, modalities: list[str]) -> list[
 
 def read(path: Path) -> dict:
     """A pickle of :func:`make`, or a one-line InputError naming the file."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(path, "no such file (make it with lv3d calibrate rows)")
-    try:
-        data = pickle.loads(path.read_bytes())
-    except Exception as e:  # noqa: BLE001 - whatever a foreign file raises, the answer is one line
-        raise InputError(path, f"not a pickle of lv3d calibrate rows ({type(e).__name__})") from None
-    if not isinstance(data, dict) or not isinstance(data.get("rows"), list) or "scenes" not in data:
-        raise InputError(path, "not a pickle of lv3d calibrate rows (no rows and scenes)")
-    return data
+    return read_pickle(path, "lv3d calibrate rows", ("rows", "scenes"))
 
 
 def make(out: Path, seed: int = 30000, per_class: int = 20, preset: str = "realsense",
