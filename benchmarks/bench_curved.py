@@ -51,6 +51,7 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
+from lv3d import compile_cache
 from lv3d.describe import curved_evidence, describe
 from lv3d.perception import perceive
 from lv3d.perception.depth.quadrics import cone_evidence, sphere_evidence
@@ -194,6 +195,7 @@ def _target(preset: str, key: str, value: float) -> str:
 
 
 def main(argv=None) -> int:
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="3 scenes a class")
     ap.add_argument("--per-class", type=int, default=10)

@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lv3d import compile_cache
 from lv3d.calibrate.measures import chance_ece, ece, ece_verdict, log_loss, reliability_bins, scene_interval
 from lv3d.calibrate.truth import match_faces, truth_labels, truth_quantities, truth_scene
 from lv3d.describe import MIN_CONF, ground
@@ -199,6 +200,7 @@ print(json.dumps({"first": first, "ts": ts, "cs": cs}))
 
 
 def main(argv=None) -> int:
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="2 scenes per class")
     ap.add_argument("--per-class", type=int, default=6)

@@ -38,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lv3d import compile_cache
 from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stratified_folds
 from lv3d.learn import Model, fit
 from lv3d.learn.engine import LearnError
@@ -203,6 +204,7 @@ def speed(data: Data, facts: dict, seed: int) -> None:
 
 
 def main(argv=None) -> int:
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seed", type=int, default=778, help="dev seed of both data sets (never 0)")
     ap.add_argument("--per-class", type=int, default=30)

@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from lv3d import compile_cache
 from lv3d.errors import InputError
 from lv3d.perception import perceive
 from lv3d.perception.depth.cloud import slope_noise
@@ -212,6 +213,7 @@ def _fmt_target(preset: str, key: str, value: float) -> str:
 
 
 def main(argv=None) -> int:
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="2 scenes per class, clean and realsense only")
     ap.add_argument("--per-class", type=int, default=10)

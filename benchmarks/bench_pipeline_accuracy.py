@@ -25,6 +25,7 @@ import numpy as np
 
 from benchmarks.bench_learner import make_dev_facts
 
+from lv3d import compile_cache
 from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stratified_folds
 from lv3d.experiment.runner import score_binary
 from lv3d.experiment.systems import LogicSystem, negative_label
@@ -63,6 +64,7 @@ def evaluate(data: dict, folds: int, positives: int, seed: int, settings: dict, 
 
 
 def main() -> None:
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     ap = argparse.ArgumentParser()
     ap.add_argument("dev", nargs="+", type=Path,
                     help="DEV data sets bench_learner made (<root>/<preset><seed>, e.g. out/bench/dev/clean778)")

@@ -124,6 +124,7 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
+from lv3d import compile_cache
 from lv3d.calibrate.measures import ece
 from lv3d.calibrate.real import BOX_PERP, PRISM_PERP, ROUND, SHAPES, perpendicular_truth
 from lv3d.errors import InputError
@@ -543,9 +544,7 @@ def main(argv=None) -> int:
         return 2
 
     _one_core()
-    import grounding
-
-    grounding.enable_cache()
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     names = [f.name for f in folders]
     names = names if len(set(names)) == len(names) else [str(f) for f in folders]
     mods = args.modalities

@@ -24,7 +24,7 @@ def enable_cache(path: str | os.PathLike | None = None) -> Path:
     Calling it again with the same folder does nothing; a different folder switches to it.
     """
     global _enabled, _asked
-    # describe() calls this every frame: resolving the path takes system calls, so the same request
+    # a caller may ask again and again: resolving the path takes system calls, so the same request
     # (argument and the environment it depends on) returns the folder it found last time
     asked = (None if path is None else os.fspath(path), os.environ.get("LV3D_CACHE"), os.environ.get("HOME"))
     if _enabled is not None and asked == _asked:

@@ -194,7 +194,6 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
 
     from .image_shape import image_shape
 
-    grounding.enable_cache()
     k = scene.intrinsics
     intr = (k.fx, k.fy, k.cx, k.cy)
     if field is None:

@@ -16,3 +16,11 @@ def real_dir():
     if not REAL_DIR.is_dir():
         pytest.skip(f"real Kinect frames not found at {REAL_DIR} (../shared/data/real/pcl-kinect)")
     return REAL_DIR
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _compile_cache():
+    """The test suite is an entry point: grounding's compiled programs are kept under LV3D_CACHE (above)."""
+    from lv3d import compile_cache
+
+    compile_cache.enable()

@@ -167,8 +167,6 @@ def make(folders: list[Path], out: Path, modalities: tuple[str, ...] = MODALITIE
     """The frame entries of every frame (the first ``limit`` of each folder) of ``folders``, written to the
     pickle ``out`` once all are done (``out`` must be absent or a pickle of this function). Every folder is
     checked before any work."""
-    import grounding
-
     bad = [m for m in modalities if m not in MODALITIES]
     if bad or not modalities:
         raise InputError("--modalities", f"choose among {', '.join(MODALITIES)}, not {','.join(modalities)!r}")
@@ -181,7 +179,6 @@ def make(folders: list[Path], out: Path, modalities: tuple[str, ...] = MODALITIE
         read(out)  # a file this command did not write is refused, never replaced
     for folder in folders:
         FrameFolder(folder).labels(SHAPES)
-    grounding.enable_cache()
     t0 = time.time()
     frames: list[dict] = []
     for folder in folders:

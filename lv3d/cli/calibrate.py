@@ -7,6 +7,8 @@ from pathlib import Path
 
 import click
 
+from .. import compile_cache
+
 
 def _say(text: str) -> None:
     click.echo(text)
@@ -54,6 +56,7 @@ def calibrate():
 @click.pass_context
 def rows(ctx, seed, per_class, preset, modalities, out, fresh):
     """Candidate facts of perceived rendered dev scenes with their truth and measurements (lv3d.calibrate.rows)."""
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     from ..calibrate.rows import make
 
     make(out, seed, per_class, preset, _modalities(modalities), fresh, command_line(ctx), log=_say)
@@ -69,6 +72,7 @@ def rows(ctx, seed, per_class, preset, modalities, out, fresh):
 def real(ctx, folders, modalities, limit, out):
     """Labelled perpendicular candidates of FOLDERS of real frames (the real layout, docs/real_frames.md)
     (lv3d.calibrate.real)."""
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     from ..calibrate.real import make
 
     make(list(folders), out, _modalities(modalities), limit, command_line(ctx), log=_say)

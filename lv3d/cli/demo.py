@@ -20,6 +20,7 @@ from pathlib import Path
 import click
 import numpy as np
 
+from .. import compile_cache
 from ..experiment.config import LOGIC_SYSTEMS, SYSTEMS, StudyConfig, from_dict
 from ..experiment.folds import Item
 
@@ -102,6 +103,7 @@ def plot_accuracy(acc: dict[str, float], path: Path) -> None:
 def demo(out: Path, per_class: int, train_per_class: int, noise: str, seed: int, systems: str, threads: int,
          real: Path | None, no_real: bool):
     """Learn four shape classes from a few RGB-D images and explain an answer."""
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     from ..errors import InputError
     from ..experiment import data as data_mod
     from ..experiment.systems import make_system

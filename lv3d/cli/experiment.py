@@ -6,6 +6,8 @@ from pathlib import Path
 
 import click
 
+from .. import compile_cache
+
 
 @click.group()
 def experiment():
@@ -28,6 +30,7 @@ def run(config: Path, out: Path, overrides: tuple[str, ...], quiet: bool, execut
         workers: int):
     """Run the study CONFIG into OUT; finished (fold, system) results are kept and skipped. The results are
     the same, bit for bit, whatever --executor and --workers."""
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     from ..experiment.config import load_study
     from ..experiment.executor import make_executor
     from ..experiment.runner import run_study

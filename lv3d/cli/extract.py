@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 import cv2
 
+from .. import compile_cache
 from ..errors import InputError
 from ..output import check_out, replacing
 
@@ -33,6 +34,7 @@ from ..output import check_out, replacing
 def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scale: float | None, modality: str,
             scene_id: str | None, out_dir: Path, facts: bool, max_objects: int | None) -> None:
     """Find objects, faces and planes in one frame COLOR; write OUT/scene.json and OUT/overlay.png."""
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     from ..rgbd import load_frame, read_intrinsics
     from ..perception.overlay import draw_overlay
     from ..perception.perceive import perceive

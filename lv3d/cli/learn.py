@@ -9,6 +9,7 @@ from pathlib import Path
 
 import click
 
+from .. import compile_cache
 from ..errors import InputError, read_json
 from ..facts import MODALITIES
 
@@ -183,6 +184,7 @@ def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classe
         time_limit: float | None):
     """Learn one program per class and save them as .pl files in OUT. Examples where perception found no
     object are left out (counted)."""
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     from ..output import check_out, replacing
     from ..learn.model import Model
 
@@ -244,6 +246,7 @@ def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path 
 def predict(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path, explain: bool):
     """Classify every example of a data set or folder with saved programs; print accuracy. An example where
     perception found no object is answered "unknown" (and counts as wrong)."""
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir)
     correct = 0
     for s, y in zip(scenes, labels):
@@ -273,6 +276,7 @@ def explain(data: Path, modality: str, facts: str | None, cache: Path | None, mo
             examples: tuple[str, ...]):
     """Print why each example gets its label: the program that proves it and the facts (with confidences)
     the proof used."""
+    compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir)
     by_id = {s.scene: (s, y) for s, y in zip(scenes, labels)}
     unknown = [e for e in examples if e not in by_id]

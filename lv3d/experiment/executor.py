@@ -15,12 +15,23 @@ so the results are the same, bit for bit, wherever and in whatever order the job
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterator
 from typing import Any
 
+from .. import compile_cache
 from ..errors import InputError
 
 EXECUTORS = ("local", "dask")
+
+
+def start_worker() -> None:
+    """A local worker process's start: it dies with its parent, and keeps compiled programs on disk when the
+    entry point that started it does (lv3d.compile_cache)."""
+    from ..workers import die_with_parent
+
+    die_with_parent()
+    compile_cache.enable_if_asked()
 
 
 class LocalExecutor:
@@ -68,9 +79,7 @@ class LocalExecutor:
         from concurrent.futures import ProcessPoolExecutor
         from multiprocessing import get_context
 
-        from ..workers import die_with_parent
-
-        return ProcessPoolExecutor(n, mp_context=get_context("spawn"), initializer=die_with_parent)
+        return ProcessPoolExecutor(n, mp_context=get_context("spawn"), initializer=start_worker)
 
     def _shared_pool(self):
         if self._pool is None:
@@ -115,6 +124,8 @@ class DaskExecutor:
         except (OSError, TimeoutError) as e:
             self.close()
             raise InputError("--address", f"cannot reach the Dask scheduler at {address}: {e}") from None
+        if os.environ.get(compile_cache.ASK) == "1":  # the entry point keeps compiled programs: so do the workers
+            self.client.run(compile_cache.enable)
 
     def map(self, fn: Callable, jobs: list, shared: Any = None, workers: int | None = None
             ) -> Iterator[tuple[int, Any]]:

@@ -101,7 +101,7 @@ _WORKER_PARENT = textwrap.dedent("""
     from lv3d.experiment.executor import LocalExecutor
 
     def job(j, shared):
-        print(os.getpid(), flush=True)
+        os.write(1, f"{os.getpid()}\\n".encode())  # one write: two workers' lines never interleave
         time.sleep(120)
 
     if __name__ == "__main__":
