@@ -7,18 +7,15 @@ Units: polygons in pixels (u right, v down); planes and points in the camera fra
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .camera import Intrinsics
 from .cone import Cone
 from .cylinder import Cylinder
+from .outline_ellipse import OutlineEllipse
 from .plane import Plane
 from .sphere import Sphere
-
-if TYPE_CHECKING:  # the colour path's measurement; scene.py imports nothing of perception at run time
-    from .perception.rgb.ellipse import OutlineEllipse
 
 PROVENANCE = ("rgb", "depth", "rgbd")
 
