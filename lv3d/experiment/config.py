@@ -130,33 +130,32 @@ def check_value(value, meta: dict, key: str, where: str):
         if len(set(value)) != len(value):
             bad("lists a folder twice")
         return tuple(value)
-    if kind == "labels":  # class names: words here; which names exist depends on the data (checked in from_dict)
+    def name_list(item_problem) -> tuple:
+        """``value`` as a list of names, each passing ``item_problem`` (None, or what is wrong with it), none
+        twice, at least ``min_len`` of them."""
         if not isinstance(value, (list, tuple)):
             bad("must be a list")
         for v in value:
-            if not isinstance(v, str) or not re.fullmatch(r"[a-z][a-z0-9_]*", v):
-                raise InputError(where, f"{key}: {v!r} is not a class name (a lower-case word)")
+            problem = item_problem(v)
+            if problem is not None:
+                raise InputError(where, f"{key}: {problem}")
         if len(set(value)) != len(value):
             bad("lists a name twice")
         if len(value) < meta["min_len"]:
             bad(f"needs a list of at least {meta['min_len']}")
         return tuple(value)
+
+    if kind == "labels":  # class names: words here; which names exist depends on the data (checked in from_dict)
+        return name_list(lambda v: None if isinstance(v, str) and re.fullmatch(r"[a-z][a-z0-9_]*", v)
+                         else f"{v!r} is not a class name (a lower-case word)")
     names = meta["names"]() if callable(meta["names"]) else meta["names"]
     if kind == "name":
         if not isinstance(value, str) or value not in names:
             bad(f"must be one of {', '.join(names)}")
         return value
     if kind == "names":
-        if not isinstance(value, (list, tuple)):
-            bad("must be a list")
-        for v in value:
-            if not isinstance(v, str) or v not in names:
-                raise InputError(where, f"{key}: unknown name {v!r}; known: {', '.join(names)}")
-        if len(set(value)) != len(value):
-            bad("lists a name twice")
-        if len(value) < meta["min_len"]:
-            bad(f"needs a list of at least {meta['min_len']}")
-        return tuple(value)
+        return name_list(lambda v: None if isinstance(v, str) and v in names
+                         else f"unknown name {v!r}; known: {', '.join(names)}")
     if kind in ("ints", "bools"):  # a grid of values: a non-empty list, each value checked, none twice
         if not isinstance(value, (list, tuple)) or not value:
             bad("must be a non-empty list")
