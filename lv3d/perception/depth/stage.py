@@ -21,6 +21,7 @@ from ...rgbd import RGBD
 from ..boundary import mask_polygon
 from .cloud import PointGrid, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
+from .creases import CreaseSettings, split_at_creases
 from .curved import CurvedFace, CurvedSettings, object_cylinders
 from .occlusion import OcclusionSettings, join_occluded
 from .quadrics import QuadricFace, QuadricSettings, leaves_room, quadric_faces
@@ -55,7 +56,9 @@ class DepthSettings:
     ``support_stand_rel`` (fraction of the median depth): how high above a candidate support plane points count
     as objects standing on it (their lower parts), and ``support_inner`` (fraction of its extent, about its
     centre) over what part of it (support.support_plane).
-    ``convexity``: the cut at concave creases (convexity.ConvexitySettings).
+    ``convexity``: the cut at concave creases between an object's planes (convexity.ConvexitySettings).
+    ``creases``: the cut at concave creases of the surface where its planes do not cut it (curved objects
+    touching: creases.CreaseSettings).
     ``curved``: a fan of planes read as one cylindrical face (curved.CurvedSettings).
     ``quadrics``: an object's sphere or cone side read as one face (quadrics.QuadricSettings).
     ``occlusion``: two pieces of one solid seen around an occluder joined (occlusion.OcclusionSettings).
@@ -73,6 +76,7 @@ class DepthSettings:
     support_stand_rel: float = 0.1
     support_inner: float = 0.85
     convexity: ConvexitySettings = field(default_factory=ConvexitySettings)
+    creases: CreaseSettings = field(default_factory=CreaseSettings)
     curved: CurvedSettings = field(default_factory=CurvedSettings)
     quadrics: QuadricSettings = field(default_factory=QuadricSettings)
     occlusion: OcclusionSettings = field(default_factory=OcclusionSettings)
@@ -142,7 +146,8 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
                   "max_need": max(1, round(settings.plane_max_frac * cells)),
                   "min_points": max(3, round(settings.plane_min_frac * cells))}
     normals = _Normals(grid)
-    solids = _solids(grid, support, objs, seed, plane_args, settings.convexity, normals)
+    solids = _solids(grid, support, objs, seed, plane_args, settings, normals,
+                     max(1, round(settings.min_object_frac * cells)))
     solids = join_occluded(solids, grid.xyz, grid.valid, settings.occlusion)
     solids.sort(key=lambda op: (-op[0].size, int(np.argmax(op[0].mask))))
     dropped = max(0, len(solids) - settings.max_objects)
@@ -230,19 +235,25 @@ class _Normals:
 
 
 def _solids(grid: PointGrid, support: Plane | None, objs: list[DepthObject], seed: int, plane_args: dict,
-            convexity: ConvexitySettings, normals: _Normals) -> list[tuple[DepthObject, list[DepthPlane]]]:
-    """Each object cut at concave creases into solids (convexity.split_at_concave), each solid with its planes: a
-    cut piece gets its planes anew, which may cut it again."""
+            settings: DepthSettings, normals: _Normals, min_cells: int
+            ) -> list[tuple[DepthObject, list[DepthPlane]]]:
+    """Each object cut at concave creases into solids, each solid with its planes: first at creases between its
+    planes (convexity.split_at_concave), else at creases of its surface (creases.split_at_creases, pieces of at
+    least ``min_cells``); a cut piece gets its planes anew, which may cut it again."""
     out = []
-    todo = list(objs)
+    todo = [(o, True) for o in objs]
     while todo:
-        o = todo.pop(0)
+        o, whole = todo.pop(0)
         planes = object_planes(grid, o.mask, seed=seed + len(out), normals=normals(o.mask), **plane_args)
-        pieces = split_at_concave(grid, o.mask, planes, convexity)
+        pieces = split_at_concave(grid, o.mask, planes, settings.convexity)
+        by_planes = len(pieces) > 1
+        if not by_planes and whole:
+            # a piece the creases cut is not asked again: its creases are its borders
+            pieces = split_at_creases(grid, o.mask, normals(o.mask), min_cells, settings.creases)
         if len(pieces) == 1:
             out.append((o, planes))
         else:
-            todo += [DepthObject(m, _height(grid, support, m)) for m in pieces]
+            todo += [(DepthObject(m, _height(grid, support, m)), by_planes) for m in pieces]
     return out
 
 
