@@ -152,13 +152,13 @@ class FrameFacts:
 
 
 def frame_facts(frame: RGBD, frame_atom: str, modality: str, labels: list[tuple[int, int, int]], *,
-                refine: bool = True) -> FrameFacts:
+                refine: bool = True, seed: int = 0) -> FrameFacts:
     """Perceive and ground ``frame`` once as ``modality`` sees it; ``labels``: (object, u, v) of each labelled
-    object. Only the labelled objects are refined and kept."""
+    object. Only the labelled objects are refined and kept. ``seed``: perception's (perceive)."""
     from .describe import describe
     from .perception import perceive
 
-    scene = perceive(frame, modality, scene_id=frame_atom)
+    scene = perceive(frame, modality, scene_id=frame_atom, seed=seed)
     shape = frame.depth.shape
     under: dict[int, str | None] = {}
     boxes: dict[int, list[int] | None] = {}

@@ -206,6 +206,7 @@ class TrainConfig:
 class Lv3dConfig:
     refine: bool = _bool(True, doc="JAX refinement before facts (false: the no-refinement ablation)")
     confidences: bool = _bool(True, doc="facts keep their confidences (false: every confidence is 1)")
+    perception_seed: int = _int(0, 0, 2 ** 31 - 1, doc="seed of perception's sample consensus (0: as lv3d extract)")
     settings: dict = _spec({}, "mapping", doc="learner settings (lv3d.learn.settings), e.g. {time_limit: 20}")
     workers: int = _int(1, 1, MAX_WORKERS, doc="processes computing facts")
 

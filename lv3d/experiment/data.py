@@ -78,20 +78,27 @@ def read_items(data: Path) -> list[Item]:
         raise InputError(path, f"cannot read the data set manifest: {e}") from None
 
 
+def facts_variant(modality: str, refine: bool, seed: int = 0) -> str:
+    """The cache folder of one way of computing facts: ``<modality>-refine<0|1>``, and ``-seed<s>`` for a
+    perception seed other than 0 (the default's folders keep their names)."""
+    return f"{modality}-refine{int(refine)}" + (f"-seed{seed}" if seed else "")
+
+
 def facts_dir(cfg: StudyConfig, out: Path, modality: str, refine: bool) -> Path:
     root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else Path(out) / "facts"
-    return root / digest(data_key(cfg)) / facts_version() / f"{modality}-refine{int(refine)}"
+    return root / digest(data_key(cfg)) / facts_version() / facts_variant(modality, refine, cfg.lv3d.perception_seed)
 
 
 def facts_job(job: tuple, shared=None) -> dict:
     """The cache record of one image's facts: ``{"facts": ..., "error": None or why the pipeline found
     nothing}`` (runs in a worker; the caller writes it)."""
-    item_dir, scene_id, modality, refine = job
+    item_dir, scene_id, modality, refine, seed = job
     from ..pipeline import scene_facts
     from ..rgbd import load_item
 
     try:
-        facts = scene_facts(load_item(Path(item_dir)), scene_id, modality, refine=refine, confidences=True)
+        facts = scene_facts(load_item(Path(item_dir)), scene_id, modality, refine=refine, confidences=True,
+                            seed=seed)
         return {"facts": facts.to_json(), "error": None}
     except InputError as e:  # e.g. no object found: the system sees an empty scene, and we count it
         return {"facts": SceneFacts(scene_id, modality, [], None).to_json(), "error": str(e)}
@@ -125,7 +132,7 @@ def ensure_facts(cfg: StudyConfig, out: Path, data: Path, items: list[Item], mod
     have = {it.id: _read_facts(dest / f"{it.id}.json") for it in items}
     todo = [it for it in items if have[it.id] is None]
     if todo:
-        jobs = [(str(Path(data) / it.dir), it.id, modality, refine) for it in todo]
+        jobs = [(str(Path(data) / it.dir), it.id, modality, refine, cfg.lv3d.perception_seed) for it in todo]
         own = executor is None
         executor = LocalExecutor(workers) if own else executor
         try:

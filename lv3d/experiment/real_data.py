@@ -94,10 +94,10 @@ def _frame_job(job: tuple, shared=None) -> dict:
     """The cache record of one frame for one modality (runs in a worker)."""
     from ..object_facts import FrameFacts, frame_facts
 
-    folder, frame, atom, labels, modality, refine = job
+    folder, frame, atom, labels, modality, refine, seed = job
     try:
         rgbd = FrameFolder(Path(folder)).load(frame)
-        return frame_facts(rgbd, atom, modality, labels, refine=refine).to_json()
+        return frame_facts(rgbd, atom, modality, labels, refine=refine, seed=seed).to_json()
     except InputError as e:  # a frame that cannot be read: its examples get no facts, and we count why
         return FrameFacts(frame, modality, SceneFacts(atom, modality, [], None),
                           {o: None for o, _, _ in labels}, {o: None for o, _, _ in labels}, str(e)).to_json()
@@ -113,19 +113,21 @@ def _read_record(path: Path):
 
 
 def ensure_frame_facts(rd: RealData, root: Path, version: str, modality: str, refine: bool, workers: int = 1,
-                       executor=None) -> dict:
-    """{frame atom: FrameFacts} for every frame with a labelled object, computed where the cache lacks it."""
+                       executor=None, seed: int = 0) -> dict:
+    """{frame atom: FrameFacts} for every frame with a labelled object, computed where the cache lacks it;
+    ``seed``: perception's."""
+    from .data import facts_variant
     from .executor import LocalExecutor
     from ..object_facts import FrameFacts
 
-    dest = Path(root) / rd.key / version / f"{modality}-refine{int(refine)}"
+    dest = Path(root) / rd.key / version / facts_variant(modality, refine, seed)
     dest.mkdir(parents=True, exist_ok=True)
     clean_stale(dest)
     have = {a: _read_record(dest / f"{a}.json") for a in rd.frames}
     todo = [a for a in rd.frames if have[a] is None]
     if todo:
         jobs = [(str(rd.frames[a][0].path), rd.frames[a][1], a, [(o.object, o.u, o.v) for o in rd.labels[a]],
-                 modality, refine) for a in todo]
+                 modality, refine, seed) for a in todo]
         own = executor is None
         executor = LocalExecutor(workers) if own else executor
         try:
@@ -169,13 +171,16 @@ def crop_box(box: list[int] | None, u: int, v: int, shape: tuple[int, int]) -> t
     return cu - side // 2, cv - side // 2, side
 
 
-def ensure_real_pixels(rd: RealData, cache: Path, size: int, rgbd_frames: dict) -> dict[str, np.ndarray]:
-    """{item id: (4, size, size) float32 crop tensor} (lv3d.baselines.pixels' channels), cached."""
+def ensure_real_pixels(rd: RealData, cache: Path, size: int, rgbd_frames: dict, version: str, seed: int = 0
+                       ) -> dict[str, np.ndarray]:
+    """{item id: (4, size, size) float32 crop tensor} (lv3d.baselines.pixels' channels), cached. The crops lie
+    around the objects rgbd perception found (``rgbd_frames``), so the cache is kept per facts ``version`` and
+    perception ``seed``, as those frames are."""
     from ..baselines.pixels import crop_tensor
     from ..object_facts import example_id
     from .data import read_pixels, write_pixels
 
-    path = Path(cache) / rd.key / f"pixels-{size}.npz"
+    path = Path(cache) / rd.key / version / (f"pixels-{size}" + (f"-seed{seed}" if seed else "") + ".npz")
     ids = [it.id for it in rd.items]
     if path.is_file():
         got = read_pixels(path, rd.items, size)

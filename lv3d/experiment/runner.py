@@ -59,7 +59,9 @@ def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
     relevant["system"] = system
     relevant["fold"] = fold
     if system in LOGIC_SYSTEMS:
-        relevant["settings"] = {k: v for k, v in d["lv3d"].items() if k != "workers"}  # workers: speed only
+        # workers: speed only; the default perception seed leaves the key as results made before it existed
+        relevant["settings"] = {k: v for k, v in d["lv3d"].items()
+                                if k != "workers" and not (k == "perception_seed" and v == 0)}
         relevant["code"] = learner_version()  # changed perception, grounding or learner: recompute
     else:
         # tuning changes the CNNs only; off, the key is the one results made before the setting existed have
@@ -80,6 +82,11 @@ def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
     if d["data"].get("folders"):  # labelled real frames: the folders' content, not a rendering recipe
         relevant["data"] = {"real": _real_key(tuple(d["data"]["folders"]), tuple(d["data"]["classes"])),
                             "seed": d["seed"]}
+        if system not in LOGIC_SYSTEMS:
+            # the baselines' crops lie around the objects rgbd perception found: they change with it
+            from .code_version import facts_version
+
+            relevant["crops"] = {"facts": facts_version(), "seed": d["lv3d"].get("perception_seed", 0)}
     return digest(relevant)
 
 
@@ -211,7 +218,8 @@ class _RealInputs:
             lv, cfg = self.cfg.lv3d, self.cfg
             root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else Path(self.out) / "facts"
             self._frames[modality] = ensure_frame_facts(self.rd, root, facts_version(), modality, lv.refine,
-                                                        lv.workers, executor=self.executor)
+                                                        lv.workers, executor=self.executor,
+                                                        seed=lv.perception_seed)
         return self._frames[modality]
 
     def for_system(self, name: str) -> dict:
@@ -229,8 +237,11 @@ class _RealInputs:
                 self._facts[m] = facts
             return self._facts[m]
         if self._pixels is None:
+            from .code_version import facts_version
+
             self._pixels = ensure_real_pixels(self.rd, data_mod.cache_root(self.cfg, self.out),
-                                              self.cfg.baselines.image_size, self.frames("rgbd"))
+                                              self.cfg.baselines.image_size, self.frames("rgbd"), facts_version(),
+                                              self.cfg.lv3d.perception_seed)
         return self._pixels
 
 

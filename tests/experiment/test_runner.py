@@ -128,3 +128,47 @@ def test_draws_must_be_a_positive_integer(tmp_path, tiny_config):
     for bad in ("0", "1.5", "true"):
         with pytest.raises(InputError, match="train.draws"):
             load_study(tiny_config, [f"train.draws={bad}"])
+
+
+def test_the_perception_seed_reaches_perception_and_keys_its_facts(tmp_path, tiny_config, fake_world, monkeypatch):
+    from lv3d.experiment.config import load_study
+    from lv3d.experiment.data import facts_variant
+    from lv3d.experiment.runner import result_key
+    from tests.experiment.conftest import fake_scene_facts
+
+    seeds = []
+
+    def recording(frame, scene_id, modality, refine=True, confidences=True, seed=0):
+        seeds.append(seed)
+        return fake_scene_facts(frame, scene_id, modality, refine, confidences, seed)
+
+    monkeypatch.setattr("lv3d.pipeline.scene_facts", recording)
+    sets = ["systems=[lv3d-depth]", "folds=2"]
+    run_study(tiny_config, tmp_path / "s", sets + ["lv3d.perception_seed=7"], progress=False)
+    assert seeds and set(seeds) == {7}
+    facts = tmp_path / "s" / "facts"
+    assert {p.name for p in facts.glob("*/*/*")} == {facts_variant("depth", True, 7)} == {"depth-refine1-seed7"}
+    assert facts_variant("depth", True, 0) == "depth-refine1"  # the default's folders keep their names
+    # the default seed keeps the keys results made before the option existed; another seed is another result
+    ccfg = load_study(tiny_config, sets).conditions["base"].to_dict()
+    before = {**ccfg, "lv3d": {k: v for k, v in ccfg["lv3d"].items() if k != "perception_seed"}}
+    assert ccfg["lv3d"]["perception_seed"] == 0
+    assert result_key(ccfg, "lv3d-depth", 0) == result_key(before, "lv3d-depth", 0)
+    other = {**ccfg, "lv3d": {**ccfg["lv3d"], "perception_seed": 7}}
+    assert result_key(other, "lv3d-depth", 0) != result_key(ccfg, "lv3d-depth", 0)
+    # rendered images do not depend on perception: the baselines' keys stay
+    assert result_key(other, "tree-rgbd", 0) == result_key(ccfg, "tree-rgbd", 0)
+
+
+def test_baselines_on_real_frames_are_keyed_by_the_perception_their_crops_came_from(tiny_config, monkeypatch):
+    from lv3d.experiment import runner
+    from lv3d.experiment.config import load_study
+
+    monkeypatch.setattr(runner, "_real_key", lambda folders, classes: "frames")
+    ccfg = load_study(tiny_config, []).conditions["base"].to_dict()
+    real = {**ccfg, "data": {**ccfg["data"], "folders": ["somewhere"]}}
+    seeded = {**real, "lv3d": {**real["lv3d"], "perception_seed": 7}}
+    before = runner.result_key(real, "effnet-rgbd", 0)
+    assert runner.result_key(seeded, "effnet-rgbd", 0) != before
+    monkeypatch.setattr("lv3d.experiment.code_version.facts_version", lambda: "other perception")
+    assert runner.result_key(real, "effnet-rgbd", 0) != before  # perception changed: the crops did too
