@@ -466,10 +466,11 @@ def write_overlay(path: Path, frame, scene, labels: list, label_img: np.ndarray 
 
 
 def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dict[str, list[dict]],
-               overlays: Path | None = None) -> dict:
+               overlays: Path | None = None, seed: int = 0) -> dict:
     """Perceive, ground and evaluate every frame (the first ``limit``) of ``folder`` in each modality; the frames'
     rows are appended to ``rows[modality]``. With ``overlays``, each frame's overlay (:func:`write_overlay`) goes
-    to ``overlays/<folder>/<frame>_<modality>.png``. Returns {modality: [rows of this folder]}."""
+    to ``overlays/<folder>/<frame>_<modality>.png``. ``seed``: perception's (perceive). Returns {modality: [rows of
+    this folder]}."""
     from lv3d.describe import describe
     from lv3d.perception import perceive
 
@@ -480,13 +481,13 @@ def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dic
     mine: dict[str, list[dict]] = {m: [] for m in modalities}
     first = ff.load(frames[0])
     for m in modalities:  # warm-up, not counted: JIT compilation and first-call costs
-        describe(perceive(first, m, scene_id="s000000"), first)
+        describe(perceive(first, m, scene_id="s000000", seed=seed), first)
     for i, name in enumerate(tqdm(frames, desc=folder.name, unit="frame", disable=None, leave=False)):
         frame = ff.load(name)
         label_img = ff.label_image(name, frame.shape)
         for m in modalities:
             t, c = time.perf_counter(), time.process_time()
-            scene = perceive(frame, m, scene_id=f"s{i:06d}")
+            scene = perceive(frame, m, scene_id=f"s{i:06d}", seed=seed)
             facts = describe(scene, frame)
             ms, cpu_ms = 1e3 * (time.perf_counter() - t), 1e3 * (time.process_time() - c)
             row = dict(evaluate_frame(scene, facts, frame, labels.get(name, []), label_img), ms=ms, cpu_ms=cpu_ms,
@@ -521,12 +522,17 @@ def main(argv=None) -> int:
     ap.add_argument("--modalities", type=_modalities, default=list(MODALITIES), metavar="M1,M2",
                     help="among rgb, depth, rgbd (default: all three)")
     ap.add_argument("--json", type=Path, metavar="FILE", help="also write the figures to FILE")
+    ap.add_argument("--seed", type=int, default=0, metavar="S",
+                    help="perception's seed (its sample consensus; default 0, as lv3d extract): rerun with others "
+                         "to see how far a figure moves by chance")
     ap.add_argument("--overlays", type=Path, metavar="DIR",
                     help="also write each frame's overlay (perceived faces, true masks and labelled pixels in white) "
                          "to DIR/<folder>/<frame>_<modality>.png")
     args = ap.parse_args(argv)
     if args.limit is not None and args.limit < 1:
         ap.error("--limit must be at least 1")
+    if args.seed < 0:
+        ap.error("--seed must be 0 or more")
     folders = args.folders or default_folders()
     try:
         if not folders:
@@ -554,7 +560,7 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     for folder, name in zip(folders, names):
         try:
-            mine = run_folder(Path(folder), mods, args.limit, pooled_rows, args.overlays)
+            mine = run_folder(Path(folder), mods, args.limit, pooled_rows, args.overlays, args.seed)
         except InputError as e:
             print(f"bench_real.py: error: {e}", file=sys.stderr)
             return 2

@@ -200,6 +200,23 @@ def test_unknown_modality_stops_at_the_command_line(capsys):
     assert e.value.code == 2 and "choose among" in capsys.readouterr().err
 
 
+def test_the_seed_reaches_perception_and_a_negative_one_stops_at_the_command_line(tmp_path, capsys, monkeypatch):
+    with pytest.raises(SystemExit) as e:
+        bench.main(["--seed", "-1"])
+    assert e.value.code == 2 and "--seed" in capsys.readouterr().err
+    seen = []
+
+    def run_folder(folder, mods, limit, rows, overlays=None, seed=0):
+        seen.append(seed)
+        return {m: [] for m in mods}
+
+    monkeypatch.setattr(bench, "run_folder", run_folder)
+    monkeypatch.setattr(bench, "labelled_folder", lambda folder: None)
+    monkeypatch.setattr(bench, "summarise", lambda rows, m: {k: None for k in bench.KEYS + bench.EXTRA_KEYS})
+    bench.main([str(tmp_path), "--seed", "5", "--modalities", "depth"])
+    assert seen == [5]
+
+
 @pytest.mark.real
 def test_one_osd_frame_end_to_end_writes_every_figure(tmp_path, capsys):
     osd = OSD
