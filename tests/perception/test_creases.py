@@ -85,4 +85,27 @@ def test_a_piece_set_into_another_joins_it():
     mask = np.zeros((H, W), bool)
     mask[10:-10, 60:-60] = True
     assert len(split(grid_of(z), mask)) == 1
-    assert len(split(grid_of(z), mask, settings=CreaseSettings(inset_share=1.0))) == 2
+    # (its border is a ring: the mean normals of the cells along it cancel, so the bend test joins it too)
+    assert len(split(grid_of(z), mask, settings=CreaseSettings(inset_share=1.0))) == 1
+
+
+def test_a_surface_covered_in_creases_by_noise_is_not_cut():
+    # two touching cylinders, with depth noise that bends the normals everywhere (a far wall's, at this scale)
+    grid, mask = cylinders([-0.045, 0.045])
+    noisy = grid.xyz.copy()
+    noisy[..., 2] += np.random.default_rng(0).normal(0.0, 0.005, noisy.shape[:2]).astype(np.float32)
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    g = PointGrid(noisy, grid.normals, grid.valid, 1)
+    normals = crop_normals(g, rows[0], cols[0], rows[-1] + 1, cols[-1] + 1, within=mask)
+    box = mask[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
+    crease = crease_cells(noisy[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1].astype(np.float64),
+                          normals.astype(np.float64), box, 2, 45.0)
+    assert crease[box].mean() > CreaseSettings().max_crease_frac
+    assert len(split_at_creases(g, mask, normals, 60)) == 1
+    # without the guard, the bend test joins most of what the noise cut (the pieces' own normals hardly bend
+    # between them) and keeps the true valley between the two cylinders
+    loose = split_at_creases(g, mask, normals, 60, CreaseSettings(max_crease_frac=1.0, bend_deg=0.0))
+    pieces = split_at_creases(g, mask, normals, 60, CreaseSettings(max_crease_frac=1.0))
+    assert 2 <= len(pieces) < len(loose)
+    left, right = (H // 2, W // 2 - 45), (H // 2, W // 2 + 45)
+    assert not any(p[left] and p[right] for p in pieces)

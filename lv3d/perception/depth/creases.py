@@ -11,9 +11,12 @@ few or none (a curved surface is no plane), so the cut between planes (convexity
    object (the classic cut of touching blobs, here with the creases as part of the outline).
 3. Cuts kept: two pieces stay apart only where at least ``crease_share`` of the cells along their common border
    lie on a crease (a border across a smooth or convex surface is a neck of one solid, and the two join again),
+   where the two pieces' cells near it bend inwards by ``bend_deg`` or more (LCCP's test of a junction, on
+   the pieces' own normals: a border the watershed ran along scattered crease cells of one flat face fails it),
    and where that border is at most ``inset_share`` of each piece's outline (a piece almost ringed by another is
    set into it: a can's lid inside its rim). A piece smaller than the least object joins the neighbour it
-   shares the longest border with.
+   shares the longest border with. A surface whose creases are everywhere (sensor noise on a far wall) is not
+   cut.
 
 Why the watershed rather than connected pieces between creases: on real depth a crease is broken in places
 (noise, a dark pixel, a handle), and one gap would join two solids; seeds far apart compete for the cells
@@ -52,6 +55,15 @@ class CreaseSettings:
     ``inset_share``: a cut along more than this share of either piece's outline joins again: that piece is set
     into the other (a can's recessed lid inside its rim, a mug's inside, a bowl's bottom), not a solid beside it.
     Solids side by side or stacked share a part of each outline; the rest of it is their silhouettes.
+    ``bend_deg`` (degrees): the least inward bend between the mean normals of two pieces' cells along their
+    border (within twice ``baseline`` of it) for the cut to stand, as LCCP tests a junction. Half ``crease_deg``:
+    along a curved border (one solid standing in or on another) the normals of each side turn with it and their
+    mean bends by less than any single crease cell; the pieces of one flat face a watershed ran between
+    scattered noise creases bend by a few degrees.
+    ``max_crease_frac``: an object with more of its cells on creases than this share is not cut at all. Creases
+    between solids are lines, a small share of their cells (at most 0.11 of the cluttered RealSense objects of
+    the real dev frames); where the sensor's noise alone bends the normals by ``crease_deg`` they cover the
+    surface (0.16-0.23 of a far wall in rendered RealSense frames), and every cut there is noise.
     """
 
     crease_deg: float = 45.0
@@ -59,6 +71,8 @@ class CreaseSettings:
     dynamics_frac: float = 0.004
     crease_share: float = 0.5
     inset_share: float = 0.5
+    max_crease_frac: float = 0.15
+    bend_deg: float = 22.5
 
 
 DEFAULT = CreaseSettings()
@@ -98,7 +112,7 @@ def split_at_creases(grid: PointGrid, obj_mask: np.ndarray, normals: np.ndarray,
     diag = float(np.hypot(*grid.shape))
     crease = crease_cells(grid.xyz[i0:i1, j0:j1].astype(np.float64), normals.astype(np.float64), m,
                           round(settings.baseline_frac * diag), settings.crease_deg)
-    if not crease.any():
+    if not crease.any() or np.count_nonzero(crease) > settings.max_crease_frac * np.count_nonzero(m):
         return [obj_mask]
     inside = np.pad(m & ~crease, 1).view(np.uint8)
     dist = cv2.distanceTransform(inside, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
@@ -111,7 +125,9 @@ def split_at_creases(grid: PointGrid, obj_mask: np.ndarray, normals: np.ndarray,
         _, (ii, jj) = ndimage.distance_transform_edt(pieces == 0, return_indices=True)
         pieces = np.where(m, pieces[ii, jj], 0)
     near_crease = cv2.dilate(crease.view(np.uint8), np.ones((3, 3), np.uint8)).view(bool)
-    labels = _join(pieces, n_seeds, near_crease, min_cells, settings)
+    band = 2 * max(1, round(settings.baseline_frac * diag))
+    labels = _join(pieces, n_seeds, near_crease, min_cells, settings,
+                   (grid.xyz[i0:i1, j0:j1].astype(np.float64), normals.astype(np.float64), band))
     out = []
     for lab in np.unique(labels[m]):
         full = np.zeros_like(obj_mask)
@@ -140,12 +156,38 @@ def _borders(labels: np.ndarray, n: int, near_crease: np.ndarray) -> tuple[np.nd
     return total, on, outline
 
 
-def _join(pieces: np.ndarray, n: int, near_crease: np.ndarray, min_cells: int, settings: CreaseSettings
-          ) -> np.ndarray:
+def _bends(labels: np.ndarray, a: int, b: int, xyz: np.ndarray, normals: np.ndarray, band: int,
+           crease_deg: float) -> bool:
+    """Whether pieces ``a`` and ``b`` of ``labels`` meet at a concave crease, as LCCP tests a junction: the mean
+    normals n_a, n_b and centroids c_a, c_b of each piece's cells within ``band`` cells of the other bend
+    inwards, (n_a - n_b) . (c_a - c_b) < 0, by ``crease_deg`` or more."""
+    sides = []
+    rows, cols = np.nonzero((labels == a) | (labels == b))
+    i0, i1 = max(0, rows.min() - 1), rows.max() + 2
+    j0, j1 = max(0, cols.min() - 1), cols.max() + 2
+    lab, nrm, pts = labels[i0:i1, j0:j1], normals[i0:i1, j0:j1], xyz[i0:i1, j0:j1]
+    for this, other in ((a, b), (b, a)):
+        far = cv2.distanceTransform((lab != other).astype(np.uint8), cv2.DIST_L2, 3)
+        near = (lab == this) & (far <= band) & (np.linalg.norm(nrm, axis=2) > 0)
+        if not near.any():
+            return False
+        n = nrm[near].sum(axis=0)
+        norm = np.linalg.norm(n)
+        if norm == 0:
+            return False
+        sides.append((n / norm, pts[near].mean(axis=0)))
+    (na, ca), (nb, cb) = sides
+    return float((na - nb) @ (ca - cb)) < 0 and float(na @ nb) < np.cos(np.radians(crease_deg))
+
+
+def _join(pieces: np.ndarray, n: int, near_crease: np.ndarray, min_cells: int, settings: CreaseSettings,
+          surface: tuple[np.ndarray, np.ndarray, int]) -> np.ndarray:
     """Labels (h, w) of ``pieces`` (1..n-1, 0 = not the object) after the cuts that do not stand are undone
-    (module docstring, step 3)."""
+    (module docstring, step 3); ``surface``: the crop's points and normals (h, w, 3) and the band (cells) either
+    side of a border whose cells say how the pieces meet there."""
     labels = pieces
-    for step in ("smooth", "inset", "small"):
+    xyz, normals, band = surface
+    for step in ("smooth", "bend", "inset", "small"):
         while True:
             ids = np.unique(labels[labels > 0])
             if len(ids) < 2:
@@ -159,6 +201,20 @@ def _join(pieces: np.ndarray, n: int, near_crease: np.ndarray, min_cells: int, s
             pairs = np.argwhere(total > 0)
             if step == "smooth":
                 weak = [(a, b) for a, b in pairs if on[a, b] < settings.crease_share * total[a, b]]
+            elif step == "bend":  # every pair judged once, on the pieces as the smooth step left them
+                flat = [(a, b) for a, b in pairs if not _bends(labels, a, b, xyz, normals, band, settings.bend_deg)]
+                root = list(range(k))
+
+                def find(x: int) -> int:
+                    while root[x] != x:
+                        root[x] = root[root[x]]
+                        x = root[x]
+                    return x
+
+                for a, b in flat:
+                    root[find(a)] = find(b)
+                labels = np.array([find(x) for x in range(k)])[labels]
+                break
             elif step == "inset":
                 weak = [(a, b) for a, b in pairs
                         if total[a, b] > settings.inset_share * min(outline[a], outline[b])]
