@@ -277,6 +277,15 @@ def connected_region(depth: np.ndarray, mask: np.ndarray, u: int, v: int) -> np.
     return blocked[1:-1, 1:-1] == 2
 
 
+def face_confidences(facts, pred: str) -> dict[str, float]:
+    """{face id: the highest confidence of a ``pred`` fact about it} over ``facts`` (a SceneFacts)."""
+    out: dict[str, float] = {}
+    for f in facts.facts:
+        if f.pred == pred:
+            out[f.args[0]] = max(out.get(f.args[0], 0.0), f.conf)
+    return out
+
+
 def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img: np.ndarray | None) -> dict:
     """Counts of one frame and modality (no perception here: ``scene`` and ``facts`` are given), summed over
     frames by :func:`summarise`. ``frame`` supplies the depth and intrinsics; ``label_img`` the masks or None."""
@@ -323,14 +332,7 @@ def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img:
     # calibration pairs: each perceived object once, with one truth; merged objects left out
     truth = perpendicular_truth(labels, held, merged)
     # curved faces: the object under each labelled pixel, as the learner's example takes it
-    cyl_conf: dict[str, float] = {}
-    for f in facts.facts:
-        if f.pred == "cylindrical":
-            cyl_conf[f.args[0]] = max(cyl_conf.get(f.args[0], 0.0), f.conf)
-    ell_conf: dict[str, float] = {}
-    for f in facts.facts:
-        if f.pred == "elliptical":
-            ell_conf[f.args[0]] = max(ell_conf.get(f.args[0], 0.0), f.conf)
+    cyl_conf, ell_conf = face_confidences(facts, "cylindrical"), face_confidences(facts, "elliptical")
     row["cyl_unocc"] = row["cyl_read"] = row["box_curved"] = row["cyl_ellipse"] = row["box_ellipse"] = 0
     for lab in labels:
         if lab.shape not in ("cylinder", "box") or (lab.shape == "cylinder" and lab.partial):

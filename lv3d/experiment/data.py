@@ -78,10 +78,14 @@ def read_items(data: Path) -> list[Item]:
         raise InputError(path, f"cannot read the data set manifest: {e}") from None
 
 
+def seed_suffix(seed: int) -> str:
+    """What a cache name gains for a perception seed other than 0: ``-seed<s>`` (the default's names stay)."""
+    return f"-seed{seed}" if seed else ""
+
+
 def facts_variant(modality: str, refine: bool, seed: int = 0) -> str:
-    """The cache folder of one way of computing facts: ``<modality>-refine<0|1>``, and ``-seed<s>`` for a
-    perception seed other than 0 (the default's folders keep their names)."""
-    return f"{modality}-refine{int(refine)}" + (f"-seed{seed}" if seed else "")
+    """The cache folder of one way of computing facts: ``<modality>-refine<0|1>`` with :func:`seed_suffix`."""
+    return f"{modality}-refine{int(refine)}" + seed_suffix(seed)
 
 
 def facts_dir(cfg: StudyConfig, out: Path, modality: str, refine: bool) -> Path:

@@ -178,9 +178,9 @@ def ensure_real_pixels(rd: RealData, cache: Path, size: int, rgbd_frames: dict, 
     perception ``seed``, as those frames are."""
     from ..baselines.pixels import crop_tensor
     from ..object_facts import example_id
-    from .data import read_pixels, write_pixels
+    from .data import read_pixels, seed_suffix, write_pixels
 
-    path = Path(cache) / rd.key / version / (f"pixels-{size}" + (f"-seed{seed}" if seed else "") + ".npz")
+    path = Path(cache) / rd.key / version / f"pixels-{size}{seed_suffix(seed)}.npz"
     ids = [it.id for it in rd.items]
     if path.is_file():
         got = read_pixels(path, rd.items, size)

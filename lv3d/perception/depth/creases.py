@@ -110,8 +110,9 @@ def split_at_creases(grid: PointGrid, obj_mask: np.ndarray, normals: np.ndarray,
     i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
     m = obj_mask[i0:i1, j0:j1]
     diag = float(np.hypot(*grid.shape))
-    crease = crease_cells(grid.xyz[i0:i1, j0:j1].astype(np.float64), normals.astype(np.float64), m,
-                          round(settings.baseline_frac * diag), settings.crease_deg)
+    baseline = max(1, round(settings.baseline_frac * diag))
+    xyz, nrm = grid.xyz[i0:i1, j0:j1].astype(np.float64), normals.astype(np.float64)
+    crease = crease_cells(xyz, nrm, m, baseline, settings.crease_deg)
     if not crease.any() or np.count_nonzero(crease) > settings.max_crease_frac * np.count_nonzero(m):
         return [obj_mask]
     inside = np.pad(m & ~crease, 1).view(np.uint8)
@@ -125,9 +126,7 @@ def split_at_creases(grid: PointGrid, obj_mask: np.ndarray, normals: np.ndarray,
         _, (ii, jj) = ndimage.distance_transform_edt(pieces == 0, return_indices=True)
         pieces = np.where(m, pieces[ii, jj], 0)
     near_crease = cv2.dilate(crease.view(np.uint8), np.ones((3, 3), np.uint8)).view(bool)
-    band = 2 * max(1, round(settings.baseline_frac * diag))
-    labels = _join(pieces, n_seeds, near_crease, min_cells, settings,
-                   (grid.xyz[i0:i1, j0:j1].astype(np.float64), normals.astype(np.float64), band))
+    labels = _join(pieces, n_seeds, near_crease, min_cells, settings, (xyz, nrm, 2 * baseline))
     out = []
     for lab in np.unique(labels[m]):
         full = np.zeros_like(obj_mask)
@@ -157,10 +156,10 @@ def _borders(labels: np.ndarray, n: int, near_crease: np.ndarray) -> tuple[np.nd
 
 
 def _bends(labels: np.ndarray, a: int, b: int, xyz: np.ndarray, normals: np.ndarray, band: int,
-           crease_deg: float) -> bool:
+           bend_deg: float) -> bool:
     """Whether pieces ``a`` and ``b`` of ``labels`` meet at a concave crease, as LCCP tests a junction: the mean
     normals n_a, n_b and centroids c_a, c_b of each piece's cells within ``band`` cells of the other bend
-    inwards, (n_a - n_b) . (c_a - c_b) < 0, by ``crease_deg`` or more."""
+    inwards, (n_a - n_b) . (c_a - c_b) < 0, by ``bend_deg`` or more."""
     sides = []
     rows, cols = np.nonzero((labels == a) | (labels == b))
     i0, i1 = max(0, rows.min() - 1), rows.max() + 2
@@ -177,7 +176,7 @@ def _bends(labels: np.ndarray, a: int, b: int, xyz: np.ndarray, normals: np.ndar
             return False
         sides.append((n / norm, pts[near].mean(axis=0)))
     (na, ca), (nb, cb) = sides
-    return float((na - nb) @ (ca - cb)) < 0 and float(na @ nb) < np.cos(np.radians(crease_deg))
+    return float((na - nb) @ (ca - cb)) < 0 and float(na @ nb) < np.cos(np.radians(bend_deg))
 
 
 def _join(pieces: np.ndarray, n: int, near_crease: np.ndarray, min_cells: int, settings: CreaseSettings,
