@@ -27,6 +27,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from ..distance import euclidean_distance
 from .cloud import PointGrid
 from .planes import DepthPlane
 
@@ -76,7 +77,7 @@ def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, offsets:
     def within(i: int) -> np.ndarray:
         if reach[i] is None:
             # Euclidean distance to the patch: the disc a dilation by an ellipse of radius ``band`` reaches
-            dist = cv2.distanceTransform((~masks[i]).view(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+            dist = euclidean_distance(~masks[i])
             reach[i] = dist <= band
         return reach[i]
 

@@ -33,6 +33,7 @@ from scipy import ndimage
 from skimage.morphology import h_maxima
 from skimage.segmentation import watershed
 
+from ..distance import euclidean_distance
 from .cloud import PointGrid
 
 
@@ -116,7 +117,7 @@ def split_at_creases(grid: PointGrid, obj_mask: np.ndarray, normals: np.ndarray,
     if not crease.any() or np.count_nonzero(crease) > settings.max_crease_frac * np.count_nonzero(m):
         return [obj_mask]
     inside = np.pad(m & ~crease, 1).view(np.uint8)
-    dist = cv2.distanceTransform(inside, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
+    dist = euclidean_distance(inside)[1:-1, 1:-1]
     seeds = h_maxima(dist, max(1.0, settings.dynamics_frac * diag)) & m
     n_seeds, markers = cv2.connectedComponents(seeds.view(np.uint8), connectivity=8)
     if n_seeds <= 2:
