@@ -14,10 +14,12 @@ from pathlib import Path
 
 _ROOT = Path(__file__).resolve().parents[2]      # the checkout (or site-packages) holding lv3d/
 
-# What the facts of an image depend on: perception, grounding and the fact writer.
+# What the facts of an image depend on: perception, grounding, the fact writer, and the confidence calibration
+# maps it applies (their file and the code that reads it: a refit changes every confidence).
 FACT_SOURCES = ("lv3d/perception", "lv3d/describe.py", "lv3d/facts.py", "lv3d/pipeline.py", "lv3d/scene.py",
                 "lv3d/plane.py", "lv3d/cylinder.py", "lv3d/sphere.py", "lv3d/cone.py", "lv3d/camera.py",
-                "lv3d/rgbd.py", "lv3d/object_facts.py", "lv3d/frame_folder.py", "grounding")
+                "lv3d/rgbd.py", "lv3d/object_facts.py", "lv3d/frame_folder.py", "lv3d/image_shape.py",
+                "lv3d/calibration.py", "lv3d/data/calibration.json", "grounding")
 # What learning from those facts depends on: the Python side of the learner and the Prolog files.
 LEARNER_SOURCES = ("lv3d/learn", "prolog")
 
@@ -32,7 +34,7 @@ def _files(part: str) -> list[Path]:
 @lru_cache(maxsize=None)
 def source_digest(parts: tuple[str, ...]) -> str:
     """A 12-hex digest of the contents of every .py/.pl file under ``parts`` (paths relative to
-    the checkout). Raises FileNotFoundError when a part is missing, rather than hashing nothing."""
+    the checkout; a part that is a file counts whatever its kind). Raises FileNotFoundError when a part is missing, rather than hashing nothing."""
     h = hashlib.sha256()
     for part in parts:
         files = _files(part)
