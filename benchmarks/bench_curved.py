@@ -24,7 +24,10 @@ axis from its apex), against the true base radius.
 ``axis_deg``: median angle between the found face's axis and the true one (cylinders: either direction; cones:
 from the apex towards the base).
 ``half_angle_deg``: median error of a found cone's half-angle (a diagnostic).
-``conf``: median of the found faces' fact confidences (lv3d.describe: cylindrical: curved_evidence;
+``radius_err_refined`` / ``axis_deg_refined``: the same two of a found cylinder after grounding's refinement
+(lv3d.describe.refine_cylinder: the cylinder its facts report); nan for cones and spheres, which have none.
+``conf``: median of the found faces' fact confidences (lv3d.describe: cylindrical: curved_evidence of the
+refined cylinder;
 spherical: sphere_evidence; conical: cone_evidence), and how many faces have none (None: too few points or a
 number that is not finite).
 ``box_curved``: share of box scenes (cube, cuboid) in which any perceived object has a curved face (target 0).
@@ -52,7 +55,7 @@ import numpy as np
 from tqdm import tqdm
 
 from lv3d import compile_cache
-from lv3d.describe import curved_evidence, describe
+from lv3d.describe import curved_evidence, describe, refine_cylinder, refined_cylinder
 from lv3d.perception import perceive
 from lv3d.perception.depth.quadrics import cone_evidence, sphere_evidence
 from lv3d.render import render_scene
@@ -83,11 +86,11 @@ def _params(face) -> np.ndarray:
         np.zeros(0)
 
 
-def _confidence(face) -> float | None:
+def _confidence(face, refined=None) -> float | None:
     if face.points is None:
         return None
     if face.surface == "cylinder":
-        return curved_evidence(face.points, face.cylinder)
+        return curved_evidence(face.points, refined or face.cylinder)
     if face.surface == "sphere":
         return sphere_evidence(face.points, face.sphere)
     if face.surface == "cone":
@@ -125,11 +128,18 @@ def evaluate(cls: str, seed: int, scene, frame, faces_mask: np.ndarray, min_face
         return out
     out["found"] = 1
     s = g["surface"]
-    out["conf"] = _confidence(best)
     if cls == "cylinder":
+        k = scene.intrinsics
+        fit = refine_cylinder(best, (k.fx, k.fy, k.cx, k.cy))
+        cyl = best.cylinder if fit is None else refined_cylinder(best, fit)
+        out["conf"] = _confidence(best, cyl)
         out["radius_err"] = abs(best.cylinder.radius - s["radius"]) / s["radius"]
         out["axis_deg"] = _angle(best.cylinder.axis, s["axis"], signed=False)
-    elif cls == "sphere":
+        out["radius_err_refined"] = abs(cyl.radius - s["radius"]) / s["radius"]
+        out["axis_deg_refined"] = _angle(cyl.axis, s["axis"], signed=False)
+        return out
+    out["conf"] = _confidence(best)
+    if cls == "sphere":
         out["radius_err"] = abs(best.sphere.radius - s["radius"]) / s["radius"]
     else:
         c = best.cone
@@ -168,6 +178,8 @@ def summarise(rows: list[dict], classes: list[str]) -> dict:
                         "radius_err": med([r["radius_err"] for r in found]),
                         "axis_deg": med([r["axis_deg"] for r in found if "axis_deg" in r]),
                         "half_angle_deg": med([r["half_angle_deg"] for r in found if "half_angle_deg" in r]),
+                        "radius_err_refined": med([r["radius_err_refined"] for r in found if "radius_err_refined" in r]),
+                        "axis_deg_refined": med([r["axis_deg_refined"] for r in found if "axis_deg_refined" in r]),
                         "conf": med([c for c in confs if c is not None]), "no_conf": sum(c is None for c in confs)}
         else:
             n = max(1, len(rs))
@@ -236,7 +248,8 @@ def main(argv=None) -> int:
             for key, fmt in (("recall", "{:.3f}"), ("radius_err", "{:.3f}"), ("axis_deg", "{:.2f}")):
                 per = " ".join(f"{fmt.format(s[c][key]):>9}" for c in CURVED)
                 print(f"{key:22} {fmt.format(a[key]):>7} {per}   {_target(preset, key, a[key])}")
-            for key, fmt in (("confused", "{:.3f}"), ("half_angle_deg", "{:.2f}"), ("conf", "{:.3f}"),
+            for key, fmt in (("radius_err_refined", "{:.3f}"), ("axis_deg_refined", "{:.2f}"),
+                             ("confused", "{:.3f}"), ("half_angle_deg", "{:.2f}"), ("conf", "{:.3f}"),
                              ("no_conf", "{:d}"), ("gt", "{:d}")):
                 per = " ".join(f"{fmt.format(s[c][key]):>9}" for c in CURVED)
                 print(f"{key:22} {'':>7} {per}   -")

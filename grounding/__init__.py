@@ -1,4 +1,4 @@
-"""grounding: refine perceived polygons and planes in JAX (optimistix least squares) and turn their
+"""grounding: refine perceived polygons, planes and cylinders in JAX (optimistix least squares) and turn their
 uncertainty into the confidences of facts. Pure functions over arrays; knows nothing of lv3d."""
 
 from ._cache import enable_cache as enable_cache
@@ -19,6 +19,9 @@ from ._confidence import PLANE_ANGLE_DEG as PLANE_ANGLE_DEG
 from ._confidence import RIGHT_ANGLE_DEG as RIGHT_ANGLE_DEG
 from ._confidence import SUPPORT_FULL as SUPPORT_FULL
 from ._confidence import interval as interval
+from ._cylinder import CYLINDER_POINTS as CYLINDER_POINTS
+from ._cylinder import CylinderFit as CylinderFit
+from ._cylinder import fit_cylinder as fit_cylinder
 from ._field import edge_distance_field as edge_distance_field
 from ._field import normal_edge_field as normal_edge_field
 from ._ground import Grounding as Grounding

@@ -16,6 +16,7 @@ import cv2
 import numpy as np
 
 from .calibration import shipped as shipped_calibration
+from .cylinder import Cylinder
 from .facts import PREDICATES, Fact, SceneFacts
 from .perception.polygons import area
 from .rgbd import RGBD
@@ -38,6 +39,8 @@ class FaceResult:
     vertex_std_px: np.ndarray    # (n,) largest standard deviation of each vertex, pixels
     # measurements the confidence calibration reads (calibration_features)
     features: dict = dc_field(default_factory=dict)
+    plane_tilt_std_rad: np.ndarray | None = None  # (2,) spread of the plane normal's two tilts, radians
+    cylinder: grounding.CylinderFit | None = None  # a cylindrical face's refined cylinder (refine_cylinder)
 
 
 @dataclass
@@ -254,8 +257,10 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
             for i, f in enumerate(chunk):
                 n = ns[i]
                 ids_i = index[i, :n]
+                fit = refine_cylinder(f, intr)
                 face_results.append(FaceResult(f, g["vertices"][ids_i], g["planes"][i] if has_plane[i] else None,
-                                               vstd_all[ids_i], feats[i]))
+                                               vstd_all[ids_i], feats[i],
+                                               g["plane_std"][i][:2] if has_plane[i] else None, fit))
                 support_term = support_l[i]
                 face_conf[f.id] = support_term
                 cands.append(("face_of", (obj.id, f.id), support_term, None))
@@ -267,10 +272,11 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                     cands.append(("parallelogram", (f.id,), c["p_parallelogram"][i], c["para_dev_deg"][i]))
                 if not has_plane[i] and scene.modality == "rgb":  # colour alone: image-plane shape
                     cands += image_shape(f.id, corner_l[i][:n], corner_sd[i][:n], side_l[i][:n], side_sd[i][:n])
-                if f.surface == "cylinder" and f.cylinder is not None and f.points is not None:
-                    p_curved = curved_evidence(f.points, f.cylinder)
+                if fit is not None:
+                    cyl = refined_cylinder(f, fit)
+                    p_curved = curved_evidence(f.points, cyl)
                     if p_curved is not None:
-                        curved.append(("cylindrical", (f.id,), p_curved, float(f.cylinder.radius)))
+                        curved.append(("cylindrical", (f.id,), p_curved, float(cyl.radius)))
                 curved += quadric_candidates(f) + ellipse_candidates(f)
                 if has_plane[i]:
                     if n == 4:
@@ -299,7 +305,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 p = min(face_conf[a], face_conf[b])  # the shared edge is as real as the weaker face
                 cands.append(("adjacent", (a, b), p, None))
                 cands.append(("adjacent", (b, a), p, None))
-        curved += cap_candidates(obj)
+        curved += cap_candidates(obj, face_results)
         cands.append(("object", (obj.id,), max(face_conf.values(), default=0.0), None))
         results.append(ObjectResult(obj, face_results, dihedrals, status, raw))
     if calibrate:
@@ -332,30 +338,64 @@ def curved_evidence(points: np.ndarray, cylinder) -> float | None:
     return cylinder_share(pts, cylinder)
 
 
+def refine_cylinder(face: Face, intrinsics: tuple[float, float, float, float]):
+    """Grounding's least-squares refinement of a cylindrical face's cylinder against its depth points
+    (grounding.fit_cylinder: robust, depth-noise-weighted, with its Laplace uncertainty), started from
+    perception's; None for a face that is not cylindrical or has fewer than 10 points."""
+    import grounding
+
+    if face.surface != "cylinder" or face.cylinder is None or face.points is None or len(face.points) < 10:
+        return None
+    c = face.cylinder
+    return grounding.fit_cylinder(face.points, np.asarray(c.axis, float), np.asarray(c.point, float),
+                                  float(c.radius), intrinsics=intrinsics)
+
+
+def refined_cylinder(face: Face, fit) -> Cylinder:
+    """The cylinder of a refinement (:func:`refine_cylinder`) that converged to a finite surface; else
+    perception's, which the refinement started from."""
+    ok = int(fit.status) == 0 and float(fit.radius) > 0 and np.all(np.isfinite(fit.axis)) and \
+        np.all(np.isfinite(fit.point)) and np.isfinite(float(fit.radius))
+    if not ok:
+        return face.cylinder
+    return Cylinder(tuple(float(x) for x in fit.axis), tuple(float(x) for x in fit.point), float(fit.radius))
+
+
 # A planar face meeting a cylindrical face is its cap, bounded by a circle, when its normal lies along the
-# cylinder's axis: within CAP_TOL_DEG (degrees; the tolerance of the plane predicates, parallel within 8-10
-# deg), the measured angle read with a Gaussian error of CAP_SIGMA_DEG (a plane fitted to hundreds of depth
-# points is good to 1-2 deg, a cylinder's axis to 2-3 deg: about 4 deg together).
+# cylinder's axis: within CAP_TOL_DEG (degrees; the tolerance of the plane predicates, parallel within 8-10 deg).
 CAP_TOL_DEG = 10.0
-CAP_SIGMA_DEG = 4.0
 
 
-def cap_candidates(obj: SceneObject) -> list[tuple[str, tuple[str, ...], float, float | None]]:
+def cap_candidates(obj: SceneObject, faces: list[FaceResult]) -> list[tuple[str, tuple[str, ...], float, float | None]]:
     """``circular`` for each planar face of ``obj`` that meets one of its cylindrical faces with its normal along
-    the cylinder's axis: the probability that the angle between them is within CAP_TOL_DEG, value the angle
-    in degrees. A can's lid is read as a polygon of a few sides; this says its outline is a circle."""
+    the cylinder's axis: the probability that the angle between them is within CAP_TOL_DEG, value the angle in
+    degrees. A can's lid is read as a polygon of a few sides; this says its outline is a circle.
+
+    The angle is read from grounding's refined plane and refined cylinder (``faces``, :class:`FaceResult`), with
+    a Gaussian error whose variance is the sum of the normal's and the axis's (each the mean of its two tilts'
+    variances: grounding's Laplace spreads) and the model-error floor of grounding's angles between planes
+    (grounding.Floors.dihedral_deg), as plane-to-plane facts have theirs."""
+    import grounding
+
+    floor = grounding.Floors().dihedral_deg
+    by_id = {fr.face.id: fr for fr in faces}
     out = []
-    faces = {f.id: f for f in obj.faces}
     for a, b in obj.adjacency:
-        for cap, side in ((faces.get(a), faces.get(b)), (faces.get(b), faces.get(a))):
+        for cap_id, side_id in ((a, b), (b, a)):
+            cap, side = by_id.get(cap_id), by_id.get(side_id)
             if cap is None or side is None or cap.plane is None or side.cylinder is None:
                 continue
-            cos = abs(float(np.dot(np.asarray(cap.plane.n, float), np.asarray(side.cylinder.axis, float))))
+            axis = refined_cylinder(side.face, side.cylinder).axis
+            n = np.asarray(cap.plane[:3], float)
+            cos = abs(float(np.dot(n / np.linalg.norm(n), np.asarray(axis, float))))
             theta = math.degrees(math.acos(min(1.0, cos)))
-            z = math.sqrt(2.0) * CAP_SIGMA_DEG
+            var = float(np.mean(np.square(np.degrees(side.cylinder.axis_std))))
+            if cap.plane_tilt_std_rad is not None:
+                var += float(np.mean(np.square(np.degrees(cap.plane_tilt_std_rad))))
+            z = math.sqrt(2.0 * (var + floor * floor))
             p = 0.5 * (math.erf((CAP_TOL_DEG - theta) / z) - math.erf((-CAP_TOL_DEG - theta) / z))
             if p > 0:
-                out.append(("circular", (cap.id,), p, round(theta, 2)))
+                out.append(("circular", (cap.face.id,), p, round(theta, 2)))
     best: dict = {}
     for c in out:  # a cap meeting two cylindrical faces: its better reading
         if c[1] not in best or c[2] > best[c[1]][2]:

@@ -213,6 +213,22 @@ def test_curved_evidence_tells_a_can_side_from_a_flat_face():
     assert curved_evidence(side[:5], cyl) is None
 
 
+def _cylinder_fit(axis, std_deg):
+    import grounding
+
+    return grounding.CylinderFit(np.asarray(axis, float), np.zeros(3), np.float32(0.04),
+                                 np.radians([std_deg, std_deg]), np.float32(1e-4), np.float32(1e-3),
+                                 np.int32(0), np.float32(1.0))
+
+
+def _face_result(face, plane=None, tilt_std_deg=None, fit=None):
+    from lv3d.describe import FaceResult
+
+    tilt = None if tilt_std_deg is None else np.radians([tilt_std_deg, tilt_std_deg])
+    return FaceResult(face, face.polygon, None if plane is None else np.asarray(plane, float), np.zeros(len(face.polygon)),
+                      {}, tilt, fit)
+
+
 def test_a_lid_along_a_cylinder_axis_is_circular_and_a_side_face_is_not():
     from lv3d.cylinder import Cylinder
     from lv3d.describe import cap_candidates
@@ -224,6 +240,27 @@ def test_a_lid_along_a_cylinder_axis_is_circular_and_a_side_face_is_not():
     lid = Face("o_f2", square, "depth", plane=Plane((0.0, -0.9986, -0.0523), 0.1))   # 3 deg off the axis
     wall = Face("o_f3", square, "depth", plane=Plane((1.0, 0.0, 0.0), 0.1))          # 90 deg off it
     obj = SceneObject("o", [side, lid, wall], [("o_f1", "o_f2"), ("o_f1", "o_f3")])
-    got = {c[1][0]: c for c in cap_candidates(obj)}
+    faces = [_face_result(side, fit=_cylinder_fit((0.0, -1.0, 0.0), 0.5)),
+             _face_result(lid, (0.0, -0.9986, -0.0523, 0.1), 0.5), _face_result(wall, (1.0, 0.0, 0.0, 0.1), 0.5)]
+    got = {c[1][0]: c for c in cap_candidates(obj, faces)}
     assert set(got) == {"o_f2"} and got["o_f2"][0] == "circular"
     assert got["o_f2"][2] > 0.9 and abs(got["o_f2"][3] - 3.0) < 0.1
+
+
+def test_a_cap_reading_is_as_sure_as_its_measured_spreads():
+    # 8 deg off the axis, inside the 10 deg tolerance: sure with tight spreads, doubtful with loose ones
+    from lv3d.cylinder import Cylinder
+    from lv3d.describe import cap_candidates
+    from lv3d.scene import Face, SceneObject
+
+    square = np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)
+    side = Face("o_f1", square, "depth", surface="cylinder", cylinder=Cylinder((0.0, -1.0, 0.0), (0.0, 0.0, 1.0), 0.04))
+    lid = Face("o_f2", square, "depth")
+    obj = SceneObject("o", [side, lid], [("o_f1", "o_f2")])
+    n = (0.0, -np.cos(np.radians(8.0)), -np.sin(np.radians(8.0)), 0.1)
+    p = {}
+    for std in (0.2, 4.0):
+        faces = [_face_result(side, fit=_cylinder_fit((0.0, -1.0, 0.0), std)), _face_result(lid, n, std)]
+        (c,) = cap_candidates(obj, faces)
+        p[std] = c[2]
+    assert p[0.2] > 0.9 and p[4.0] < 0.75
