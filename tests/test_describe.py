@@ -264,3 +264,18 @@ def test_a_cap_reading_is_as_sure_as_its_measured_spreads():
         (c,) = cap_candidates(obj, faces)
         p[std] = c[2]
     assert p[0.2] > 0.9 and p[4.0] < 0.75
+
+
+def test_a_refinement_without_spreads_gives_no_cap_reading():
+    # a cylinder refinement whose spreads are not finite (a degenerate face) says nothing about its cap
+    from lv3d.cylinder import Cylinder
+    from lv3d.describe import cap_candidates
+    from lv3d.scene import Face, SceneObject
+
+    square = np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)
+    side = Face("o_f1", square, "depth", surface="cylinder", cylinder=Cylinder((0.0, -1.0, 0.0), (0.0, 0.0, 1.0), 0.04))
+    lid = Face("o_f2", square, "depth")
+    obj = SceneObject("o", [side, lid], [("o_f1", "o_f2")])
+    faces = [_face_result(side, fit=_cylinder_fit((0.0, -1.0, 0.0), np.nan)),
+             _face_result(lid, (0.0, -1.0, 0.0, 0.1), 0.5)]
+    assert cap_candidates(obj, faces) == []

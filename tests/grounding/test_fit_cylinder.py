@@ -64,3 +64,15 @@ def test_stray_readings_do_not_pull_the_fit():
 def test_too_few_points_is_refused():
     with pytest.raises(ValueError, match="at least 6 points"):
         grounding.fit_cylinder(np.zeros((3, 3)), np.array([0.0, 1.0, 0.0]), np.zeros(3), 0.03, intrinsics=INTR)
+
+
+def test_points_no_cylinder_can_fit_keep_the_first_guess():
+    # a straight line of readings and readings that are not numbers: status 1 and the first guess, no exception
+    line = np.zeros((50, 3))
+    line[:, 0] = np.linspace(0.0, 0.1, 50)
+    line[:, 2] = 1.0
+    for pts in (line, np.full((20, 3), np.nan)):
+        fit = grounding.fit_cylinder(pts, np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.05]), 0.05,
+                                     intrinsics=INTR)
+        assert int(fit.status) == 1
+        assert float(fit.radius) == pytest.approx(0.05) and np.allclose(fit.axis, [0.0, 1.0, 0.0])
