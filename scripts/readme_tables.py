@@ -15,8 +15,8 @@ per fold the mean binary accuracy over the class tasks, then the mean over folds
   a row per (data seed, condition), seed 0 being the study itself and seed s the report
   ``experiments/results/seed_protocol_seed<s>/``, and a column per lv3d system (``mean / multi``).
 - The top-level README's seed-protocol table (header ``| system | clean | realsense noise |``) has a row per lv3d
-  system and the best CNN and the best decision tree of each condition (highest mean binary accuracy), each cell
-  ``mean / multi``, the best baseline's modality in parentheses.
+  system and the best CNN, the best pretrained network and the best decision tree of each condition (highest mean
+  binary accuracy), each cell ``mean / multi``, the best baseline's modality in parentheses.
 """
 
 from __future__ import annotations
@@ -36,7 +36,8 @@ ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "experiments" / "README.md"
 TOP_README = ROOT / "README.md"
 TOP_HEADER = "| system | clean | realsense noise |"
-BEST = {"best CNN": "cnn-", "best decision tree": "tree-"}  # row label prefix -> the systems it picks among
+# row label prefix -> the systems it picks among
+BEST = {"best CNN": "cnn-", "best pretrained network": "effnet-", "best decision tree": "tree-"}
 # section heading -> (study, its table's first header cell)
 SECTIONS = {
     "### Seed protocol": ("seed_protocol", "system"),
