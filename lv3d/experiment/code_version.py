@@ -34,7 +34,8 @@ def _files(part: str) -> list[Path]:
 @lru_cache(maxsize=None)
 def source_digest(parts: tuple[str, ...]) -> str:
     """A 12-hex digest of the contents of every .py/.pl file under ``parts`` (paths relative to
-    the checkout; a part that is a file counts whatever its kind). Raises FileNotFoundError when a part is missing, rather than hashing nothing."""
+    the checkout; a part that is a file counts whatever its kind). Raises FileNotFoundError when a part
+    is missing, rather than hashing nothing."""
     h = hashlib.sha256()
     for part in parts:
         files = _files(part)
