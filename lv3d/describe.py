@@ -40,7 +40,7 @@ class FaceResult:
     # measurements the confidence calibration reads (calibration_features)
     features: dict = dc_field(default_factory=dict)
     plane_tilt_std_rad: np.ndarray | None = None  # (2,) spread of the plane normal's two tilts, radians
-    cylinder_fit: grounding.CylinderFit | None = None  # a cylindrical face's refinement (refine_cylinder)
+    cylinder: grounding.CylinderFit | None = None  # a cylindrical face's refined cylinder (refine_cylinder)
 
 
 @dataclass
@@ -383,13 +383,13 @@ def cap_candidates(obj: SceneObject, faces: list[FaceResult]) -> list[tuple[str,
     for a, b in obj.adjacency:
         for cap_id, side_id in ((a, b), (b, a)):
             cap, side = by_id.get(cap_id), by_id.get(side_id)
-            if cap is None or side is None or cap.plane is None or side.cylinder_fit is None:
+            if cap is None or side is None or cap.plane is None or side.cylinder is None:
                 continue
-            axis = refined_cylinder(side.face, side.cylinder_fit).axis
+            axis = refined_cylinder(side.face, side.cylinder).axis
             n = np.asarray(cap.plane[:3], float)
             cos = abs(float(np.dot(n / np.linalg.norm(n), np.asarray(axis, float))))
             theta = math.degrees(math.acos(min(1.0, cos)))
-            var = float(np.mean(np.square(np.degrees(side.cylinder_fit.axis_std))))
+            var = float(np.mean(np.square(np.degrees(side.cylinder.axis_std))))
             if cap.plane_tilt_std_rad is not None:
                 var += float(np.mean(np.square(np.degrees(cap.plane_tilt_std_rad))))
             z = math.sqrt(2.0 * (var + floor * floor))
