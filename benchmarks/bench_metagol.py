@@ -92,12 +92,13 @@ def run_metagol(driver: Path, example: Path, goal: str, limit: float) -> dict[st
     return runs
 
 
-def coverage(example: Path, goal: str, clauses: list[str], limit: float) -> str | None:
-    """'<pos bits>/<neg bits>' of the clauses on the goal's examples (lv3d's interpreter), or None."""
+def coverage(example: Path, goal: str, clauses: list[str], limit: float) -> tuple[str | None, str]:
+    """('<pos bits>/<neg bits>' of the clauses on the goal's examples (lv3d's interpreter), or None with why the
+    check gave none: its exit status and the last line it wrote to stderr)."""
     import prolog as sources
 
     if not clauses:
-        return None
+        return None, "no clauses"
     with tempfile.NamedTemporaryFile("w", suffix=".pl", delete=False) as f:
         f.write("\n".join(clauses) + "\n")
         path = f.name
@@ -106,14 +107,17 @@ def coverage(example: Path, goal: str, clauses: list[str], limit: float) -> str 
                             f"[time_limit({limit})]", f"check:{path}", goal],
                            capture_output=True, text=True, timeout=3 * limit + 30)
     except subprocess.TimeoutExpired:
-        return None
+        return None, f"no answer within {3 * limit + 30:g} s"
     finally:
         Path(path).unlink(missing_ok=True)
     for line in r.stdout.splitlines():
         rec = line.split("\t")
         if rec[0] == "coverage":
-            return f"{rec[1]}/{rec[2]}"
-    return None
+            return f"{rec[1]}/{rec[2]}", ""
+        if rec[0] == "failed":
+            return None, " ".join(rec[1:])
+    err = r.stderr.strip().splitlines()
+    return None, f"exit {r.returncode}" + (f": {err[-1]}" if err else "")
 
 
 def result_text(status: str | None, clauses) -> str:
@@ -169,11 +173,14 @@ def main(argv=None) -> int:
                 m_solved = m_status in ("done", "failed") and mg.get("cpu") is not None and mg["cpu"] <= a.limit
                 same_text = (ours_clauses == m_clauses) if have_metagol and g.error is None else None
                 goal_arg = "" if is_dir else g.name
-                cov_o = coverage(ex, goal_arg, ours_clauses, a.limit) if ours_clauses else None
-                cov_m = coverage(ex, goal_arg, m_clauses, a.limit) if m_clauses else None
+                cov_o, why_o = coverage(ex, goal_arg, ours_clauses, a.limit) if ours_clauses else (None, "no program")
+                cov_m, why_m = coverage(ex, goal_arg, m_clauses, a.limit) if m_clauses else (None, "no program")
                 same_cov = None
                 if have_metagol and g.error is None:
                     same_cov = cov_o == cov_m
+                    if not same_cov:  # say what each check gave, so that a difference can be traced
+                        print(f"{ex.name} {g.name}: coverage of lv3d's program {cov_o or why_o}, of Metagol's "
+                              f"{cov_m or why_m}", flush=True)
                 target = "-"
                 if have_metagol and m_solved:
                     ok = bool(same_cov) and g.error is None and g.cpu_s <= 2 * mg["cpu"] + 0.5
