@@ -1,45 +1,76 @@
 #!/usr/bin/env bash
-# Rerun every study in experiments/ after a change to lv3d's code, retraining only the lv3d systems, and the seed
-# protocol's four replicates (its lv3d systems on data seeds 1-4; scripts/pooled_replicates.py pools them):
-# each study's baseline fold files are restored from its committed results.csv first
-# (scripts/restore_baselines.py), then `lv3d experiment run` computes the lv3d folds and rewrites the report.
-# Two studies run at a time (one per core). The seed protocol, learning curve, ablations and few-shot study
-# share one data cache (the same images), which the seed protocol fills before the others start.
+# Rerun every study in experiments/ after a change to lv3d's code, retraining only the lv3d systems, with the
+# systems and conditions of the committed reports in experiments/results/, and the seed protocol's four
+# replicates (its lv3d systems on data seeds 1-4; scripts/pooled_replicates.py pools them). Each study's
+# baseline fold files are restored from its committed results.csv first (scripts/restore_baselines.py), then
+# `lv3d experiment run` computes the lv3d folds and rewrites the report.
 #
 #   bash scripts/rerun_studies.sh [RUNS_DIR]     # default: runs/rerun
 #
+# What the committed reports hold, and so what is passed here: the seed protocol and its replicates at the
+# clean and realsense presets; the few-shot study with the lv3d systems, cnn-rgbd, the pretrained networks and
+# the tree; the real-objects study with the tuned CNN at one positive only (its two parts are joined by
+# `lv3d experiment report`). Three lanes run at once on two cores; the studies of the seed protocol's images
+# share one data cache, which the seed protocol fills before the ablations start. About 50 min on two cores.
+#
 # Then copy each run's results.{csv,md} and plots into experiments/results/<study>/ (the script prints the
 # commands), rewrite the tables of experiments/README.md (scripts/readme_tables.py --write) and its text.
-# Resumable: rerunning skips finished folds.
+# Resumable: rerunning skips finished folds. Progress: RUNS_DIR/progress, one line per finished study.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 RUNS=${1:-runs/rerun}
 PY=.venv/bin/python
 LV3D=.venv/bin/lv3d
 mkdir -p "$RUNS"
+CACHE="data.cache=$RUNS/cache"           # the seed protocol's images (and the ten-class ones)
+NOISE_CACHE="data.cache=$RUNS/noise_cache"
+REAL_CACHE="data.cache=$RUNS/real_cache"
+TWO_PRESETS="sweep={param: data.noise, values: [clean, realsense]}"
+LV3D_ONLY="systems=[lv3d-rgb,lv3d-depth,lv3d-rgbd]"
+
+log() { echo "$(date +%T) $*" | tee -a "$RUNS/progress"; }
 
 study() {  # study NAME [--set ...]: restore the baselines, run, log to RUNS/NAME.log
     local name=$1; shift
     $PY scripts/restore_baselines.py "experiments/$name.yaml" "experiments/results/$name/results.csv" \
         --out "$RUNS/$name" "$@" > "$RUNS/$name.log" 2>&1
     OMP_NUM_THREADS=1 $LV3D experiment run "experiments/$name.yaml" --out "$RUNS/$name" "$@" >> "$RUNS/$name.log" 2>&1
-    echo "$(date +%T) $name: $(grep -a 'fold results computed' "$RUNS/$name.log" | tail -1)"
+    log "$name: $(grep -a 'fold results computed' "$RUNS/$name.log" | tail -1)"
 }
-
-CACHE=(--set "data.cache=$RUNS/cache")
-study seed_protocol "${CACHE[@]}"
-study learning_curve "${CACHE[@]}" & study ablations "${CACHE[@]}"; wait
-study few_shot "${CACHE[@]}" & study noise_depth; wait
-study noise_color & study noise_occlusion; wait
-study noise_clutter & study noise_lighting; wait
 
 replicate() {  # replicate SEED: the seed protocol's lv3d systems on images of another data seed (no baselines)
     OMP_NUM_THREADS=1 $LV3D experiment run experiments/seed_protocol.yaml --out "$RUNS/seed_protocol_seed$1" \
-        --set seed="$1" --set "systems=[lv3d-rgb,lv3d-depth,lv3d-rgbd]" > "$RUNS/seed_protocol_seed$1.log" 2>&1
-    echo "$(date +%T) seed_protocol_seed$1: $(grep -a 'fold results computed' "$RUNS/seed_protocol_seed$1.log" | tail -1)"
+        --set seed="$1" --set "$CACHE" --set "$LV3D_ONLY" --set "$TWO_PRESETS" > "$RUNS/seed_protocol_seed$1.log" 2>&1
+    log "seed_protocol_seed$1: $(grep -a 'fold results computed' "$RUNS/seed_protocol_seed$1.log" | tail -1)"
 }
-replicate 1 & replicate 2; wait
-replicate 3 & replicate 4; wait
+
+real_objects() {  # the lv3d systems, the pretrained networks and the tree at every size, the tuned CNN at one
+    local out=$RUNS/real_objects all="systems=[lv3d-rgb,lv3d-depth,lv3d-rgbd,effnet-rgb,effnet-depth,effnet-rgbd,tree-rgbd]"
+    local csv=experiments/results/real_objects/results.csv
+    {
+        $PY scripts/restore_baselines.py experiments/real_objects.yaml $csv --out "$out" --set "$REAL_CACHE" --set "$all"
+        $PY scripts/restore_baselines.py experiments/real_objects.yaml $csv --out "$out" --set "$REAL_CACHE" \
+            --set "systems=[cnn-rgbd]" --set "sweep={param: train.positives, values: [1]}"
+        OMP_NUM_THREADS=1 $LV3D experiment run experiments/real_objects.yaml --out "$out" --set "$REAL_CACHE" \
+            --set "$LV3D_ONLY"
+        $LV3D experiment report experiments/real_objects.yaml --out "$out" --set "$REAL_CACHE"
+    } > "$RUNS/real_objects.log" 2>&1
+    log "real_objects: report joined"
+}
+
+FEW_SHOT="systems=[lv3d-rgb,lv3d-depth,lv3d-rgbd,cnn-rgbd,effnet-rgb,effnet-depth,effnet-rgbd,tree-rgbd]"
+rm -f "$RUNS/.seed_protocol_done"
+pids=()
+( study seed_protocol --set "$CACHE" --set "$TWO_PRESETS"; touch "$RUNS/.seed_protocol_done"
+  study learning_curve --set "$CACHE"; study few_shot --set "$CACHE" --set "$FEW_SHOT"; replicate 1; replicate 2 ) & pids+=($!)
+( for n in noise_depth noise_color noise_occlusion noise_clutter noise_lighting; do study $n --set "$NOISE_CACHE"; done
+  real_objects ) & pids+=($!)
+( study ten_classes --set "$CACHE"
+  until [ -e "$RUNS/.seed_protocol_done" ]; do sleep 10; done
+  study ablations --set "$CACHE"; replicate 3; replicate 4 ) & pids+=($!)
+failed=0
+for p in "${pids[@]}"; do wait "$p" || failed=1; done
+[ "$failed" = 0 ] || { echo "a lane stopped: see $RUNS/progress and the last log it names" >&2; exit 1; }
 
 for d in "$RUNS"/*/results.csv; do
     name=$(basename "$(dirname "$d")")

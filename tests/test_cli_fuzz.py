@@ -142,6 +142,11 @@ CASES = [
     # experiment run
     *[f"experiment run {{box}}/bad{i}.yaml --out {{out}}" for i in range(len(BAD_CONFIGS))],
     "experiment run {box}/nope.yaml --out {out}",
+    # experiment report
+    "experiment report {box}/nope.yaml --out {out}",
+    "experiment report {box}/syntax.yaml --out {out}",
+    "experiment report {box}/study.yaml --out {out}",
+    "experiment report {box}/study.yaml --out {box} --set nonsense",
     "experiment run {box}/syntax.yaml --out {out}",
     "experiment run {box}/list.yaml --out {out}",
     "experiment run {box}/study.yaml --out {out} --set nonsense",

@@ -1,4 +1,5 @@
-"""``lv3d experiment run CONFIG --out DIR [--set key=value ...]``: run or resume one study."""
+"""``lv3d experiment run CONFIG --out DIR [--set key=value ...]``: run or resume one study;
+``lv3d experiment report CONFIG --out DIR [--set ...]``: rewrite its report from the fold files there."""
 
 from __future__ import annotations
 
@@ -47,4 +48,18 @@ def run(config: Path, out: Path, overrides: tuple[str, ...], quiet: bool, execut
     if res["learn_failures"]:
         click.echo(f"lv3d: warning: in {res['learn_failures']} learn calls the learner found no program for a class; "
                    f"{out / 'results.md'} says which and why", err=True)
+    click.echo((out / "results.md").read_text())
+
+
+@experiment.command()
+@click.argument("config", type=click.Path(path_type=Path))
+@click.option("--out", "out", required=True, type=click.Path(path_type=Path), help="work directory of the study")
+@click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE", help="override a config key, as for run")
+def report(config: Path, out: Path, overrides: tuple[str, ...]):
+    """Rewrite OUT's report (results.md, results.csv, results.json, plots) from the fold files OUT holds, for
+    CONFIG with the overrides given; computes nothing. For a study whose systems ran in parts, e.g. a costly
+    baseline at one size only: run each part, then report the whole."""
+    from ..experiment.runner import report_study
+
+    report_study(config, out, list(overrides))
     click.echo((out / "results.md").read_text())

@@ -27,6 +27,7 @@ import numpy as np
 import yaml
 from tqdm import tqdm
 
+from ..errors import InputError
 from ..output import claim, clean_stale, locked, write_atomic
 from . import data as data_mod
 from .code_version import learner_version
@@ -289,6 +290,20 @@ def run_study(config: Path, out: Path, overrides: list[str] = (), progress: bool
     claim(out, (config,), own=_is_study)  # a new, empty or lv3d-written folder; filled in place, so it resumes
     with locked(out):
         return _run(study, out, progress, executor or LocalExecutor(1))
+
+
+def report_study(config: Path, out: Path, overrides: list[str] = ()) -> dict:
+    """Rewrite the report of the study folder ``out`` (made by :func:`run_study`) from the fold files it holds,
+    for ``config`` with ``overrides``: for a study whose systems were run in parts (a costly baseline at fewer
+    sizes, the lv3d systems rerun after a code change). Computes nothing; a (condition, system) without fold
+    files is reported as such. Returns the report's summary."""
+    study = load_study(Path(config), list(overrides))
+    out = Path(out)
+    if not _is_study(out):
+        raise InputError(out, "not the work folder of a study (lv3d experiment run writes config.yaml and folds/)")
+    with locked(out):
+        write_atomic(out / "config.yaml", yaml.safe_dump(study.merged, sort_keys=False))
+        return write_report(out, study.base, study.conditions)
 
 
 def _run(study: Study, out: Path, progress: bool, executor) -> dict:
