@@ -302,13 +302,18 @@ def report_study(config: Path, out: Path, overrides: list[str] = ()) -> dict:
     if not _is_study(out):
         raise InputError(out, "not the work folder of a study (lv3d experiment run writes config.yaml and folds/)")
     with locked(out):
-        write_atomic(out / "config.yaml", yaml.safe_dump(study.merged, sort_keys=False))
+        _write_config(out, study)
         return write_report(out, study.base, study.conditions)
+
+
+def _write_config(out: Path, study: Study) -> None:
+    """The study's merged config as the report describes it: ``out/config.yaml``."""
+    write_atomic(out / "config.yaml", yaml.safe_dump(study.merged, sort_keys=False))
 
 
 def _run(study: Study, out: Path, progress: bool, executor) -> dict:
     conds = study.conditions
-    write_atomic(out / "config.yaml", yaml.safe_dump(study.merged, sort_keys=False))
+    _write_config(out, study)
     for p in (out / "folds").glob("*/*") if (out / "folds").is_dir() else ():
         clean_stale(p)  # fold files a killed run was writing
     jobs = [(c, s, k) for c in conds for s in conds[c].systems for k in range(conds[c].folds)]
