@@ -411,8 +411,10 @@ def quadric_candidates(face: Face) -> list[tuple[str, tuple[str, ...], float, fl
     ``conical``: the share of a least-squares cylinder's residual variance that the cone explains
     (quadrics.cone_evidence; a cone of half-angle near 0 is a cylinder, and a cylinder fits a cone's points at
     least as well as a plane, so the cylinder is the alternative a cone must beat), value its half-angle in
-    degrees."""
-    from .perception.depth.quadrics import cone_evidence, sphere_evidence
+    degrees; and, the two surfaces being nested, ``cylindrical`` of the same face: (1 - conical) times the share
+    of a plane's residual variance the least-squares cylinder explains (quadrics.cone_readings), value the
+    cylinder's radius in metres."""
+    from .perception.depth.quadrics import cone_readings, sphere_evidence
 
     if face.points is None:
         return []
@@ -420,8 +422,14 @@ def quadric_candidates(face: Face) -> list[tuple[str, tuple[str, ...], float, fl
         p = sphere_evidence(face.points, face.sphere)
         return [] if p is None else [("spherical", (face.id,), p, float(face.sphere.radius))]
     if face.surface == "cone" and face.cone is not None:
-        p = cone_evidence(face.points, face.cone)
-        return [] if p is None else [("conical", (face.id,), p, float(face.cone.half_angle_deg))]
+        read = cone_readings(face.points, face.cone)
+        if read is None:
+            return []
+        conical, cylindrical = read
+        out = [("conical", (face.id,), conical, float(face.cone.half_angle_deg))]
+        if cylindrical is not None:
+            out.append(("cylindrical", (face.id,), cylindrical[0], float(cylindrical[1])))
+        return out
     return []
 
 

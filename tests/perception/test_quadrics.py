@@ -8,8 +8,8 @@ import pytest
 from lv3d.cone import Cone
 from lv3d.describe import quadric_candidates
 from lv3d.perception import perceive
-from lv3d.perception.depth.quadrics import (QuadricSettings, cone_evidence, cone_from_normals, object_quadrics,
-                                            refine_cone, refine_sphere, sample_sphere, sphere_evidence)
+from lv3d.perception.depth.quadrics import (QuadricSettings, cone_evidence, cone_from_normals, cone_readings,
+                                            object_quadrics, refine_cone, refine_sphere, sample_sphere, sphere_evidence)
 from lv3d.plane import Plane
 from lv3d.render import render_scene
 from lv3d.scene import Face
@@ -160,6 +160,23 @@ def test_evidence_is_the_share_of_the_simpler_surface_residual_explained():
     assert sphere_evidence(p[:5], Sphere(tuple(CENTRE), 0.05)) is None
 
 
+def test_a_face_read_as_a_cone_is_also_read_as_the_cylinder_it_is_nested_in():
+    rng = np.random.default_rng(9)
+    # a cylinder's side taken for a narrow cone: little conical, mostly cylindrical, with the cylinder's radius
+    ypts, _ = _cylinder_side(rng)
+    narrow = Cone((CENTRE[0], CENTRE[1] - 2.0, CENTRE[2]), (0.0, 1.0, 0.0), float(np.degrees(np.arctan(0.04 / 2.0))),
+                  2.05)
+    conical, (cylindrical, radius) = cone_readings(ypts.reshape(-1, 3), narrow)
+    assert conical < 0.2 and cylindrical > 0.7
+    assert conical == pytest.approx(cone_evidence(ypts.reshape(-1, 3), narrow))
+    assert radius == pytest.approx(0.04, rel=0.05)
+    # a true cone's side: conical, and the cylinder reading is what the cone leaves over
+    (cpts, _), apex, axis = _cone_side(rng)
+    conical, (cylindrical, _) = cone_readings(cpts.reshape(-1, 3), Cone(tuple(apex), tuple(axis), 30.0, 0.09))
+    assert conical > 0.8 and cylindrical < 1.0 - conical + 1e-9
+    assert cone_readings(cpts.reshape(-1, 3)[:5], Cone(tuple(apex), tuple(axis), 30.0, 0.09)) is None
+
+
 def test_facts_of_spherical_and_conical_faces_come_from_the_measurement():
     rng = np.random.default_rng(8)
     pts, _ = _sphere_cap(rng)
@@ -171,8 +188,10 @@ def test_facts_of_spherical_and_conical_faces_come_from_the_measurement():
     (cpts, _), apex, axis = _cone_side(rng)
     cface = Face("s0_o1_f2", poly, "depth", points=cpts.reshape(-1, 3), surface="cone",
                  cone=Cone(tuple(apex), tuple(axis), 30.0, 0.09))
-    [(pred, _, conf, value)] = quadric_candidates(cface)
+    [(pred, _, conf, value), (pred2, args2, conf2, value2)] = quadric_candidates(cface)
     assert pred == "conical" and 0.5 < conf <= 1.0 and value == pytest.approx(30.0)
+    # the cylinder it is nested in, with what the cone leaves of its probability
+    assert pred2 == "cylindrical" and args2 == ("s0_o1_f2",) and 0.0 <= conf2 <= 1.0 - conf + 1e-9 and value2 > 0
     d = cface.to_dict()
     assert d["surface"] == "cone" and d["cone"]["half_angle_deg"] == 30.0 and d["sphere"] is None
     assert quadric_candidates(Face("s0_o1_f3", poly, "depth", points=cpts.reshape(-1, 3))) == []

@@ -191,9 +191,10 @@ def sphere_evidence(points: np.ndarray, sphere: Sphere) -> float | None:
     return _share(float(np.mean(sphere.residual(pts) ** 2)), plane_ms(pts))
 
 
-def cylinder_ms(pts: np.ndarray, axis0: np.ndarray) -> float:
-    """Mean square distance of points (m, 3) from their least-squares cylinder, its axis started at ``axis0``
-    (its circle Kasa's fit seen along it), nan where the fit fails."""
+def least_squares_cylinder(pts: np.ndarray, axis0: np.ndarray) -> tuple[float, float]:
+    """Mean square distance of points (m, 3) from their least-squares cylinder (geometric distances,
+    Levenberg-Marquardt), its axis started at ``axis0`` and its circle at Kasa's fit seen along it; and that
+    cylinder's radius (metres). (nan, nan) where the fit fails."""
     from scipy.optimize import least_squares
 
     a0, b1, b2 = _basis(axis0)
@@ -226,10 +227,16 @@ def cylinder_ms(pts: np.ndarray, axis0: np.ndarray) -> float:
     try:
         fit = least_squares(res, np.array([0.0, 0.0, 0.0, 0.0, r0]), jac=jac, method="lm", max_nfev=MAX_EVALS)
     except (ValueError, np.linalg.LinAlgError):
-        return float("nan")
-    if fit.status <= 0 or not np.all(np.isfinite(fit.fun)):
-        return float("nan")
-    return float(np.mean(fit.fun ** 2))
+        return float("nan"), float("nan")
+    if fit.status <= 0 or not np.all(np.isfinite(fit.fun)) or not np.isfinite(fit.x[4]):
+        return float("nan"), float("nan")
+    return float(np.mean(fit.fun ** 2)), abs(float(fit.x[4]))
+
+
+def cylinder_ms(pts: np.ndarray, axis0: np.ndarray) -> float:
+    """Mean square distance of points (m, 3) from their least-squares cylinder (:func:`least_squares_cylinder`),
+    nan where the fit fails."""
+    return least_squares_cylinder(pts, axis0)[0]
 
 
 def cone_evidence(points: np.ndarray, cone: Cone) -> float | None:
@@ -242,6 +249,26 @@ def cone_evidence(points: np.ndarray, cone: Cone) -> float | None:
     if len(pts) < 10:
         return None
     return _share(float(np.mean(cone.residual(pts) ** 2)), cylinder_ms(pts, np.asarray(cone.axis, float)))
+
+
+def cone_readings(points: np.ndarray, cone: Cone) -> tuple[float, tuple[float, float] | None] | None:
+    """How likely a face fitted as ``cone`` is a cone and how likely it is a cylinder's side, from its points
+    (m, 3): (conical, (cylindrical, the cylinder's radius in metres) or None). The two surfaces are nested (a cone
+    whose half-angle closes is a cylinder), so a face read as a cone is a cylinder's side with the probability
+    the cone does not beat the cylinder and the cylinder beats a plane: conical = :func:`cone_evidence`,
+    cylindrical = (1 - conical) x the share of a plane's residual variance the least-squares cylinder explains.
+    A cylinder's side that the cone search took (its fitted cone explains little more than a cylinder does)
+    thus reads cylindrical, as the cylinder search would have read it. None for fewer than 10 points or numbers
+    that are not finite; the cylindrical part None where the cylinder's fit fails."""
+    pts = np.asarray(points, float)
+    if len(pts) < 10:
+        return None
+    cyl_ms, radius = least_squares_cylinder(pts, np.asarray(cone.axis, float))
+    conical = _share(float(np.mean(cone.residual(pts) ** 2)), cyl_ms)
+    if conical is None:
+        return None
+    over_plane = _share(cyl_ms, plane_ms(pts))
+    return conical, None if over_plane is None else ((1.0 - conical) * over_plane, radius)
 
 
 # ---------------------------------------------------------------------------------------------------------------
