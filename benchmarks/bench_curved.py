@@ -25,7 +25,7 @@ axis from its apex), against the true base radius.
 from the apex towards the base).
 ``half_angle_deg``: median error of a found cone's half-angle (a diagnostic).
 ``radius_err_refined`` / ``axis_deg_refined``: the same two of a found cylinder after grounding's refinement
-(lv3d.describe.refine_cylinder: the cylinder its facts report); nan for cones and spheres, which have none.
+(lv3d.describe.read_cylinder: the cylinder its facts report); nan for cones and spheres, which have none.
 ``conf``: median of the found faces' fact confidences (lv3d.describe: cylindrical: curved_evidence of the
 refined cylinder;
 spherical: sphere_evidence; conical: cone_evidence), and how many faces have none (None: too few points or a
@@ -55,7 +55,7 @@ import numpy as np
 from tqdm import tqdm
 
 from lv3d import compile_cache
-from lv3d.describe import curved_evidence, describe, refine_cylinder, refined_cylinder
+from lv3d.describe import curved_evidence, describe, read_cylinder
 from lv3d.perception import perceive
 from lv3d.perception.depth.quadrics import cone_evidence, sphere_evidence
 from lv3d.render import render_scene
@@ -86,11 +86,11 @@ def _params(face) -> np.ndarray:
         np.zeros(0)
 
 
-def _confidence(face, refined=None) -> float | None:
+def _confidence(face) -> float | None:
     if face.points is None:
         return None
     if face.surface == "cylinder":
-        return curved_evidence(face.points, refined or face.cylinder)
+        return curved_evidence(face.points, face.cylinder)
     if face.surface == "sphere":
         return sphere_evidence(face.points, face.sphere)
     if face.surface == "cone":
@@ -130,9 +130,9 @@ def evaluate(cls: str, seed: int, scene, frame, faces_mask: np.ndarray, min_face
     s = g["surface"]
     if cls == "cylinder":
         k = scene.intrinsics
-        fit = refine_cylinder(best, (k.fx, k.fy, k.cx, k.cy))
-        cyl = best.cylinder if fit is None else refined_cylinder(best, fit)
-        out["conf"] = _confidence(best, cyl)
+        reading = read_cylinder(best, (k.fx, k.fy, k.cx, k.cy))
+        cyl = best.cylinder if reading is None else reading.cylinder
+        out["conf"] = _confidence(best) if reading is None else reading.evidence
         out["radius_err"] = abs(best.cylinder.radius - s["radius"]) / s["radius"]
         out["axis_deg"] = _angle(best.cylinder.axis, s["axis"], signed=False)
         out["radius_err_refined"] = abs(cyl.radius - s["radius"]) / s["radius"]

@@ -29,6 +29,18 @@ SIDE_NAMES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
 _SIDE_PREDS = frozenset(SIDE_NAMES.values())
 
 
+@dataclass(frozen=True)
+class CylinderReading:
+    """What grounding made of a cylindrical face (:func:`read_cylinder`): its least-squares refinement ``fit``
+    (grounding.CylinderFit, with its Laplace spreads), the ``cylinder`` the facts report (the refined one where
+    the refinement converged, else perception's) and the ``evidence`` that the face is curved as that cylinder
+    says (:func:`curved_evidence`, None where it cannot be measured)."""
+
+    fit: grounding.CylinderFit
+    cylinder: Cylinder
+    evidence: float | None
+
+
 @dataclass
 class FaceResult:
     """Grounding of one face, kept for inspection and benchmarks."""
@@ -40,7 +52,7 @@ class FaceResult:
     # measurements the confidence calibration reads (calibration_features)
     features: dict = dc_field(default_factory=dict)
     plane_tilt_std_rad: np.ndarray | None = None  # (2,) spread of the plane normal's two tilts, radians
-    cylinder: grounding.CylinderFit | None = None  # a cylindrical face's refined cylinder (refine_cylinder)
+    cylinder_reading: CylinderReading | None = None  # a cylindrical face's refined cylinder (read_cylinder)
 
 
 @dataclass
@@ -257,10 +269,10 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
             for i, f in enumerate(chunk):
                 n = ns[i]
                 ids_i = index[i, :n]
-                fit = refine_cylinder(f, intr)
+                reading = read_cylinder(f, intr)
                 face_results.append(FaceResult(f, g["vertices"][ids_i], g["planes"][i] if has_plane[i] else None,
                                                vstd_all[ids_i], feats[i],
-                                               g["plane_std"][i][:2] if has_plane[i] else None, fit))
+                                               g["plane_std"][i][:2] if has_plane[i] else None, reading))
                 support_term = support_l[i]
                 face_conf[f.id] = support_term
                 cands.append(("face_of", (obj.id, f.id), support_term, None))
@@ -272,11 +284,8 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                     cands.append(("parallelogram", (f.id,), c["p_parallelogram"][i], c["para_dev_deg"][i]))
                 if not has_plane[i] and scene.modality == "rgb":  # colour alone: image-plane shape
                     cands += image_shape(f.id, corner_l[i][:n], corner_sd[i][:n], side_l[i][:n], side_sd[i][:n])
-                if fit is not None:
-                    cyl = refined_cylinder(f, fit)
-                    p_curved = curved_evidence(f.points, cyl)
-                    if p_curved is not None:
-                        curved.append(("cylindrical", (f.id,), p_curved, float(cyl.radius)))
+                if reading is not None and reading.evidence is not None:
+                    curved.append(("cylindrical", (f.id,), reading.evidence, float(reading.cylinder.radius)))
                 curved += quadric_candidates(f) + ellipse_candidates(f)
                 if has_plane[i]:
                     if n == 4:
@@ -351,6 +360,17 @@ def refine_cylinder(face: Face, intrinsics: tuple[float, float, float, float]):
                                   float(c.radius), intrinsics=intrinsics)
 
 
+def read_cylinder(face: Face, intrinsics: tuple[float, float, float, float]) -> CylinderReading | None:
+    """A cylindrical face's refinement (:func:`refine_cylinder`), the cylinder it gives (:func:`refined_cylinder`)
+    and the evidence of a curved face (:func:`curved_evidence`): what ``cylindrical`` reports. None where there
+    is no refinement (a face that is not cylindrical or has fewer than 10 points)."""
+    fit = refine_cylinder(face, intrinsics)
+    if fit is None:
+        return None
+    cyl = refined_cylinder(face, fit)
+    return CylinderReading(fit, cyl, curved_evidence(face.points, cyl))
+
+
 def refined_cylinder(face: Face, fit) -> Cylinder:
     """The cylinder of a refinement (:func:`refine_cylinder`) that converged to a finite surface; else
     perception's, which the refinement started from."""
@@ -383,13 +403,13 @@ def cap_candidates(obj: SceneObject, faces: list[FaceResult]) -> list[tuple[str,
     for a, b in obj.adjacency:
         for cap_id, side_id in ((a, b), (b, a)):
             cap, side = by_id.get(cap_id), by_id.get(side_id)
-            if cap is None or side is None or cap.plane is None or side.cylinder is None:
+            if cap is None or side is None or cap.plane is None or side.cylinder_reading is None:
                 continue
-            axis = refined_cylinder(side.face, side.cylinder).axis
+            axis = side.cylinder_reading.cylinder.axis
             n = np.asarray(cap.plane[:3], float)
             cos = abs(float(np.dot(n / np.linalg.norm(n), np.asarray(axis, float))))
             theta = math.degrees(math.acos(min(1.0, cos)))
-            var = float(np.mean(np.square(np.degrees(side.cylinder.axis_std))))
+            var = float(np.mean(np.square(np.degrees(side.cylinder_reading.fit.axis_std))))
             if cap.plane_tilt_std_rad is not None:
                 var += float(np.mean(np.square(np.degrees(cap.plane_tilt_std_rad))))
             z = math.sqrt(2.0 * (var + floor * floor))

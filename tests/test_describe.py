@@ -222,11 +222,12 @@ def _cylinder_fit(axis, std_deg):
 
 
 def _face_result(face, plane=None, tilt_std_deg=None, fit=None):
-    from lv3d.describe import FaceResult
+    from lv3d.describe import CylinderReading, FaceResult, refined_cylinder
 
     tilt = None if tilt_std_deg is None else np.radians([tilt_std_deg, tilt_std_deg])
+    reading = None if fit is None else CylinderReading(fit, refined_cylinder(face, fit), None)
     return FaceResult(face, face.polygon, None if plane is None else np.asarray(plane, float), np.zeros(len(face.polygon)),
-                      {}, tilt, fit)
+                      {}, tilt, reading)
 
 
 def test_a_lid_along_a_cylinder_axis_is_circular_and_a_side_face_is_not():
