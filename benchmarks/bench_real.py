@@ -3,6 +3,7 @@
     .venv/bin/python -m benchmarks.bench_real                          # every folder under ../shared/data/real with objects.csv
     .venv/bin/python -m benchmarks.bench_real ../shared/data/real/osd-learn --limit 5 --modalities depth,rgbd
     .venv/bin/python -m benchmarks.bench_real --json out/bench_real.json
+    .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --seed 0,1,2     # pooled over perception seeds
 
 A folder is in the real layout of ../shared/data/real/README.md: ``<frame>_rgb.*`` and ``<frame>_depth*`` images,
 ``intrinsics.json``, ``objects.csv`` (one row per labelled object: frame, object, a pixel u,v inside it, shape,
@@ -468,11 +469,11 @@ def write_overlay(path: Path, frame, scene, labels: list, label_img: np.ndarray 
 
 
 def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dict[str, list[dict]],
-               overlays: Path | None = None, seed: int = 0) -> dict:
-    """Perceive, ground and evaluate every frame (the first ``limit``) of ``folder`` in each modality; the frames'
-    rows are appended to ``rows[modality]``. With ``overlays``, each frame's overlay (:func:`write_overlay`) goes
-    to ``overlays/<folder>/<frame>_<modality>.png``. ``seed``: perception's (perceive). Returns {modality: [rows of
-    this folder]}."""
+               overlays: Path | None = None, seeds: tuple[int, ...] = (0,)) -> dict:
+    """Perceive, ground and evaluate every frame (the first ``limit``) of ``folder`` in each modality, once per
+    perception seed of ``seeds`` (perceive's: its sample consensus); the rows (one per frame, seed and modality)
+    are appended to ``rows[modality]``. With ``overlays``, each frame's overlay (:func:`write_overlay`) of the
+    first seed goes to ``overlays/<folder>/<frame>_<modality>.png``. Returns {modality: [rows of this folder]}."""
     from lv3d.describe import describe
     from lv3d.perception import perceive
 
@@ -483,27 +484,38 @@ def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dic
     mine: dict[str, list[dict]] = {m: [] for m in modalities}
     first = ff.load(frames[0])
     for m in modalities:  # warm-up, not counted: JIT compilation and first-call costs
-        describe(perceive(first, m, scene_id="s000000", seed=seed), first)
+        describe(perceive(first, m, scene_id="s000000", seed=seeds[0]), first)
     for i, name in enumerate(tqdm(frames, desc=folder.name, unit="frame", disable=None, leave=False)):
         frame = ff.load(name)
         label_img = ff.label_image(name, frame.shape)
-        for m in modalities:
-            t, c = time.perf_counter(), time.process_time()
-            scene = perceive(frame, m, scene_id=f"s{i:06d}", seed=seed)
-            facts = describe(scene, frame)
-            ms, cpu_ms = 1e3 * (time.perf_counter() - t), 1e3 * (time.process_time() - c)
-            row = dict(evaluate_frame(scene, facts, frame, labels.get(name, []), label_img), ms=ms, cpu_ms=cpu_ms,
-                       frame=name)
-            mine[m].append(row)
-            rows[m].append(row)
-            if overlays is not None:
-                write_overlay(overlays / folder.name / f"{name}_{m}.png", frame, scene, labels.get(name, []),
-                              label_img)
+        for seed in seeds:
+            for m in modalities:
+                t, c = time.perf_counter(), time.process_time()
+                scene = perceive(frame, m, scene_id=f"s{i:06d}", seed=seed)
+                facts = describe(scene, frame)
+                ms, cpu_ms = 1e3 * (time.perf_counter() - t), 1e3 * (time.process_time() - c)
+                row = dict(evaluate_frame(scene, facts, frame, labels.get(name, []), label_img), ms=ms,
+                           cpu_ms=cpu_ms, frame=name, seed=seed)
+                mine[m].append(row)
+                rows[m].append(row)
+                if overlays is not None and seed == seeds[0]:
+                    write_overlay(overlays / folder.name / f"{name}_{m}.png", frame, scene, labels.get(name, []),
+                                  label_img)
     return mine
 
 
 def default_folders() -> list[Path]:
     return sorted(p for p in REAL.iterdir() if (p / "objects.csv").is_file()) if REAL.is_dir() else []
+
+
+def _seeds(s: str) -> tuple[int, ...]:
+    try:
+        seeds = tuple(int(x) for x in s.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"seeds are whole numbers, comma-separated (0 or 0,1,2), not {s!r}")
+    if any(x < 0 for x in seeds) or len(set(seeds)) != len(seeds):
+        raise argparse.ArgumentTypeError(f"seeds are distinct and 0 or more, not {s!r}")
+    return seeds
 
 
 def _modalities(s: str) -> list[str]:
@@ -524,17 +536,16 @@ def main(argv=None) -> int:
     ap.add_argument("--modalities", type=_modalities, default=list(MODALITIES), metavar="M1,M2",
                     help="among rgb, depth, rgbd (default: all three)")
     ap.add_argument("--json", type=Path, metavar="FILE", help="also write the figures to FILE")
-    ap.add_argument("--seed", type=int, default=0, metavar="S",
-                    help="perception's seed (its sample consensus; default 0, as lv3d extract): rerun with others "
-                         "to see how far a figure moves by chance")
+    ap.add_argument("--seed", type=_seeds, default=(0,), metavar="S[,S...]",
+                    help="perception's seed (its sample consensus; default 0, as lv3d extract); several (0,1,2) "
+                         "perceive every frame once per seed and pool the counts over them, so that a figure is "
+                         "not one draw of perception's chance")
     ap.add_argument("--overlays", type=Path, metavar="DIR",
                     help="also write each frame's overlay (perceived faces, true masks and labelled pixels in white) "
                          "to DIR/<folder>/<frame>_<modality>.png")
     args = ap.parse_args(argv)
     if args.limit is not None and args.limit < 1:
         ap.error("--limit must be at least 1")
-    if args.seed < 0:
-        ap.error("--seed must be 0 or more")
     folders = args.folders or default_folders()
     try:
         if not folders:
@@ -559,6 +570,8 @@ def main(argv=None) -> int:
     pooled_rows: dict[str, list[dict]] = {m: [] for m in mods}
     result: dict = {"pooled": {}, "folders": {}}
     pixels = "a perceived object's pixels: its segment (depth, rgbd), else the union of its faces' polygons (rgb)"
+    seeds_text = "" if len(args.seed) == 1 else \
+        f", each frame perceived once per seed {','.join(map(str, args.seed))} (counts pooled)"
     t0 = time.perf_counter()
     for folder, name in zip(folders, names):
         try:
@@ -568,16 +581,16 @@ def main(argv=None) -> int:
             return 2
         figures = {m: summarise(mine[m], m) for m in mods}
         result["folders"][name] = {m: {k: figures[m][k] for k in KEYS + EXTRA_KEYS} for m in mods}
-        any_rows = mine[mods[0]]
+        any_rows = [r for r in mine[mods[0]] if r["seed"] == args.seed[0]]  # each frame once
         masks = sum(r["gt"] is not None for r in any_rows)
         print(table(f"\n== {name}: {len(any_rows)} frames ({masks} with masks), "
-                    f"{sum(r['labelled'] for r in any_rows)} labelled objects; {pixels}", figures, mods))
+                    f"{sum(r['labelled'] for r in any_rows)} labelled objects{seeds_text}; {pixels}", figures, mods))
         sys.stdout.flush()
     figures = {m: summarise(pooled_rows[m], m) for m in mods}
     result["pooled"] = figures
-    n = len(pooled_rows[mods[0]])
-    print(table(f"\n== pooled over {len(folders)} folder(s): {n} frames, "
-                f"{sum(r['labelled'] for r in pooled_rows[mods[0]])} labelled objects "
+    once = [r for r in pooled_rows[mods[0]] if r["seed"] == args.seed[0]]
+    print(table(f"\n== pooled over {len(folders)} folder(s): {len(once)} frames, "
+                f"{sum(r['labelled'] for r in once)} labelled objects{seeds_text} "
                 f"({time.perf_counter() - t0:.0f} s)", figures, mods))
     print("ok / MISS: the figure meets / misses its target (issues 39, 40); targets hold for the modalities named; "
           "ms: perception + grounding per frame, one core, warm")

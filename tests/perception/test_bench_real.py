@@ -206,15 +206,22 @@ def test_the_seed_reaches_perception_and_a_negative_one_stops_at_the_command_lin
     assert e.value.code == 2 and "--seed" in capsys.readouterr().err
     seen = []
 
-    def run_folder(folder, mods, limit, rows, overlays=None, seed=0):
-        seen.append(seed)
+    def run_folder(folder, mods, limit, rows, overlays=None, seeds=(0,)):
+        seen.append(seeds)
         return {m: [] for m in mods}
 
     monkeypatch.setattr(bench, "run_folder", run_folder)
     monkeypatch.setattr(bench, "labelled_folder", lambda folder: None)
     monkeypatch.setattr(bench, "summarise", lambda rows, m: {k: None for k in bench.KEYS + bench.EXTRA_KEYS})
     bench.main([str(tmp_path), "--seed", "5", "--modalities", "depth"])
-    assert seen == [5]
+    assert seen == [(5,)] and "per seed" not in capsys.readouterr().out
+    # several seeds: every frame perceived once per seed, the counts pooled (and the tables say so)
+    bench.main([str(tmp_path), "--seed", "0,1,2", "--modalities", "depth"])
+    assert seen[-1] == (0, 1, 2) and "once per seed 0,1,2" in capsys.readouterr().out
+    for bad in ("1,1", "0,x"):
+        with pytest.raises(SystemExit) as e:
+            bench.main(["--seed", bad])
+        assert e.value.code == 2 and "--seed" in capsys.readouterr().err
 
 
 @pytest.mark.real
