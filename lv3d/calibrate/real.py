@@ -100,8 +100,11 @@ def frame_entry(scene, frame, labels: list, label_img, folder: str, name: str) -
             "boxes": boxes, "rounds": rounds}
 
 
-def collect(folder: Path, modalities: list[str], limit: int | None = None) -> list[dict]:
-    """:func:`frame_entry` of every frame (the first ``limit``) of a real-layout folder, per modality."""
+def collect(folder: Path, modalities: list[str], limit: int | None = None, seeds: tuple[int, ...] = (0,)
+            ) -> list[dict]:
+    """:func:`frame_entry` of every frame (the first ``limit``) of a real-layout folder, per modality and per
+    perception seed of ``seeds`` (perceive's; each entry records its ``seed``). A frame's entries of every seed
+    name the same frame, so that frame-grouped folds keep them together."""
     from ..perception import perceive
 
     ff = FrameFolder(folder)
@@ -111,9 +114,11 @@ def collect(folder: Path, modalities: list[str], limit: int | None = None) -> li
     for i, name in enumerate(frames[:limit] if limit else frames):
         frame = ff.load(name)
         label_img = ff.label_image(name, frame.shape)
-        for m in modalities:
-            scene = perceive(frame, m, scene_id=f"s{i:06d}")  # the scene id bench_real gives the frame
-            out.append(frame_entry(scene, frame, labels.get(name, []), label_img, ff.name, name))
+        for seed in seeds:
+            for m in modalities:
+                scene = perceive(frame, m, scene_id=f"s{i:06d}", seed=seed)  # the scene id bench_real gives it
+                entry = frame_entry(scene, frame, labels.get(name, []), label_img, ff.name, name)
+                out.append({**entry, "seed": seed})
     return out
 
 
@@ -163,15 +168,17 @@ def read(path: Path) -> dict:
 
 
 def make(folders: list[Path], out: Path, modalities: tuple[str, ...] = MODALITIES, limit: int | None = None,
-         command: str = "", log=print) -> dict:
-    """The frame entries of every frame (the first ``limit`` of each folder) of ``folders``, written to the
-    pickle ``out`` once all are done (``out`` must be absent or a pickle of this function). Every folder is
-    checked before any work."""
+         command: str = "", log=print, seeds: tuple[int, ...] = (0,)) -> dict:
+    """The frame entries of every frame (the first ``limit`` of each folder) of ``folders``, once per perception
+    seed of ``seeds``, written to the pickle ``out`` once all are done (``out`` must be absent or a pickle of
+    this function). Every folder is checked before any work."""
     bad = [m for m in modalities if m not in MODALITIES]
     if bad or not modalities:
         raise InputError("--modalities", f"choose among {', '.join(MODALITIES)}, not {','.join(modalities)!r}")
     if limit is not None and limit < 1:
         raise InputError("--limit", f"must be at least 1, not {limit}")
+    if not seeds or any(x < 0 for x in seeds) or len(set(seeds)) != len(seeds):
+        raise InputError("--seed", f"seeds are distinct and 0 or more, not {','.join(map(str, seeds))!r}")
     out = Path(out)
     if out.is_dir():
         raise InputError(out, "is a folder; --out names a file")
@@ -182,7 +189,7 @@ def make(folders: list[Path], out: Path, modalities: tuple[str, ...] = MODALITIE
     t0 = time.time()
     frames: list[dict] = []
     for folder in folders:
-        frames += collect(Path(folder), list(modalities), limit)
+        frames += collect(Path(folder), list(modalities), limit, tuple(seeds))
         log(f"{Path(folder).name}: {len(frames)} frame entries, {len(rows_of(frames))} rows, {time.time() - t0:.0f} s")
     data = {"rows": rows_of(frames), "frames": frames, "folders": [Path(f).name for f in folders], "made_by": command}
     write_atomic(out, pickle.dumps(data))

@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from .. import compile_cache
+from ..errors import InputError
 
 
 def _say(text: str) -> None:
@@ -67,15 +68,22 @@ def rows(ctx, seed, per_class, preset, modalities, out, fresh):
 @click.option("--modalities", default="depth,rgbd", show_default=True, help="among depth, rgbd")
 @click.option("--limit", type=click.IntRange(1, None), default=None, metavar="N",
               help="only the first N frames of each folder")
+@click.option("--seed", "seeds", default="0", show_default=True, metavar="S[,S...]",
+              help="perception's seeds: every frame is perceived once per seed (0,1,2: rows of three draws of its "
+                   "sample consensus, so that the maps do not fit one draw)")
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="the pickle of real rows to write")
 @click.pass_context
-def real(ctx, folders, modalities, limit, out):
+def real(ctx, folders, modalities, limit, seeds, out):
     """Labelled perpendicular candidates of FOLDERS of real frames (the real layout, docs/real_frames.md)
     (lv3d.calibrate.real)."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     from ..calibrate.real import make
 
-    make(list(folders), out, _modalities(modalities), limit, command_line(ctx), log=_say)
+    try:
+        seed_list = tuple(int(x) for x in seeds.split(","))
+    except ValueError:
+        raise InputError("--seed", f"seeds are whole numbers, comma-separated (0 or 0,1,2), not {seeds!r}")
+    make(list(folders), out, _modalities(modalities), limit, command_line(ctx), log=_say, seeds=seed_list)
 
 
 @calibrate.command()

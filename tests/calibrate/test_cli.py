@@ -49,6 +49,10 @@ def test_a_file_the_command_did_not_write_is_not_replaced(tmp_path, capsys):
 def test_bad_options_are_one_line(capsys, tmp_path):
     assert main(["calibrate", "real", str(tmp_path), "--modalities", "rgb", "--out", str(tmp_path / "r.pkl")]) == 2
     assert "--modalities: choose among depth, rgbd" in capsys.readouterr().err
+    for seeds, what in (("0,x", "whole numbers"), ("1,1", "distinct")):
+        assert main(["calibrate", "real", str(tmp_path), "--seed", seeds, "--out", str(tmp_path / "r.pkl")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "--seed" in err[0] and what in err[0]
     assert main(["calibrate", "rows", "--preset", "nosuch", "--out", str(tmp_path / "r.pkl")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "nosuch" in err[0]
