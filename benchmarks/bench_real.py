@@ -127,7 +127,7 @@ from tqdm import tqdm
 
 from lv3d import compile_cache
 from lv3d.calibrate.measures import ece
-from lv3d.calibrate.real import BOX_PERP, PRISM_PERP, ROUND, SHAPES, perpendicular_truth
+from lv3d.calibrate.real import BOX_PERP, PRISM_PERP, ROUND, SHAPES, perpendicular_truth, seed_list
 from lv3d.errors import InputError
 from lv3d.facts import MODALITIES, PREDICATES
 from lv3d.frame_folder import FrameFolder, LabelledObject
@@ -510,12 +510,9 @@ def default_folders() -> list[Path]:
 
 def _seeds(s: str) -> tuple[int, ...]:
     try:
-        seeds = tuple(int(x) for x in s.split(","))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"seeds are whole numbers, comma-separated (0 or 0,1,2), not {s!r}")
-    if any(x < 0 for x in seeds) or len(set(seeds)) != len(seeds):
-        raise argparse.ArgumentTypeError(f"seeds are distinct and 0 or more, not {s!r}")
-    return seeds
+        return seed_list(s)
+    except InputError as e:
+        raise argparse.ArgumentTypeError(e.problem) from None
 
 
 def _modalities(s: str) -> list[str]:

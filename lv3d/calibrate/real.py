@@ -162,6 +162,25 @@ def figures(frames: list[dict], conf) -> dict[str, dict]:
     return out
 
 
+def checked_seeds(seeds) -> tuple[int, ...]:
+    """Perception seeds (perceive's) as a tuple: at least one, each 0 or more, none twice; else an InputError
+    naming ``--seed``."""
+    seeds = tuple(seeds)
+    if not seeds or any(x < 0 for x in seeds) or len(set(seeds)) != len(seeds):
+        raise InputError("--seed", f"seeds are distinct and 0 or more, not {','.join(map(str, seeds))!r}")
+    return seeds
+
+
+def seed_list(text: str) -> tuple[int, ...]:
+    """The perception seeds of an option's text, ``0`` or ``0,1,2`` (:func:`checked_seeds`); an InputError naming
+    ``--seed`` otherwise."""
+    try:
+        seeds = tuple(int(x) for x in text.split(","))
+    except ValueError:
+        raise InputError("--seed", f"seeds are whole numbers, comma-separated (0 or 0,1,2), not {text!r}") from None
+    return checked_seeds(seeds)
+
+
 def read(path: Path) -> dict:
     """A pickle of :func:`make`, or a one-line InputError naming the file."""
     return read_pickle(path, "lv3d calibrate real", ("rows", "frames"))
@@ -177,8 +196,7 @@ def make(folders: list[Path], out: Path, modalities: tuple[str, ...] = MODALITIE
         raise InputError("--modalities", f"choose among {', '.join(MODALITIES)}, not {','.join(modalities)!r}")
     if limit is not None and limit < 1:
         raise InputError("--limit", f"must be at least 1, not {limit}")
-    if not seeds or any(x < 0 for x in seeds) or len(set(seeds)) != len(seeds):
-        raise InputError("--seed", f"seeds are distinct and 0 or more, not {','.join(map(str, seeds))!r}")
+    seeds = checked_seeds(seeds)
     out = Path(out)
     if out.is_dir():
         raise InputError(out, "is a folder; --out names a file")
@@ -189,7 +207,7 @@ def make(folders: list[Path], out: Path, modalities: tuple[str, ...] = MODALITIE
     t0 = time.time()
     frames: list[dict] = []
     for folder in folders:
-        frames += collect(Path(folder), list(modalities), limit, tuple(seeds))
+        frames += collect(Path(folder), list(modalities), limit, seeds)
         log(f"{Path(folder).name}: {len(frames)} frame entries, {len(rows_of(frames))} rows, {time.time() - t0:.0f} s")
     data = {"rows": rows_of(frames), "frames": frames, "folders": [Path(f).name for f in folders], "made_by": command}
     write_atomic(out, pickle.dumps(data))

@@ -8,7 +8,6 @@ from pathlib import Path
 import click
 
 from .. import compile_cache
-from ..errors import InputError
 
 
 def _say(text: str) -> None:
@@ -77,13 +76,9 @@ def real(ctx, folders, modalities, limit, seeds, out):
     """Labelled perpendicular candidates of FOLDERS of real frames (the real layout, docs/real_frames.md)
     (lv3d.calibrate.real)."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
-    from ..calibrate.real import make
+    from ..calibrate.real import make, seed_list
 
-    try:
-        seed_list = tuple(int(x) for x in seeds.split(","))
-    except ValueError:
-        raise InputError("--seed", f"seeds are whole numbers, comma-separated (0 or 0,1,2), not {seeds!r}")
-    make(list(folders), out, _modalities(modalities), limit, command_line(ctx), log=_say, seeds=seed_list)
+    make(list(folders), out, _modalities(modalities), limit, command_line(ctx), log=_say, seeds=seed_list(seeds))
 
 
 @calibrate.command()
