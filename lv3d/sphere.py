@@ -29,3 +29,16 @@ class Sphere:
 
     def to_dict(self) -> dict:
         return {"centre": list(self.centre), "radius": self.radius}
+
+
+def algebraic_sphere(pts: np.ndarray) -> Sphere | None:
+    """The linear least-squares sphere of points (m, 3): ``|p|^2 = 2 c . p + k`` in the four unknowns c and k
+    (the radius is ``sqrt(k + |c|^2)``). None where that is not a sphere."""
+    if len(pts) < 4:
+        return None
+    sol, *_ = np.linalg.lstsq(np.column_stack([2 * pts, np.ones(len(pts))]), np.einsum("ij,ij->i", pts, pts),
+                              rcond=None)
+    r2 = sol[3] + sol[:3] @ sol[:3]
+    if not (np.all(np.isfinite(sol)) and r2 > 0):
+        return None
+    return Sphere(tuple(float(x) for x in sol[:3]), float(np.sqrt(r2)))

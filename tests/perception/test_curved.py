@@ -144,3 +144,40 @@ def test_a_noisy_box_corner_is_no_cylinder():
         return np.where(np.abs(y) < 0.05, t, np.inf)
 
     assert _cylinders_of(_range_grid(hit)) == []
+
+
+def _inside_hit(r: float, centre: np.ndarray, sphere: bool, half_height: float = 0.05):
+    """Depth along each ray to the far wall of an open pot (a vertical cylinder, camera y its axis) or of a
+    bowl (a sphere) of radius ``r`` about ``centre``, seen from inside it (the camera looks over the rim)."""
+
+    def hit(rays):
+        c = np.asarray(centre, float)
+        if sphere:
+            a = np.einsum("...j,...j->...", rays, rays)
+            b = -2 * (rays @ c)
+            cc = c @ c - r * r
+        else:
+            a = rays[..., 0] ** 2 + rays[..., 2] ** 2
+            b = -2 * (rays[..., 0] * c[0] + rays[..., 2] * c[2])
+            cc = c[0] ** 2 + c[2] ** 2 - r * r
+        disc = b * b - 4 * a * cc
+        t = (-b + np.sqrt(np.maximum(disc, 0))) / (2 * a)  # the far hit: the inner wall behind the axis
+        y = rays[..., 1] * t
+        keep = (disc > 0) & (np.abs(y - c[1]) < half_height) & (t * rays[..., 2] > c[2])
+        return np.where(keep, t, np.inf)
+
+    return hit
+
+
+def test_the_inside_of_an_open_pot_is_one_cylindrical_face():
+    # the far half of a pot's inner wall, radius 9 cm, axis 0.7 m away: its normals point towards the axis
+    found = _cylinders_of(_range_grid(_inside_hit(0.09, np.array([0.0, 0.0, 0.7]), sphere=False)))
+    assert len(found) >= 1
+    cyl, on, _ = found[0]
+    assert abs(cyl.radius - 0.09) < 0.01 and abs(abs(cyl.axis[1]) - 1) < 0.05
+    assert on.mean() > 0.6
+
+
+def test_the_inside_of_a_bowl_is_no_cylinder():
+    # the far half of a bowl's inside (a sphere of radius 9 cm): a sphere explains it, not a cylinder
+    assert _cylinders_of(_range_grid(_inside_hit(0.09, np.array([0.0, 0.0, 0.7]), sphere=True))) == []

@@ -18,6 +18,11 @@ and keeps the cylinder most cells agree with; it is refitted on every cell on it
 and stands only where it fits those cells better than the object's planes do and its normals fill a wide arc
 without the dip two planes leave (a box's two faces at 90 deg stay planes), and where it takes over at least half
 of one of the object's planes. A tin's lid fits no pair (its normals are parallel).
+
+A cylinder is read from either side: its outside (a can; the normals point away from the axis) or its inside
+(an open pot's or a cup's inner wall seen over the rim; the normals point towards it). A pair of cells tells
+which: the centre lies behind both or in front of both. An inside must also beat a sphere, which a bowl's
+inside is.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ import numpy as np
 
 from ...cylinder import Cylinder
 from ...plane import row_norms
+from ...sphere import algebraic_sphere
 from .planes import largest_piece_on
 
 
@@ -96,9 +102,20 @@ class CurvedFace:
     rms_m: float
 
 
-def _inliers(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: float) -> np.ndarray:
+def _inliers(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: float, side: float = 1.0
+             ) -> np.ndarray:
+    """The points (m, 3) within ``dist_m`` of the surface whose unit normals (m, 3) turn from the radial
+    direction by less than ``arccos(cos_min)``: the direction away from the axis for ``side`` 1 (the outside of
+    a can), towards it for -1 (the inside of a pot or a cup, seen over its rim)."""
     r, out = cyl.radial(pts)
-    return (np.abs(r - cyl.radius) <= dist_m) & (np.einsum("ij,ij->i", out, nrm) >= cos_min)
+    return (np.abs(r - cyl.radius) <= dist_m) & (side * np.einsum("ij,ij->i", out, nrm) >= cos_min)
+
+
+def facing(cyl: Cylinder, nrm: np.ndarray, pts: np.ndarray) -> float:
+    """Which side of the cylinder the points (m, 3) with unit normals (m, 3) show: 1 its outside (their normals
+    point away from the axis, most of them), -1 its inside."""
+    _, out = cyl.radial(pts)
+    return 1.0 if float(np.median(np.einsum("ij,ij->i", out, nrm))) >= 0 else -1.0
 
 
 def refine(pts: np.ndarray, nrm: np.ndarray) -> Cylinder | None:
@@ -165,7 +182,8 @@ def fan_cylinder(normals: list[np.ndarray], sizes: list[int], adjacency: list[tu
         cyl = refine(pts[cells], nrm[cells])
         if cyl is None or cyl.radius > settings.max_radius_frac * extent_m:
             continue
-        inl = known & _inliers(cyl, pts, nrm, settings.inlier_dists * dist_m, cos_min)
+        side = facing(cyl, nrm[cells], pts[cells])
+        inl = known & _inliers(cyl, pts, nrm, settings.inlier_dists * dist_m, cos_min, side)
         for _ in range(3):  # refit on the surface's own cells, strips between the fan's planes included
             if np.count_nonzero(inl) < 20:
                 break
@@ -173,7 +191,7 @@ def fan_cylinder(normals: list[np.ndarray], sizes: list[int], adjacency: list[tu
             if again is None or again.radius > settings.max_radius_frac * extent_m:
                 break
             cyl = again
-            inl = known & _inliers(cyl, pts, nrm, settings.inlier_dists * dist_m, cos_min)
+            inl = known & _inliers(cyl, pts, nrm, settings.inlier_dists * dist_m, cos_min, side)
         if np.count_nonzero(inl & cells) < settings.min_cover * np.count_nonzero(cells):
             continue
         r, _ = cyl.radial(pts[inl])
@@ -187,11 +205,13 @@ def fan_cylinder(normals: list[np.ndarray], sizes: list[int], adjacency: list[tu
 
 
 def _pair_cylinders(p1: np.ndarray, n1: np.ndarray, p2: np.ndarray, n2: np.ndarray, min_sin: float
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Cylinders through pairs of oriented points (k, 3) each (Schnabel, Wahl and Klein 2007): the axis is
-    perpendicular to both normals, the centre where the lines back along the normals meet, seen along the axis.
-    Returns axes (k, 3), centres (k, 3), radii (k,) and which pairs give one (their normals turned by an angle
-    whose sine is ``min_sin`` or more, the centre behind both points at distances that agree within half)."""
+    perpendicular to both normals, the centre where the lines along the normals meet, seen along the axis.
+    Returns axes (k, 3), centres (k, 3), radii (k,), sides (k,) (1: the centre lies behind both points, which
+    show the cylinder's outside; -1: in front of both, its inside) and which pairs give one (their normals turned
+    by an angle whose sine is ``min_sin`` or more, the centre on one side of both points at distances that agree
+    within half)."""
     a = np.cross(n1, n2)
     s = np.linalg.norm(a, axis=1)
     ok = s >= min_sin
@@ -205,10 +225,11 @@ def _pair_cylinders(p1: np.ndarray, n1: np.ndarray, p2: np.ndarray, n2: np.ndarr
     det = np.where(np.abs(det) < 1e-12, 1e-12, det)
     t = (-b1 + c12 * b2) / det
     u = (-c12 * b1 + b2) / det
-    r = 0.5 * (t + u)
-    ok &= (t > 0) & (u > 0) & (np.abs(t - u) <= 0.5 * r)
+    side = np.where(t + u >= 0, 1.0, -1.0)
+    r = 0.5 * np.abs(t + u)
+    ok &= (side * t > 0) & (side * u > 0) & (np.abs(t - u) <= 0.5 * r)
     centre = p1 - t[:, None] * n1
-    return a, centre, r, ok
+    return a, centre, r, side, ok
 
 
 def axis_terms(pts: np.ndarray, nrm: np.ndarray, origins: np.ndarray, axes: np.ndarray
@@ -229,29 +250,32 @@ def axis_terms(pts: np.ndarray, nrm: np.ndarray, origins: np.ndarray, axes: np.n
 
 def sample_cylinder(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: float, r_min: float, r_max: float,
                     rng: np.random.Generator, trials: int = 256, score_points: int = 800,
-                    min_pair_deg: float = 15.0) -> Cylinder | None:
+                    min_pair_deg: float = 15.0) -> tuple[Cylinder, float] | None:
     """The cylinder with most inliers (within ``dist_m`` of the surface, the normal within ``arccos(cos_min)`` of
-    the radial direction) among ``trials`` seeded random pairs of the oriented points (m, 3) and unit normals
-    (m, 3), scored on a seeded sample of ``score_points`` of them; its radius in [r_min, r_max]. None when no pair
-    gives one."""
+    the radial direction, outwards or inwards as the pair shows it) among ``trials`` seeded random pairs of the
+    oriented points (m, 3) and unit normals (m, 3), scored on a seeded sample of ``score_points`` of them; its
+    radius in [r_min, r_max]. Returns it and the side the points show (1 outside, -1 inside: _pair_cylinders);
+    None when no pair gives one."""
     m = len(pts)
     if m < 20:
         return None
     score = rng.choice(m, min(m, score_points), replace=False)
     sp, sn = pts[score], nrm[score]
     i, j = rng.integers(0, m, trials), rng.integers(0, m, trials)
-    axes, centres, radii, ok = _pair_cylinders(pts[i], nrm[i], pts[j], nrm[j], np.sin(np.radians(min_pair_deg)))
+    axes, centres, radii, sides, ok = _pair_cylinders(pts[i], nrm[i], pts[j], nrm[j],
+                                                      np.sin(np.radians(min_pair_deg)))
     ok &= (radii >= r_min) & (radii <= r_max)
     if not ok.any():
         return None
-    axes, centres, radii = axes[ok], centres[ok], radii[ok]
+    axes, centres, radii, sides = axes[ok], centres[ok], radii[ok], sides[ok]
     # each hypothesis k against each scored point s, d = p_s - c_k, in (k, s) products rather than (k, s, 3)
     # arrays: along = d . a, r^2 = |d|^2 - along^2, and the radial direction's dot with the normal is
     # (d . n - along (a . n)) / r (coordinates taken about the scored points' mean, where they are small)
     r, radial_n, _ = axis_terms(sp, sn, centres, axes)
-    count = np.count_nonzero((np.abs(r - radii[:, None]) <= dist_m) & (radial_n >= cos_min * r), axis=1)
+    count = np.count_nonzero((np.abs(r - radii[:, None]) <= dist_m) & (sides[:, None] * radial_n >= cos_min * r),
+                             axis=1)
     b = int(np.argmax(count))
-    return Cylinder(tuple(axes[b]), tuple(centres[b]), float(radii[b]))
+    return Cylinder(tuple(axes[b]), tuple(centres[b]), float(radii[b])), float(sides[b])
 
 
 def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of: np.ndarray, planes: list,
@@ -295,30 +319,32 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
         if fan is not None:
             cyl, on, members = fan
             on = largest_piece_on(on, box)
-            if _stands(cyl, pts[on], nrm[on], None, dist_m, min_cells, settings):
+            side = facing(cyl, nrm[on], pts[on]) if on.any() else 1.0
+            if _stands(cyl, pts[on], nrm[on], None, dist_m, min_cells, settings, side):
                 out.append((cyl, on, sorted(set(members) | set(replaced(on)))))
                 free &= ~on
     for _ in range(settings.max_faces * 2 if sample else 0):  # a rejected sample does not end the search at once
         if len(out) >= settings.max_faces or np.count_nonzero(free) < max(20, min_cells):
             break
         idx = np.flatnonzero(free)
-        cyl = sample_cylinder(pts[idx], nrm[idx], dist, cos_min, r_min, r_max, rng, settings.trials,
-                              settings.score_cells)
-        if cyl is None:
+        sampled = sample_cylinder(pts[idx], nrm[idx], dist, cos_min, r_min, r_max, rng, settings.trials,
+                                  settings.score_cells)
+        if sampled is None:
             break
+        cyl, side = sampled
         on = np.zeros(len(pts), bool)
         for _ in range(settings.refits):
-            on = largest_piece_on(free & _inliers(cyl, pts, nrm, dist, cos_min), box)
+            on = largest_piece_on(free & _inliers(cyl, pts, nrm, dist, cos_min, side), box)
             if np.count_nonzero(on) < max(20, min_cells):
                 break
             again = refine(pts[on], nrm[on])
             if again is None or not r_min <= again.radius <= r_max:
                 break
             cyl = again
-        on = largest_piece_on(free & _inliers(cyl, pts, nrm, dist, cos_min), box)
+        on = largest_piece_on(free & _inliers(cyl, pts, nrm, dist, cos_min, side), box)
         ok = on & (plane_of >= 0)
         gone = replaced(on) if ok.any() else []
-        if gone and _stands(cyl, pts[on], nrm[on], res[ok], dist, min_cells, settings):
+        if gone and _stands(cyl, pts[on], nrm[on], res[ok], dist, min_cells, settings, side):
             out.append((cyl, on, gone))
             free &= ~on
         elif on.any():
@@ -329,12 +355,15 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
 
 
 def _stands(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarray | None, dist_m: float,
-            min_cells: int, settings: CurvedSettings) -> bool:
+            min_cells: int, settings: CurvedSettings, side: float = 1.0) -> bool:
     """Whether a cylinder's cells (points and normals) make a curved face: enough of them, within the inlier
     distance of it on average and closer to it than to the object's planes (``plane_res``: each cell's distance
     from its own plane, None for a fan of planes already read as a cylinder), spread around the axis through a
     wide arc without a gap (:func:`track`), and a cylinder that explains most of one plane's residual over them
-    (:func:`curved_share`)."""
+    (:func:`curved_share`). Cells that show a cylinder's inside (``side`` -1: a pot's or a cup's inner wall over
+    its rim) must also be explained better by it than by a sphere (the share of the algebraic sphere's residual
+    variance it explains at least ``min_share``): a bowl's inside is a sphere's, and no sphere search of the
+    outside kind (quadrics) takes it first, as it takes a ball's outside."""
     if len(pts) < max(20, min_cells):
         return False
     r, _ = cyl.radial(pts)
@@ -349,6 +378,12 @@ def _stands(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarr
     arc, dip = normal_profile(cyl, nrm, settings.max_gap_deg / 2)
     if arc < settings.sample_arc_deg or dip < settings.min_dip:
         return False
+    if side < 0:
+        sphere = algebraic_sphere(pts)
+        if sphere is not None:
+            over_sphere = explained_share(rms * rms, float(np.mean(sphere.residual(pts) ** 2)))
+            if over_sphere is None or over_sphere < settings.min_share:
+                return False
     return curved_share(pts, cyl) >= settings.min_share
 
 

@@ -31,7 +31,7 @@ import numpy as np
 
 from ...cone import Cone
 from ...plane import row_norms
-from ...sphere import Sphere
+from ...sphere import Sphere, algebraic_sphere
 from .curved import axis_terms
 from .curved import explained_share as _share
 from .curved import plane_ms
@@ -363,19 +363,6 @@ def sample_cone(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: float,
 
 # ---------------------------------------------------------------------------------------------------------------
 # least-squares refinement
-
-
-def algebraic_sphere(pts: np.ndarray) -> Sphere | None:
-    """The linear least-squares sphere of points (m, 3): ``|p|^2 = 2 c . p + k`` in the four unknowns c and k
-    (the radius is ``sqrt(k + |c|^2)``). None where that is not a sphere."""
-    if len(pts) < 4:
-        return None
-    sol, *_ = np.linalg.lstsq(np.column_stack([2 * pts, np.ones(len(pts))]), np.einsum("ij,ij->i", pts, pts),
-                              rcond=None)
-    r2 = sol[3] + sol[:3] @ sol[:3]
-    if not (np.all(np.isfinite(sol)) and r2 > 0):
-        return None
-    return Sphere(tuple(float(x) for x in sol[:3]), float(np.sqrt(r2)))
 
 
 def refine_sphere(pts: np.ndarray, start: Sphere) -> Sphere | None:
