@@ -122,10 +122,7 @@ def refine(pts: np.ndarray, nrm: np.ndarray) -> Cylinder | None:
     """Least-squares cylinder through points (m, 3) with outward unit normals (m, 3): the axis is the direction
     the normals are most nearly perpendicular to, the circle Kasa's fit to the points projected along it."""
     _, vecs = np.linalg.eigh(nrm.T @ nrm)
-    a = vecs[:, 0]
-    b1 = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
-    b1 /= np.linalg.norm(b1)
-    b2 = np.cross(a, b1)
+    a, b1, b2 = axis_basis(vecs[:, 0])
     x, y = pts @ b1, pts @ b2
     mat = np.stack([x, y, np.ones_like(x)], axis=1)
     sol, *_ = np.linalg.lstsq(mat, x * x + y * y, rcond=None)
@@ -139,10 +136,7 @@ def refine(pts: np.ndarray, nrm: np.ndarray) -> Cylinder | None:
 
 def _normal_arc(cyl: Cylinder, nrm: np.ndarray) -> tuple[float, float]:
     """The arc (degrees) the unit normals (m, 3) span around the cylinder's axis, and the widest gap inside it."""
-    a = np.asarray(cyl.axis)
-    b1 = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
-    b1 /= np.linalg.norm(b1)
-    b2 = np.cross(a, b1)
+    _, b1, b2 = axis_basis(cyl.axis)
     ang = np.sort(np.degrees(np.arctan2(nrm @ b2, nrm @ b1)))
     gaps = np.diff(np.concatenate([ang, ang[:1] + 360.0]))
     k = int(np.argmax(gaps))  # the arc is the circle less its widest gap
@@ -415,8 +409,10 @@ def curved_share(pts: np.ndarray, cyl: Cylinder) -> float:
     return 0.0 if share is None else share
 
 
-def _basis(axis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def axis_basis(axis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The unit ``axis`` (3,) (normalised) and two unit vectors that make a right-handed frame with it."""
     a = np.asarray(axis, float)
+    a = a / np.linalg.norm(a)
     b1 = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
     b1 /= np.linalg.norm(b1)
     return a, b1, np.cross(a, b1)
@@ -430,7 +426,7 @@ def track(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, bin_deg: float, min_c
     absolute value, the arc the points span over such bins, the widest gap between them), degrees. A cylinder's
     normals follow the radial direction and only their noise spreads them (a median cancels it); two planes a
     cylinder was fitted through keep their normals fixed while the radial direction turns along them."""
-    a, b1, b2 = _basis(cyl.axis)
+    a, b1, b2 = axis_basis(cyl.axis)
     d = pts - np.asarray(cyl.point)
     theta = np.degrees(np.arctan2(d @ b2, d @ b1))
     phi = np.degrees(np.arctan2(nrm @ b2, nrm @ b1))
@@ -459,7 +455,7 @@ def normal_profile(cyl: Cylinder, nrm: np.ndarray, bin_deg: float, edge_frac: fl
     side's normals fill their arc (a camera sees fewer cells per degree towards its rims, half as many at 60 deg
     from the line of sight); two planes' normals make two peaks with a dip between them that their noise does not
     fill (a box's edge, rounded by the sensor, holds a few cells per degree where its faces hold hundreds)."""
-    a, b1, b2 = _basis(cyl.axis)
+    a, b1, b2 = axis_basis(cyl.axis)
     phi = np.degrees(np.arctan2(nrm @ b2, nrm @ b1))
     nb = int(np.ceil(360.0 / bin_deg))
     counts = np.bincount(((phi + 180.0) // bin_deg).astype(int) % nb, minlength=nb)

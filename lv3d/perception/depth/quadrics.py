@@ -32,7 +32,7 @@ import numpy as np
 from ...cone import Cone
 from ...plane import row_norms
 from ...sphere import Sphere, algebraic_sphere
-from .curved import axis_terms
+from .curved import axis_basis, axis_terms
 from .curved import explained_share as _share
 from .curved import plane_ms
 from .planes import largest_piece_on
@@ -197,7 +197,7 @@ def least_squares_cylinder(pts: np.ndarray, axis0: np.ndarray) -> tuple[float, f
     cylinder's radius (metres). (nan, nan) where the fit fails."""
     from scipy.optimize import least_squares
 
-    a0, b1, b2 = _basis(axis0)
+    a0, b1, b2 = axis_basis(axis0)
     x, y = pts @ b1, pts @ b2
     sol, *_ = np.linalg.lstsq(np.stack([x, y, np.ones_like(x)], axis=1), x * x + y * y, rcond=None)
     cx, cy = sol[0] / 2, sol[1] / 2
@@ -246,9 +246,14 @@ def cone_evidence(points: np.ndarray, cone: Cone) -> float | None:
     it is the cylinder the cone must beat; a cylinder's side read as a cone gives near 0. None for fewer than 10
     points or numbers that are not finite."""
     pts = np.asarray(points, float)
-    if len(pts) < 10:
-        return None
-    return _share(float(np.mean(cone.residual(pts) ** 2)), cylinder_ms(pts, np.asarray(cone.axis, float)))
+    return None if len(pts) < 10 else _over_cylinder(pts, cone)[0]
+
+
+def _over_cylinder(pts: np.ndarray, cone: Cone) -> tuple[float | None, float, float]:
+    """:func:`cone_evidence` of points (m, 3), with the least-squares cylinder's mean square residual and radius
+    (:func:`least_squares_cylinder`, its axis started along the cone's)."""
+    cyl_ms, radius = least_squares_cylinder(pts, np.asarray(cone.axis, float))
+    return _share(float(np.mean(cone.residual(pts) ** 2)), cyl_ms), cyl_ms, radius
 
 
 def cone_readings(points: np.ndarray, cone: Cone) -> tuple[float, tuple[float, float] | None] | None:
@@ -263,8 +268,7 @@ def cone_readings(points: np.ndarray, cone: Cone) -> tuple[float, tuple[float, f
     pts = np.asarray(points, float)
     if len(pts) < 10:
         return None
-    cyl_ms, radius = least_squares_cylinder(pts, np.asarray(cone.axis, float))
-    conical = _share(float(np.mean(cone.residual(pts) ** 2)), cyl_ms)
+    conical, cyl_ms, radius = _over_cylinder(pts, cone)
     if conical is None:
         return None
     over_plane = _share(cyl_ms, plane_ms(pts))
@@ -273,14 +277,6 @@ def cone_readings(points: np.ndarray, cone: Cone) -> tuple[float, tuple[float, f
 
 # ---------------------------------------------------------------------------------------------------------------
 # sample consensus
-
-
-def _basis(axis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    a = np.asarray(axis, float)
-    a = a / np.linalg.norm(a)
-    b1 = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
-    b1 /= np.linalg.norm(b1)
-    return a, b1, np.cross(a, b1)
 
 
 def sample_sphere(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: float, r_min: float, r_max: float,
@@ -420,7 +416,7 @@ def refine_cone(pts: np.ndarray, start: Cone) -> Cone | None:
     percentile). None when it does not converge, its numbers are not finite or its half-angle leaves (0, 90)."""
     from scipy.optimize import least_squares
 
-    a0, b1, b2 = _basis(start.axis)
+    a0, b1, b2 = axis_basis(start.axis)
 
     def unpack(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
         a = a0 + p[3] * b1 + p[4] * b2
@@ -488,7 +484,7 @@ def _azimuth_profile(axis, nrm: np.ndarray, bin_deg: float, edge_frac: float = 0
     """The arc (degrees) the normals (m, 3) fill around ``axis`` (from the first to the last bin of ``bin_deg``
     holding ``edge_frac`` of the fullest or more, the circle cut at its longest empty run) and its emptiest bin
     over its fullest."""
-    _, b1, b2 = _basis(axis)
+    _, b1, b2 = axis_basis(axis)
     phi = np.degrees(np.arctan2(nrm @ b2, nrm @ b1))
     nb = int(np.ceil(360.0 / bin_deg))
     counts = np.bincount(((phi + 180.0) // bin_deg).astype(int) % nb, minlength=nb)
