@@ -15,7 +15,7 @@ folders (pooled = counts added over all frames, not an average of the folders' f
 writes them as ``{"pooled": {MODALITY: {...}}, "folders": {NAME: {MODALITY: {...}}}}`` with the keys
 object_recall, merged_frac, split_frac, support_ok_frac, box_perpendicular_frac, box_overfaced_frac,
 cylinder_as_prism_frac, perpendicular_ece, cylinder_read_frac, box_curved_frac, ms_median, ms_p90 and the extra
-labelled_found, cpu_ms_median, cylinder_elliptical_frac and box_elliptical_frac; a figure a folder or modality
+labelled_found, cpu_ms_median, bowl_curved_frac, cylinder_elliptical_frac and box_elliptical_frac; a figure a folder or modality
 cannot measure is null (recall and split without masks; support, every ``perpendicular`` figure and both
 curved-face figures under rgb, which has no planes and no curved faces; both elliptical figures under depth and
 rgbd, which do not say ``elliptical``).
@@ -84,6 +84,10 @@ pixel, else the nearest within 1 % of the image diagonal), so that this figure r
 
 ``box_curved_frac`` (depth and rgbd): share of labelled boxes (partial or not) whose object under the labelled
 pixel (as above) has any cylindrical face (``Face.surface == "cylinder"``), whatever its fact's confidence.
+
+``bowl_curved_frac`` (depth and rgbd, an extra figure, no target): share of labelled bowls (partial or not) whose
+object under the labelled pixel has a curved face (``Face.surface`` other than "plane": a cylinder's, a sphere's or
+a cone's side); issue 40 asks that bowls read as curved.
 
 ``cylinder_elliptical_frac`` (rgb, an extra figure, no target): share of labelled cylinders with partial = no
 whose object under the labelled pixel has an ``elliptical`` fact (colour alone: a face whose outline is an
@@ -154,7 +158,8 @@ MASK_ERODE_PX = 1      # a ground-truth mask is shrunk by this much before its d
 KEYS = ("object_recall", "merged_frac", "split_frac", "support_ok_frac", "box_perpendicular_frac",
         "box_overfaced_frac", "cylinder_as_prism_frac", "perpendicular_ece", "cylinder_read_frac", "box_curved_frac",
         "ms_median", "ms_p90")
-EXTRA_KEYS = ("labelled_found", "cpu_ms_median", "cylinder_elliptical_frac", "box_elliptical_frac")
+EXTRA_KEYS = ("labelled_found", "cpu_ms_median", "bowl_curved_frac", "cylinder_elliptical_frac",
+              "box_elliptical_frac")
 # figure -> (comparison, target, modalities the target is for); None: no target
 TARGETS: dict[str, tuple[str, float, tuple[str, ...]] | None] = {
     "object_recall": (">=", 0.90, ("depth", "rgbd")),
@@ -335,7 +340,12 @@ def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img:
     # curved faces: the object under each labelled pixel, as the learner's example takes it
     cyl_conf, ell_conf = face_confidences(facts, "cylindrical"), face_confidences(facts, "elliptical")
     row["cyl_unocc"] = row["cyl_read"] = row["box_curved"] = row["cyl_ellipse"] = row["box_ellipse"] = 0
+    row["bowls"] = row["bowl_curved"] = 0
     for lab in labels:
+        if lab.shape == "bowl":
+            obj, _ = object_under(scene, lab.u, lab.v, shape)
+            row["bowls"] += 1
+            row["bowl_curved"] += obj is not None and any(f.surface != "plane" for f in obj.faces)
         if lab.shape not in ("cylinder", "box") or (lab.shape == "cylinder" and lab.partial):
             continue
         obj, _ = object_under(scene, lab.u, lab.v, shape)
@@ -385,6 +395,7 @@ def summarise(rows: list[dict], modality: str) -> dict:
         "ms_p90": float(np.percentile(ms, 90)) if ms else None,
         "labelled_found": _ratio(rows, "found", "labelled"),
         "cpu_ms_median": float(np.median(cpu)) if cpu else None,
+        "bowl_curved_frac": _ratio(rows, "bowl_curved", "bowls") if curved else None,
         "cylinder_elliptical_frac": _ratio(rows, "cyl_ellipse", "cyl_unocc") if elliptical else None,
         "box_elliptical_frac": _ratio(rows, "box_ellipse", "boxes") if elliptical else None,
     }

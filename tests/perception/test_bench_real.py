@@ -293,3 +293,15 @@ def test_cylinders_read_need_a_cylindrical_fact_of_0_7_and_boxes_count_any_curve
     weak = SceneFacts("s0", "depth", [Fact("cylindrical", ("s0_o2_f2",), 0.6)])
     assert bench.evaluate_frame(scene, weak, frame, labels, None)["cyl_read"] == 0
     assert bench.summarise([dict(row, ms=1.0)], "rgb")["cylinder_read_frac"] is None
+
+
+def test_bowls_read_as_curved_count_any_curved_face_of_the_object_under_the_pixel():
+    scene, facts, frame = _scene()
+    labels = [_lab(1, 10, 10, "bowl"), _lab(2, 50, 20, "bowl")]
+    row = bench.evaluate_frame(scene, facts, frame, labels, None)
+    assert (row["bowls"], row["bowl_curved"]) == (2, 0)
+    scene.objects[1].faces[0].surface = "sphere"   # a bowl's inside read as a sphere's
+    row = bench.evaluate_frame(scene, facts, frame, labels, None)
+    assert (row["bowls"], row["bowl_curved"]) == (2, 1)
+    assert bench.summarise([dict(row, ms=1.0)], "depth")["bowl_curved_frac"] == 0.5
+    assert bench.summarise([dict(row, ms=1.0)], "rgb")["bowl_curved_frac"] is None
