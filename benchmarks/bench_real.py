@@ -15,10 +15,10 @@ folders (pooled = counts added over all frames, not an average of the folders' f
 writes them as ``{"pooled": {MODALITY: {...}}, "folders": {NAME: {MODALITY: {...}}}}`` with the keys
 object_recall, merged_frac, split_frac, support_ok_frac, box_perpendicular_frac, box_overfaced_frac,
 cylinder_as_prism_frac, perpendicular_ece, cylinder_read_frac, box_curved_frac, ms_median, ms_p90 and the extra
-labelled_found, cpu_ms_median, bowl_curved_frac, cylinder_elliptical_frac and box_elliptical_frac; a figure a folder or modality
-cannot measure is null (recall and split without masks; support, every ``perpendicular`` figure and both
-curved-face figures under rgb, which has no planes and no curved faces; both elliptical figures under depth and
-rgbd, which do not say ``elliptical``).
+labelled_found, cpu_ms_median, bowl_curved_frac, cylinder_elliptical_frac and box_elliptical_frac; a figure a
+folder or modality cannot measure is null (recall and split without masks; support, every ``perpendicular``
+figure and the curved-face figures under rgb, which has no planes and no curved faces; both elliptical figures
+under depth and rgbd, which do not say ``elliptical``).
 
 Definitions
 -----------
