@@ -32,9 +32,10 @@ def test_a_fan_of_planes_on_a_can_is_one_cylinder():
     found = fan_cylinder(normals, [int(np.sum(plane_of == i)) for i in range(len(normals))], adj, pts, nrm,
                          plane_of, 0.005, 0.12)
     assert found is not None
-    cyl, on, fan = found
+    cyl, on, fan, side = found
     assert abs(cyl.radius - 0.04) < 0.002 and abs(abs(cyl.axis[1]) - 1) < 1e-3
     assert on.mean() > 0.9 and sorted(fan) == list(range(len(normals)))
+    assert side == 1.0  # a can's outside
 
 
 def test_two_faces_of_a_box_are_no_cylinder():

@@ -217,3 +217,18 @@ def test_unread_face_is_found_where_missing_readings_on_the_table_run_into_it():
     assert _unread(blotted, max_planes=0) == []
     ious = [_iou(rasterize(f.polygon, unread.shape), unread) for f in _unread(blotted)]
     assert max(ious, default=0.0) >= 0.8
+
+
+def test_a_rim_far_behind_the_object_is_no_face_of_it():
+    from lv3d.perception.depth import depth_scene
+
+    frame, _ = _grazing_cuboid()
+    dres = depth_scene(frame)
+    xyz = dres.grid.xyz[dres.objects[0].obj.mask].astype(np.float64)
+    z, extent = float(np.median(xyz[:, 2])), float(np.linalg.norm(np.percentile(xyz, 95, 0) - np.percentile(xyz, 5, 0)))
+    # the face depth did not read lies within the object's reach
+    assert len(_unread(frame, reach=(z, extent))) == 1
+    # the same rim behind an object that ends two of its extents nearer (a veil of mixed pixels from its edge to
+    # the background) is none
+    assert _unread(frame, reach=(z - 2 * extent, extent)) == []
+    assert len(_unread(frame, reach=(z - 2 * extent, extent), max_behind=3.0)) == 1

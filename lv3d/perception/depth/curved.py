@@ -146,11 +146,12 @@ def _normal_arc(cyl: Cylinder, nrm: np.ndarray) -> tuple[float, float]:
 
 def fan_cylinder(normals: list[np.ndarray], sizes: list[int], adjacency: list[tuple[int, int]],
                  pts: np.ndarray, nrm: np.ndarray, plane_of: np.ndarray, dist_m: float, extent_m: float,
-                 settings: CurvedSettings = DEFAULT) -> tuple[Cylinder, np.ndarray, list[int]] | None:
+                 settings: CurvedSettings = DEFAULT) -> tuple[Cylinder, np.ndarray, list[int], float] | None:
     """The cylindrical face of an object whose planes have unit ``normals`` (towards the camera), cell counts
     ``sizes`` and touching pairs ``adjacency``; ``pts`` (m, 3) metres and unit ``nrm`` (m, 3) are the object's
     cells (zero normal where unknown), ``plane_of`` (m,) the plane index of each cell (-1: none). Returns the
-    cylinder, the cells on it (m,) bool and the planes it replaces; None when no fan makes one."""
+    cylinder, the cells on it (m,) bool, the planes it replaces and the side the fan shows (:func:`facing`: 1 the
+    outside, -1 the inside); None when no fan makes one."""
     cos_step = np.cos(np.radians(settings.max_step_deg))
     parent = list(range(len(normals)))
 
@@ -194,7 +195,7 @@ def fan_cylinder(normals: list[np.ndarray], sizes: list[int], adjacency: list[tu
         arc, gap = _normal_arc(cyl, nrm[inl])
         if arc < settings.min_arc_deg or gap > settings.max_gap_deg:
             continue
-        return cyl, inl, fan
+        return cyl, inl, fan, side
     return None
 
 
@@ -311,9 +312,8 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
         fan = fan_cylinder([p.n for p in planes], [int(c) for c in plane_cells], list(adjacency), pts, nrm,
                            plane_of, dist_m, extent_m, settings)
         if fan is not None:
-            cyl, on, members = fan
+            cyl, on, members, side = fan
             on = largest_piece_on(on, box)
-            side = facing(cyl, nrm[on], pts[on]) if on.any() else 1.0
             if _stands(cyl, pts[on], nrm[on], None, dist_m, min_cells, settings, side):
                 out.append((cyl, on, sorted(set(members) | set(replaced(on)))))
                 free &= ~on

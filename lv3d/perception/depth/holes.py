@@ -129,7 +129,8 @@ class UnreadFace(NamedTuple):
 def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plane_masks: list[np.ndarray],
                  known: list[Plane], box: tuple[int, int, int, int], min_graze_deg: float = _UNREAD_DEG,
                  min_apart_deg: float = 20.0, min_on_plane: float = 0.6, max_on_object: float = 0.55,
-                 max_planes: int = 3, seed: int = 0) -> list[UnreadFace]:
+                 max_planes: int = 3, seed: int = 0, reach: tuple[float, float] | None = None,
+                 max_behind: float = 1.0) -> list[UnreadFace]:
     """Faces of one object that depth alone infers from the holes beside it where no colour confirms them: the
     readings stop at a face's own edges, on the object's neighbouring faces and on the table, so the points just
     outside a hole that is an unread face lie on the face's plane.
@@ -141,6 +142,10 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
     table's plane as its rim) and stands at least ``min_apart_deg`` from every plane in ``known`` (the object's
     planes and the support), and when the object makes at most ``max_on_object`` of what surrounds it (a face seen
     edge-on lies along the object's silhouette; a hole the object surrounds is a blob on one of its faces).
+    With ``reach`` (the median depth and the extent of the object's points, metres), a plane whose rim points lie
+    (median) farther behind the object's median depth than ``max_behind`` times its extent is no face of it: a
+    Kinect's veil of mixed pixels between an object's edge and the background, or the two sides of an occlusion
+    shadow, reach from the object's edge to the surface behind it, tens of centimetres away.
 
     A hole that runs into another (two faces seen edge-on side by side, or a face and a blob of missing readings)
     is not convex, or reaches the crop's border: up to ``max_planes`` planes are peeled off its rim, and each that
@@ -180,6 +185,8 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
         if np.degrees(np.arccos(min(1.0, abs(float(plane.n @ ray)) / float(np.linalg.norm(ray))))) < min_graze_deg:
             return None
         if any(angle_deg(plane, q) < min_apart_deg for q in known):
+            return None
+        if reach is not None and float(np.median(pts[inl, 2])) - reach[0] > max_behind * reach[1]:
             return None
         return plane, inl
 
