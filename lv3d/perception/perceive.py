@@ -153,7 +153,8 @@ def _unread(frame: RGBD, dres: DepthResult, o: DepthObjectResult, box: tuple[int
     ``object_px`` are the object's pixels."""
     known = [p.plane for p in o.planes] + ([dres.support] if dres.support is not None else [])
     pts = dres.grid.xyz[o.obj.mask].astype(np.float64)
-    reach = (float(np.median(pts[:, 2])), float(np.linalg.norm(np.percentile(pts, 95, axis=0) - np.percentile(pts, 5, axis=0))))
+    extent = float(np.linalg.norm(np.percentile(pts, 95, axis=0) - np.percentile(pts, 5, axis=0)))
+    reach = (float(np.median(pts[:, 2])), extent)  # a face of the object lies within it (holes.unread_faces)
     return unread_faces(frame.depth, dres.grid, object_px, [p.mask for p in o.planes], known, box, seed=seed,
                         reach=reach)
 
