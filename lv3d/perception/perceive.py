@@ -152,11 +152,9 @@ def _unread(frame: RGBD, dres: DepthResult, o: DepthObjectResult, box: tuple[int
     """The faces beside depth object ``o`` that depth did not read (holes.unread_faces), searched in ``box``, where
     ``object_px`` are the object's pixels."""
     known = [p.plane for p in o.planes] + ([dres.support] if dres.support is not None else [])
-    pts = dres.grid.xyz[o.obj.mask].astype(np.float64)
-    extent = float(np.linalg.norm(np.percentile(pts, 95, axis=0) - np.percentile(pts, 5, axis=0)))
-    reach = (float(np.median(pts[:, 2])), extent)  # a face of the object lies within it (holes.unread_faces)
+    # a face of the object lies within its reach: its median depth and extent (holes.unread_faces)
     return unread_faces(frame.depth, dres.grid, object_px, [p.mask for p in o.planes], known, box, seed=seed,
-                        reach=reach)
+                        reach=o.scale, settings=dres.settings.unread)
 
 
 def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[str, float]) -> list[SceneObject]:

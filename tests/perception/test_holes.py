@@ -1,5 +1,6 @@
 import cv2
 import numpy as np
+import pytest
 
 from lv3d.perception.edges import channel_edges, channels, edge_distance
 from lv3d.perception.depth.holes import hole_faces, hole_sizes
@@ -159,11 +160,13 @@ def test_face_depth_did_not_read_is_found_from_its_rim_with_its_plane_and_neighb
     assert sum(face.id in pair for pair in obj.adjacency) == 2
 
 
-def _unread(frame, **checks) -> list:
-    """holes.unread_faces beside the largest depth object of ``frame``."""
+def _unread(frame, reach=None, **checks) -> list:
+    """holes.unread_faces beside the largest depth object of ``frame``, ``checks`` overriding its UnreadSettings."""
+    from dataclasses import replace
+
     from lv3d.perception.boundary import grid_to_pixels
     from lv3d.perception.depth import depth_scene
-    from lv3d.perception.depth.holes import unread_faces
+    from lv3d.perception.depth.holes import UNREAD, unread_faces
 
     dres = depth_scene(frame)
     o = dres.objects[0]
@@ -171,7 +174,7 @@ def _unread(frame, **checks) -> list:
     box = (max(0, u0 - 14), max(0, v0 - 14), min(w, u1 + 14), min(h, v1 + 14))
     known = [p.plane for p in o.planes] + [dres.support]
     return unread_faces(frame.depth, dres.grid, grid_to_pixels(o.obj.mask, dres.grid.stride, box),
-                        [p.mask for p in o.planes], known, box, **checks)
+                        [p.mask for p in o.planes], known, box, reach=reach, settings=replace(UNREAD, **checks))
 
 
 def test_missing_readings_on_the_table_or_inside_a_face_are_no_face():
@@ -226,9 +229,29 @@ def test_a_rim_far_behind_the_object_is_no_face_of_it():
     dres = depth_scene(frame)
     xyz = dres.grid.xyz[dres.objects[0].obj.mask].astype(np.float64)
     z, extent = float(np.median(xyz[:, 2])), float(np.linalg.norm(np.percentile(xyz, 95, 0) - np.percentile(xyz, 5, 0)))
+    assert dres.objects[0].scale == pytest.approx((z, extent))  # the reach perceive passes
     # the face depth did not read lies within the object's reach
     assert len(_unread(frame, reach=(z, extent))) == 1
     # the same rim behind an object that ends two of its extents nearer (a veil of mixed pixels from its edge to
     # the background) is none
     assert _unread(frame, reach=(z - 2 * extent, extent)) == []
     assert len(_unread(frame, reach=(z - 2 * extent, extent), max_behind=3.0)) == 1
+
+
+def test_unread_settings_are_checked_and_perceive_takes_them_from_the_depth_stage(monkeypatch):
+    from dataclasses import replace
+
+    import lv3d.perception.depth.stage as stage
+    from lv3d.perception import perceive
+    from lv3d.perception.depth.holes import UnreadSettings
+
+    for bad in ({"min_graze_deg": 95.0}, {"min_on_plane": 1.5}, {"max_planes": -1}, {"max_behind": 0.0}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            UnreadSettings(**bad)
+    frame, _ = _grazing_cuboid()
+    assert len(perceive(frame, "depth").objects[0].faces) == 3  # two faces read, one inferred from its hole
+    # the depth stage's settings, as its result carries them, decide the unread faces too
+    defaults = list(stage.depth_scene.__defaults__)
+    defaults[-1] = replace(stage.DEFAULT, unread=UnreadSettings(max_planes=0, min_on_plane=1.0))
+    monkeypatch.setattr(stage.depth_scene, "__defaults__", tuple(defaults))
+    assert len(perceive(frame, "depth").objects[0].faces) == 2

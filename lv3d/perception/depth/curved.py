@@ -119,8 +119,9 @@ def facing(cyl: Cylinder, nrm: np.ndarray, pts: np.ndarray) -> float:
 
 
 def refine(pts: np.ndarray, nrm: np.ndarray) -> Cylinder | None:
-    """Least-squares cylinder through points (m, 3) with outward unit normals (m, 3): the axis is the direction
-    the normals are most nearly perpendicular to, the circle Kasa's fit to the points projected along it."""
+    """Least-squares cylinder through points (m, 3) with unit normals (m, 3), of its outside or its inside (the
+    normals' sign does not matter): the axis is the direction the normals are most nearly perpendicular to, the
+    circle Kasa's fit to the points projected along it."""
     _, vecs = np.linalg.eigh(nrm.T @ nrm)
     a, b1, b2 = axis_basis(vecs[:, 0])
     x, y = pts @ b1, pts @ b2

@@ -22,6 +22,7 @@ object's side of it (:func:`add_hole_faces`).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import cv2
@@ -52,6 +53,51 @@ _MIN_TOUCH = 4.0 / 800.0
 # a pixel's neighbourhood (px, not a scale): a band of a pixel or two between two regions drawn apart on the pixel
 # grid (rasterised outlines, a hole and the readings round it) is where they touch
 _RIM_PX = 2
+
+
+@dataclass(frozen=True)
+class UnreadSettings:
+    """When a hole beside an object is a face that depth alone did not read (:func:`unread_faces`).
+
+    ``min_graze_deg`` (degrees from face-on): the plane of the hole's rim must be seen at least this obliquely; a
+    RealSense reads to about 78 degrees, so a plane seen within 70 is one the sensor reads, and cannot be why
+    there is a hole.
+    ``min_apart_deg`` (degrees): the rim's plane must stand this far from every plane already known (the
+    object's and the support's): a hole on a face or on the table has that surface's plane as its rim.
+    ``min_on_plane`` (fraction of the rim's read pixels): the share that must lie on one plane; a face's
+    readings stop at its own edges, so most of its rim is on its plane.
+    ``max_on_object`` (fraction of the pixels around the hole): the object may make at most this share of what
+    surrounds the hole; a face seen edge-on lies along the silhouette, a hole the object surrounds is a blob on
+    one of its faces.
+    ``max_planes`` (planes): a hole that runs into another (two faces seen edge-on side by side) has this many
+    planes peeled off its rim at most.
+    ``max_behind`` (multiples of the object's extent): a rim plane whose readings lie (median) farther behind
+    the object's median depth than this is no face of it: a Kinect's veil of mixed pixels between an object's
+    edge and the background, or the two sides of an occlusion shadow, reach from the object's edge to the
+    surface behind it, tens of centimetres away, where a face of the object lies within its own size.
+    """
+
+    min_graze_deg: float = _UNREAD_DEG
+    min_apart_deg: float = 20.0
+    min_on_plane: float = 0.6
+    max_on_object: float = 0.55
+    max_planes: int = 3
+    max_behind: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("min_graze_deg", "min_apart_deg"):
+            if not 0 <= getattr(self, name) <= 90:
+                raise ValueError(f"{name} is an angle in [0, 90] degrees, got {getattr(self, name)!r}")
+        for name in ("min_on_plane", "max_on_object"):
+            if not 0 <= getattr(self, name) <= 1:
+                raise ValueError(f"{name} is a fraction in [0, 1], got {getattr(self, name)!r}")
+        if not isinstance(self.max_planes, int) or self.max_planes < 0:
+            raise ValueError(f"max_planes must be a whole number of at least 0, got {self.max_planes!r}")
+        if not self.max_behind > 0:
+            raise ValueError(f"max_behind is a positive multiple of the object's extent, got {self.max_behind!r}")
+
+
+UNREAD = UnreadSettings()
 
 
 def hole_sizes(shape: tuple[int, ...]) -> tuple[float, int, int]:
@@ -127,15 +173,14 @@ class UnreadFace(NamedTuple):
 
 
 def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plane_masks: list[np.ndarray],
-                 known: list[Plane], box: tuple[int, int, int, int], min_graze_deg: float = _UNREAD_DEG,
-                 min_apart_deg: float = 20.0, min_on_plane: float = 0.6, max_on_object: float = 0.55,
-                 max_planes: int = 3, seed: int = 0, reach: tuple[float, float] | None = None,
-                 max_behind: float = 1.0) -> list[UnreadFace]:
+                 known: list[Plane], box: tuple[int, int, int, int], seed: int = 0,
+                 reach: tuple[float, float] | None = None, settings: UnreadSettings = UNREAD) -> list[UnreadFace]:
     """Faces of one object that depth alone infers from the holes beside it where no colour confirms them: the
     readings stop at a face's own edges, on the object's neighbouring faces and on the table, so the points just
     outside a hole that is an unread face lie on the face's plane.
 
-    A hole of :func:`hole_regions` is taken for a face when at least ``min_on_plane`` of its rim points (read pixels
+    A hole of :func:`hole_regions` is taken for a face (thresholds: ``settings``, :class:`UnreadSettings`) when at
+    least ``min_on_plane`` of its rim points (read pixels
     within 2 px of it, at least the least rim of :func:`hole_sizes`) lie on one plane (RANSAC within the noise
     threshold of their depth) that is seen at ``min_graze_deg`` or more from face-on (a plane the sensor reads well
     cannot be the reason for a hole: a blob of missing readings on a face or on the table has that face's or the
@@ -156,6 +201,8 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
     the object's pixels in ``box`` = (u0, v0, u1, v1); ``plane_masks``: the object's planes' grid masks, for the
     planes each face meets (at least the least contact of :func:`hole_sizes` in rim points on a plane's mask).
     Polygons are in full-frame pixels."""
+    min_graze_deg, min_apart_deg, max_behind = settings.min_graze_deg, settings.min_apart_deg, settings.max_behind
+    min_on_plane, max_on_object, max_planes = settings.min_on_plane, settings.max_on_object, settings.max_planes
     min_area_px, min_rim, min_contact = hole_sizes(depth.shape)
     u0, v0, u1, v1 = box
     crop = depth[v0:v1, u0:u1]

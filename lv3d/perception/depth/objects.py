@@ -26,6 +26,14 @@ class DepthObject:
         return int(np.count_nonzero(self.mask))
 
 
+def object_scale(points: np.ndarray) -> tuple[float, float]:
+    """(median depth, extent) of an object's points (m, 3) metres: its extent is the length of the diagonal from
+    the 5th to the 95th percentile of each coordinate, a size a few flying points do not stretch. The depth stage
+    computes it once per object; the searches for curved faces and for unread faces scale with it."""
+    extent = float(np.linalg.norm(np.percentile(points, 95, axis=0) - np.percentile(points, 5, axis=0)))
+    return float(np.median(points[:, 2])), extent
+
+
 def border_contact(mask: np.ndarray) -> float:
     """Length of the mask's outline on the grid border over its whole outline length (grid cells)."""
     edge = np.count_nonzero(mask[0]) + np.count_nonzero(mask[-1]) + np.count_nonzero(mask[:, 0]) + \

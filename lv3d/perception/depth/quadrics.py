@@ -676,13 +676,14 @@ def leaves_room(mask: np.ndarray, nrm_box: np.ndarray, rows: np.ndarray, cols: n
 
 def quadric_faces(xyz: np.ndarray, mask: np.ndarray, nrm_box: np.ndarray, planes: list,
                   adjacency: list[tuple[int, int]], cell_rel: float, min_cells: int, seed: int,
-                  settings: QuadricSettings = DEFAULT, room: bool | None = None
+                  scale: tuple[float, float], settings: QuadricSettings = DEFAULT, room: bool | None = None
                   ) -> tuple[list, list[tuple[int, int]], list[QuadricFace], int]:
     """The depth stage's view of :func:`object_quadrics` for one object: ``xyz`` (h, w, 3) the grid's points,
     ``mask`` (h, w) the object's cells, ``nrm_box`` its normals on its bounding box of the grid, ``planes`` its
     DepthPlanes (each with a grid ``mask`` and a ``plane``) touching in pairs ``adjacency``, ``cell_rel`` a grid
-    cell's width as a fraction of the depth, ``min_cells`` the fewest cells of a face. The inlier distance is the
-    sensor's noise at the object's median depth (support.noise_threshold), as for cylinders. Returns the planes
+    cell's width as a fraction of the depth, ``min_cells`` the fewest cells of a face, ``scale`` the object's
+    median depth and extent (objects.object_scale). The inlier distance is the sensor's noise at the object's
+    median depth (support.noise_threshold), as for cylinders. Returns the planes
     kept and their adjacency, the faces (each one connected piece of cells no kept plane holds) and the count of
     fits that did not converge. ``room``: :func:`leaves_room` of the object where the caller already asked it."""
     from .planes import largest_piece
@@ -700,8 +701,7 @@ def quadric_faces(xyz: np.ndarray, mask: np.ndarray, nrm_box: np.ndarray, planes
     plane_of = np.full(len(pts), -1)
     for k, p in enumerate(planes):
         plane_of[p.mask[i0:i1, j0:j1][box]] = k
-    extent = float(np.linalg.norm(np.percentile(pts, 95, axis=0) - np.percentile(pts, 5, axis=0)))
-    z = float(np.median(pts[:, 2]))
+    z, extent = scale
     found = object_quadrics(pts, nrm, box, plane_of, [p.plane for p in planes], noise_threshold(z), extent,
                             cell_rel * z, min_cells, seed, settings)
     if not found.faces:

@@ -23,9 +23,10 @@ from .cloud import PointGrid, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
 from .creases import CreaseSettings, split_at_creases
 from .curved import CurvedFace, CurvedSettings, object_cylinders
+from .holes import UnreadSettings
 from .occlusion import OcclusionSettings, join_occluded
 from .quadrics import QuadricFace, QuadricSettings, leaves_room, quadric_faces
-from .objects import DepthObject, heavy_noise, segment_objects, support_band
+from .objects import DepthObject, heavy_noise, object_scale, segment_objects, support_band
 from .planes import DepthPlane, largest_piece, merge_coplanar, object_planes, plane_adjacency
 from .plane_outline import simplify_on_plane
 from ..polygons import merge_close_corners
@@ -62,6 +63,8 @@ class DepthSettings:
     ``curved``: a fan of planes read as one cylindrical face (curved.CurvedSettings).
     ``quadrics``: an object's sphere or cone side read as one face (quadrics.QuadricSettings).
     ``occlusion``: two pieces of one solid seen around an occluder joined (occlusion.OcclusionSettings).
+    ``unread``: the faces beside an object that depth did not read, inferred from the holes its readings leave
+    (holes.UnreadSettings; perceive asks it of each object).
     """
 
     max_objects: int = 24
@@ -80,6 +83,7 @@ class DepthSettings:
     curved: CurvedSettings = field(default_factory=CurvedSettings)
     quadrics: QuadricSettings = field(default_factory=QuadricSettings)
     occlusion: OcclusionSettings = field(default_factory=OcclusionSettings)
+    unread: UnreadSettings = field(default_factory=UnreadSettings)
 
     def __post_init__(self) -> None:
         if not isinstance(self.max_objects, int) or self.max_objects < 1:
@@ -98,7 +102,8 @@ MAX_OBJECTS = DEFAULT.max_objects
 @dataclass(frozen=True)
 class DepthObjectResult:
     """One object: its grid ``mask``, ``planes`` (largest first), their image ``polygons`` (None where the
-    mask gave none), ``adjacency`` (i, j) between planes, and the object's point centroid (metres)."""
+    mask gave none), ``adjacency`` (i, j) between planes, the object's point centroid (metres) and its ``scale``,
+    the median depth and the extent of its points (metres, objects.object_scale)."""
 
     obj: DepthObject
     planes: list[DepthPlane]
@@ -106,6 +111,7 @@ class DepthObjectResult:
     adjacency: list[tuple[int, int]]
     centroid_m: np.ndarray
     box_px: tuple[int, int, int, int]  # (u0, v0, u1, v1), end exclusive
+    scale: tuple[float, float]
     # curved faces (a can's side, a ball, a cone's side), not in ``planes``
     curved: list[CurvedFace | QuadricFace] = field(default_factory=list)
     curved_polygons: list[np.ndarray | None] = field(default_factory=list)
@@ -120,6 +126,7 @@ class DepthResult:
     timings_ms: dict[str, float] = field(default_factory=dict)
     dropped_objects: int = 0  # objects found beyond the cap (``max_objects``), smallest first
     unconverged_fits: int = 0  # sphere and cone least-squares fits that did not converge (no face came of them)
+    settings: DepthSettings = DEFAULT  # what the stages ran with
 
 
 def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | None = None,
@@ -164,13 +171,14 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
         # whether the planes leave room for a curved surface: asked once, of the planes both searches start from
         room = _room(o.mask, normals(o.mask), planes, adj, settings.quadrics)
         # a sphere or a cone first: the cylinder search would read a cone's side as a cylinder
+        scale = object_scale(grid.xyz[o.mask].astype(np.float64))
         planes, adj, quads, failed = quadric_faces(grid.xyz, o.mask, normals(o.mask), planes, adj,
                                                    stride / frame.intrinsics.fx, _plane_need(o, plane_args), seed + k,
-                                                   settings.quadrics, room=room)
+                                                   scale, settings.quadrics, room=room)
         unconverged += failed
         # (a sphere or a cone that replaced planes leaves others: the question is asked again of those)
         planes, adj, curved = _curved(grid, o, planes, adj, settings.curved, normals, stride / frame.intrinsics.fx,
-                                      _plane_need(o, plane_args), seed + k, settings.quadrics,
+                                      _plane_need(o, plane_args), seed + k, settings.quadrics, scale,
                                       room=None if quads else room)
         curved = quads + [c for c in curved if not any(np.any(c.mask & q.mask) for q in quads)]
         curved_adj = _touching(planes, curved, o.mask)
@@ -194,10 +202,10 @@ def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | 
         box = (int(j0 * stride), int(i0 * stride), min(w, int((j1 + 1) * stride)), min(h, int((i1 + 1) * stride)))
         curved_polys = [mask_polygon(c.mask, stride, (h, w), convex=False) for c in curved]
         results.append(DepthObjectResult(o, planes, polys, adj, grid.xyz[o.mask].mean(axis=0).astype(np.float64), box,
-                                         curved, curved_polys, curved_adj))
+                                         scale, curved, curved_polys, curved_adj))
     timings = {"cloud": (t1 - t0) * 1e3, "support": (t2 - t1) * 1e3, "objects": (t3 - t2) * 1e3,
                "planes": t_planes * 1e3, "boundary": t_boundary * 1e3}
-    return DepthResult(grid, support, results, timings, dropped, unconverged)
+    return DepthResult(grid, support, results, timings, dropped, unconverged, settings)
 
 
 def _touching(planes: list[DepthPlane], curved: list, mask: np.ndarray, reach: int = 2, min_contact: int = 4
@@ -266,10 +274,12 @@ def _room(mask: np.ndarray, nrm_box: np.ndarray, planes: list[DepthPlane], adj: 
 
 def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list[tuple[int, int]],
             settings: CurvedSettings, normals: _Normals, cell_rel: float, min_cells: int, seed: int, room_settings,
-            room: bool | None = None) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
+            scale: tuple[float, float], room: bool | None = None
+            ) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
     """The object's planes and their adjacency with the planes its cylindrical faces replace left out, and those
     faces (curved.object_cylinders); the inputs unchanged when there is none. ``cell_rel``: a grid cell's width as
-    a fraction of the depth (stride / fx); ``min_cells``: the fewest cells of a face, as of a plane. The sample
+    a fraction of the depth (stride / fx); ``min_cells``: the fewest cells of a face, as of a plane; ``scale``: the
+    object's median depth and extent (objects.object_scale). The sample
     consensus of cylinders runs only where the planes leave room for a curved surface (quadrics.leaves_room with
     ``room_settings``; ``room``: its answer where already known); the fan of planes always."""
     if not planes:
@@ -283,8 +293,7 @@ def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list
     plane_of = np.full(len(pts), -1)
     for k, p in enumerate(planes):
         plane_of[p.mask[i0:i1, j0:j1][box]] = k
-    extent = float(np.linalg.norm(np.percentile(pts, 95, axis=0) - np.percentile(pts, 5, axis=0)))
-    z = float(np.median(pts[:, 2]))
+    z, extent = scale
     if room is None:
         room = leaves_room(m, normals(m), rows, cols, planes, adj, room_settings)
     found = object_cylinders(pts, nrm, box, plane_of, [p.plane for p in planes], noise_threshold(z), extent, cell_rel * z,
