@@ -4,6 +4,7 @@
     .venv/bin/python -m benchmarks.bench_real ../shared/data/real/osd-learn --limit 5 --modalities depth,rgbd
     .venv/bin/python -m benchmarks.bench_real --json out/bench_real.json
     .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --seed 0,1,2     # pooled over perception seeds
+    .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --set stride=2   # depth settings other than the defaults
 
 A folder is in the real layout of ../shared/data/real/README.md: ``<frame>_rgb.*`` and ``<frame>_depth*`` images,
 ``intrinsics.json``, ``objects.csv`` (one row per labelled object: frame, object, a pixel u,v inside it, shape,
@@ -479,11 +480,44 @@ def write_overlay(path: Path, frame, scene, labels: list, label_img: np.ndarray 
     cv2.imwrite(str(path), cv2.cvtColor(img, cv2.COLOR_RGB2BGR))
 
 
+def depth_settings(overrides: list[str]):
+    """lv3d.perception.depth.DEFAULT with each ``KEY=VALUE`` of ``overrides`` (``--set``) applied: KEY a field of
+    DepthSettings (``stride``) or of one of its parts (``quadrics.fit_cells``), VALUE parsed as YAML. InputError
+    naming the key for an unknown key or a value the settings refuse."""
+    from dataclasses import fields, is_dataclass, replace
+
+    from lv3d.experiment.config import parse_override
+    from lv3d.perception.depth import DEFAULT
+
+    settings = DEFAULT
+    for text in overrides:
+        key, value = parse_override(text)
+        *path, name = key.split(".")
+        parts = [settings]
+        for p in path:
+            inner = getattr(parts[-1], p, None)
+            if not is_dataclass(inner):
+                raise InputError("--set", f"{key}: {p!r} is no part of the depth settings")
+            parts.append(inner)
+        if name not in {f.name for f in fields(parts[-1])}:
+            known = ", ".join(f.name for f in fields(parts[-1]))
+            raise InputError("--set", f"{key}: unknown setting {name!r}; known here: {known}")
+        try:
+            new = replace(parts[-1], **{name: value})
+            for outer, p in zip(reversed(parts[:-1]), reversed(path)):
+                new = replace(outer, **{p: new})
+        except (TypeError, ValueError) as e:
+            raise InputError("--set", f"{key}: {e}") from None
+        settings = new
+    return settings
+
+
 def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dict[str, list[dict]],
-               overlays: Path | None = None, seeds: tuple[int, ...] = (0,)) -> dict:
+               overlays: Path | None = None, seeds: tuple[int, ...] = (0,), settings=None) -> dict:
     """Perceive, ground and evaluate every frame (the first ``limit``) of ``folder`` in each modality, once per
     perception seed of ``seeds`` (perceive's: its sample consensus); the rows (one per frame, seed and modality)
-    are appended to ``rows[modality]``. With ``overlays``, each frame's overlay (:func:`write_overlay`) of the
+    are appended to ``rows[modality]``. ``settings``: the depth stage's (:func:`depth_settings`; default its own).
+    With ``overlays``, each frame's overlay (:func:`write_overlay`) of the
     first seed goes to ``overlays/<folder>/<frame>_<modality>.png``. Returns {modality: [rows of this folder]}."""
     from lv3d.describe import describe
     from lv3d.perception import perceive
@@ -494,15 +528,16 @@ def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dic
     frames = frames[:limit] if limit else frames
     mine: dict[str, list[dict]] = {m: [] for m in modalities}
     first = ff.load(frames[0])
+    extra = {} if settings is None else {"depth_settings": settings}
     for m in modalities:  # warm-up, not counted: JIT compilation and first-call costs
-        describe(perceive(first, m, scene_id="s000000", seed=seeds[0]), first)
+        describe(perceive(first, m, scene_id="s000000", seed=seeds[0], **extra), first)
     for i, name in enumerate(tqdm(frames, desc=folder.name, unit="frame", disable=None, leave=False)):
         frame = ff.load(name)
         label_img = ff.label_image(name, frame.shape)
         for seed in seeds:
             for m in modalities:
                 t, c = time.perf_counter(), time.process_time()
-                scene = perceive(frame, m, scene_id=f"s{i:06d}", seed=seed)
+                scene = perceive(frame, m, scene_id=f"s{i:06d}", seed=seed, **extra)
                 facts = describe(scene, frame)
                 ms, cpu_ms = 1e3 * (time.perf_counter() - t), 1e3 * (time.process_time() - c)
                 row = dict(evaluate_frame(scene, facts, frame, labels.get(name, []), label_img), ms=ms,
@@ -548,6 +583,9 @@ def main(argv=None) -> int:
                     help="perception's seed (its sample consensus; default 0, as lv3d extract); several (0,1,2) "
                          "perceive every frame once per seed and pool the counts over them, so that a figure is "
                          "not one draw of perception's chance")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a depth-stage setting other than its default (lv3d.perception.depth.DepthSettings; "
+                         "repeatable): stride=2, quadrics.fit_cells=400, unread.max_behind=2")
     ap.add_argument("--overlays", type=Path, metavar="DIR",
                     help="also write each frame's overlay (perceived faces, true masks and labelled pixels in white) "
                          "to DIR/<folder>/<frame>_<modality>.png")
@@ -560,6 +598,7 @@ def main(argv=None) -> int:
             raise InputError(REAL, "no folder with objects.csv (name folders on the command line)")
         for folder in folders:
             labelled_folder(folder)
+        settings = depth_settings(args.set) if args.set else None
     except InputError as e:
         print(f"bench_real.py: error: {e}", file=sys.stderr)
         return 2
@@ -580,10 +619,11 @@ def main(argv=None) -> int:
     pixels = "a perceived object's pixels: its segment (depth, rgbd), else the union of its faces' polygons (rgb)"
     seeds_text = "" if len(args.seed) == 1 else \
         f", each frame perceived once per seed {','.join(map(str, args.seed))} (counts pooled)"
+    seeds_text += "".join(f"; {t}" for t in args.set)
     t0 = time.perf_counter()
     for folder, name in zip(folders, names):
         try:
-            mine = run_folder(Path(folder), mods, args.limit, pooled_rows, args.overlays, args.seed)
+            mine = run_folder(Path(folder), mods, args.limit, pooled_rows, args.overlays, args.seed, settings)
         except InputError as e:
             print(f"bench_real.py: error: {e}", file=sys.stderr)
             return 2

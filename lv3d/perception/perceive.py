@@ -10,7 +10,7 @@ from ..errors import InputError
 from ..facts import MODALITIES, face_id, object_id
 from ..rgbd import RGBD
 from ..scene import Face, Scene, SceneObject
-from .depth import MAX_OBJECTS, DepthObjectResult, DepthResult, depth_scene
+from .depth import DEFAULT, MAX_OBJECTS, DepthObjectResult, DepthResult, DepthSettings, depth_scene
 from .boundary import grid_to_pixels
 from .fuse import fused_faces, largest_first
 from .depth.holes import UnreadFace, unread_faces
@@ -25,11 +25,12 @@ _CROP_MARGIN = 0.0175
 
 
 def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 0,
-             max_objects: int = MAX_OBJECTS) -> Scene:
+             max_objects: int = MAX_OBJECTS, depth_settings: DepthSettings = DEFAULT) -> Scene:
     """Objects and faces of ``frame`` as a system that sees ``modality`` ('rgb', 'depth', 'rgbd') finds them.
 
     At most ``max_objects`` objects found by depth are described (the largest); ``Scene.dropped_objects`` counts
-    the rest. Object ids are ``<scene>_o<k>`` and face ids ``<scene>_o<k>_f<j>``, k and j from 1, objects largest first.
+    the rest. ``depth_settings``: the depth stage's thresholds (depth.DepthSettings; its ``max_objects`` gives way
+    to the argument). Object ids are ``<scene>_o<k>`` and face ids ``<scene>_o<k>_f<j>``, k and j from 1, objects largest first.
     ``Scene.timings_ms`` holds the time of each stage. Deterministic for a given ``seed``."""
     if modality not in MODALITIES:
         raise InputError("--modality", f"unknown modality {modality!r}; choose one of {', '.join(MODALITIES)}")
@@ -40,7 +41,7 @@ def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 
         scene = Scene(scene_id, modality, frame.intrinsics, timings_ms={})
         scene.objects = _colour_objects(frame, scene_id, scene.timings_ms)
         return scene
-    dres = depth_scene(frame, seed=seed, max_objects=max_objects)
+    dres = depth_scene(frame, seed=seed, max_objects=max_objects, settings=depth_settings)
     scene = Scene(scene_id, modality, frame.intrinsics, support_plane=dres.support, timings_ms=dict(dres.timings_ms),
                   dropped_objects=dres.dropped_objects, unconverged_fits=dres.unconverged_fits)
     if modality == "depth":

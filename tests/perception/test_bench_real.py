@@ -206,7 +206,7 @@ def test_the_seed_reaches_perception_and_a_negative_one_stops_at_the_command_lin
     assert e.value.code == 2 and "--seed" in capsys.readouterr().err
     seen = []
 
-    def run_folder(folder, mods, limit, rows, overlays=None, seeds=(0,)):
+    def run_folder(folder, mods, limit, rows, overlays=None, seeds=(0,), settings=None):
         seen.append(seeds)
         return {m: [] for m in mods}
 
@@ -222,6 +222,31 @@ def test_the_seed_reaches_perception_and_a_negative_one_stops_at_the_command_lin
         with pytest.raises(SystemExit) as e:
             bench.main(["--seed", bad])
         assert e.value.code == 2 and "--seed" in capsys.readouterr().err
+
+
+def test_depth_settings_reach_perception_and_a_wrong_one_is_named(tmp_path, capsys, monkeypatch):
+    from lv3d.perception.depth import DEFAULT
+
+    s = bench.depth_settings(["stride=2", "quadrics.fit_cells=400", "unread.max_behind=2"])
+    assert (s.stride, s.quadrics.fit_cells, s.unread.max_behind) == (2, 400, 2)
+    assert s.curved == DEFAULT.curved and DEFAULT.stride == 1  # the rest, and the default, as they were
+    seen = []
+
+    def run_folder(folder, mods, limit, rows, overlays=None, seeds=(0,), settings=None):
+        seen.append(settings)
+        return {m: [] for m in mods}
+
+    monkeypatch.setattr(bench, "run_folder", run_folder)
+    monkeypatch.setattr(bench, "labelled_folder", lambda folder: None)
+    monkeypatch.setattr(bench, "summarise", lambda rows, m: {k: None for k in bench.KEYS + bench.EXTRA_KEYS})
+    bench.main([str(tmp_path), "--modalities", "depth", "--set", "stride=2"])
+    assert seen[-1].stride == 2 and "stride=2" in capsys.readouterr().out
+    bench.main([str(tmp_path), "--modalities", "depth"])
+    assert seen[-1] is None
+    for bad, said in (("strid=2", "unknown setting 'strid'"), ("stride=0", "stride must be"),
+                      ("nothing.x=1", "no part"), ("stride", "key=value")):
+        assert bench.main([str(tmp_path), "--set", bad]) == 2
+        assert said in capsys.readouterr().err
 
 
 @pytest.mark.real

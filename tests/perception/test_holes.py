@@ -238,11 +238,11 @@ def test_a_rim_far_behind_the_object_is_no_face_of_it():
     assert len(_unread(frame, reach=(z - 2 * extent, extent), max_behind=3.0)) == 1
 
 
-def test_unread_settings_are_checked_and_perceive_takes_them_from_the_depth_stage(monkeypatch):
+def test_unread_settings_are_checked_and_perceive_takes_them_from_the_depth_settings():
     from dataclasses import replace
 
-    import lv3d.perception.depth.stage as stage
     from lv3d.perception import perceive
+    from lv3d.perception.depth import DEFAULT
     from lv3d.perception.depth.holes import UnreadSettings
 
     for bad in ({"min_graze_deg": 95.0}, {"min_on_plane": 1.5}, {"max_planes": -1}, {"max_behind": 0.0}):
@@ -251,7 +251,5 @@ def test_unread_settings_are_checked_and_perceive_takes_them_from_the_depth_stag
     frame, _ = _grazing_cuboid()
     assert len(perceive(frame, "depth").objects[0].faces) == 3  # two faces read, one inferred from its hole
     # the depth stage's settings, as its result carries them, decide the unread faces too
-    defaults = list(stage.depth_scene.__defaults__)
-    defaults[-1] = replace(stage.DEFAULT, unread=UnreadSettings(max_planes=0, min_on_plane=1.0))
-    monkeypatch.setattr(stage.depth_scene, "__defaults__", tuple(defaults))
-    assert len(perceive(frame, "depth").objects[0].faces) == 2
+    strict = replace(DEFAULT, unread=UnreadSettings(max_planes=0, min_on_plane=1.0))
+    assert len(perceive(frame, "depth", depth_settings=strict).objects[0].faces) == 2

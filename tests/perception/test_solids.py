@@ -71,6 +71,8 @@ def test_depth_settings_are_checked_and_hold_at_any_image_size():
         DepthSettings(max_objects=0)
     with pytest.raises(ValueError, match="max_border"):
         DepthSettings(max_border=1.5)
+    with pytest.raises(ValueError, match="stride"):
+        DepthSettings(stride=0)
     counts = []
     for w, h in ((320, 240), (640, 480), (960, 720)):
         frame = render_scene("cube", 1, noise_config("clean", touching=1.0), w, h)[0]

@@ -38,6 +38,10 @@ from .support import noise_threshold
 class DepthSettings:
     """Thresholds of the depth stage, each with its unit and the reason for its value.
 
+    ``stride`` (pixels per grid cell, each way): the point grid reads every ``stride``-th pixel of each row and
+    column. 1, every pixel: on the Kinect table-top frames of the real dev set a grid of 2 gives the same objects,
+    faces and confidences at about half the time, but on the RealSense clutter frames it loses small cans and
+    cups (their sides come out as planes: docs/perception.md, "Speed").
     ``max_objects`` (objects): the most objects described, the largest; a table-top scene, clutter included,
     holds fewer, and every object costs grounding time. The scene counts the rest (``dropped_objects``).
     ``min_object_frac`` (fraction of the image's cells): the smallest object; below it a piece is a speck of
@@ -67,6 +71,7 @@ class DepthSettings:
     (holes.UnreadSettings; perceive asks it of each object).
     """
 
+    stride: int = 1
     max_objects: int = 24
     min_object_frac: float = 0.0002
     max_border: float = 0.12
@@ -86,6 +91,8 @@ class DepthSettings:
     unread: UnreadSettings = field(default_factory=UnreadSettings)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.stride, int) or self.stride < 1:
+            raise ValueError(f"stride must be a whole number of at least 1, got {self.stride!r}")
         if not isinstance(self.max_objects, int) or self.max_objects < 1:
             raise ValueError(f"max_objects must be a whole number of at least 1, got {self.max_objects!r}")
         for name in ("min_object_frac", "max_border", "regrow_frac", "plane_share", "noisy_plane_share",
@@ -129,12 +136,13 @@ class DepthResult:
     settings: DepthSettings = DEFAULT  # what the stages ran with
 
 
-def depth_scene(frame: RGBD, stride: int = 1, seed: int = 0, max_objects: int | None = None,
+def depth_scene(frame: RGBD, seed: int = 0, max_objects: int | None = None,
                 settings: DepthSettings = DEFAULT) -> DepthResult:
     """Run the depth stages on one frame; the ``settings.max_objects`` largest objects (``max_objects`` overrides
     it) are described, the number left out is ``dropped_objects``."""
     if max_objects is not None:
         settings = replace(settings, max_objects=max_objects)
+    stride = settings.stride
     t0 = time.perf_counter()
     grid = point_grid(frame.depth, frame.intrinsics, stride, normals=False)
     t1 = time.perf_counter()
