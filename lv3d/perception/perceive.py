@@ -10,7 +10,7 @@ from ..errors import InputError
 from ..facts import MODALITIES, face_id, object_id
 from ..rgbd import RGBD
 from ..scene import Face, Scene, SceneObject
-from .depth import DEFAULT, MAX_OBJECTS, DepthObjectResult, DepthResult, DepthSettings, depth_scene
+from .depth import DEFAULT, DepthObjectResult, DepthResult, DepthSettings, depth_scene
 from .boundary import grid_to_pixels
 from .fuse import fused_faces, largest_first
 from .depth.holes import UnreadFace, unread_faces
@@ -25,15 +25,17 @@ _CROP_MARGIN = 0.0175
 
 
 def perceive(frame: RGBD, modality: str, scene_id: str = "s000000", seed: int = 0,
-             max_objects: int = MAX_OBJECTS, depth_settings: DepthSettings = DEFAULT) -> Scene:
+             max_objects: int | None = None, depth_settings: DepthSettings = DEFAULT) -> Scene:
     """Objects and faces of ``frame`` as a system that sees ``modality`` ('rgb', 'depth', 'rgbd') finds them.
 
-    At most ``max_objects`` objects found by depth are described (the largest); ``Scene.dropped_objects`` counts
-    the rest. ``depth_settings``: the depth stage's thresholds (depth.DepthSettings; its ``max_objects`` gives way
-    to the argument). Object ids are ``<scene>_o<k>`` and face ids ``<scene>_o<k>_f<j>``, k and j from 1, objects largest first.
+    At most ``max_objects`` objects found by depth are described (the largest; default the depth settings'
+    ``max_objects``, 24); ``Scene.dropped_objects`` counts the rest. ``depth_settings``: the depth stage's
+    thresholds (depth.DepthSettings). Object ids are ``<scene>_o<k>`` and face ids ``<scene>_o<k>_f<j>``, k and j from 1, objects largest first.
     ``Scene.timings_ms`` holds the time of each stage. Deterministic for a given ``seed``."""
     if modality not in MODALITIES:
         raise InputError("--modality", f"unknown modality {modality!r}; choose one of {', '.join(MODALITIES)}")
+    if max_objects is None:
+        max_objects = depth_settings.max_objects
     if not isinstance(max_objects, int) or max_objects < 1:
         raise InputError("--max-objects", f"must be a whole number of at least 1, got {max_objects!r}")
     _check_frame(frame, modality)

@@ -62,6 +62,11 @@ def test_the_object_cap_is_an_option_and_counts_what_it_drops():
     assert perceive(frame, "depth").dropped_objects == 0
     with pytest.raises(InputError, match="max-objects"):
         perceive(frame, "depth", max_objects=0)
+    # without the argument, the depth settings' cap
+    from dataclasses import replace
+
+    from lv3d.perception.depth import DEFAULT
+    assert perceive(frame, "depth", depth_settings=replace(DEFAULT, max_objects=1)).dropped_objects == 1
 
 
 def test_depth_settings_are_checked_and_hold_at_any_image_size():

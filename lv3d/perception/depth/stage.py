@@ -39,9 +39,9 @@ class DepthSettings:
     """Thresholds of the depth stage, each with its unit and the reason for its value.
 
     ``stride`` (pixels per grid cell, each way): the point grid reads every ``stride``-th pixel of each row and
-    column. 1, every pixel: on the Kinect table-top frames of the real dev set a grid of 2 gives the same objects,
-    faces and confidences at about half the time, but on the RealSense clutter frames it loses small cans and
-    cups (their sides come out as planes: docs/perception.md, "Speed").
+    column. 1, every pixel: a grid of 2 takes about half the time, and on the Kinect table-top frames of the real
+    dev set it keeps the figures (one or two more round objects read as prisms), but on the RealSense clutter
+    frames small cans and cups lose their curvature (docs/perception.md, "Speed").
     ``max_objects`` (objects): the most objects described, the largest; a table-top scene, clutter included,
     holds fewer, and every object costs grounding time. The scene counts the rest (``dropped_objects``).
     ``min_object_frac`` (fraction of the image's cells): the smallest object; below it a piece is a speck of
@@ -103,7 +103,6 @@ class DepthSettings:
 
 
 DEFAULT = DepthSettings()
-MAX_OBJECTS = DEFAULT.max_objects
 
 
 @dataclass(frozen=True)
