@@ -200,24 +200,31 @@ def test_unknown_modality_stops_at_the_command_line(capsys):
     assert e.value.code == 2 and "choose among" in capsys.readouterr().err
 
 
-def test_the_seed_reaches_perception_and_a_negative_one_stops_at_the_command_line(tmp_path, capsys, monkeypatch):
-    with pytest.raises(SystemExit) as e:
-        bench.main(["--seed", "-1"])
-    assert e.value.code == 2 and "--seed" in capsys.readouterr().err
+def _stub_folders(monkeypatch) -> list:
+    """bench.main with folders and figures stubbed out: each folder's (seeds, depth settings) is appended to the
+    list returned."""
     seen = []
 
     def run_folder(folder, mods, limit, rows, overlays=None, seeds=(0,), settings=None):
-        seen.append(seeds)
+        seen.append((seeds, settings))
         return {m: [] for m in mods}
 
     monkeypatch.setattr(bench, "run_folder", run_folder)
     monkeypatch.setattr(bench, "labelled_folder", lambda folder: None)
     monkeypatch.setattr(bench, "summarise", lambda rows, m: {k: None for k in bench.KEYS + bench.EXTRA_KEYS})
+    return seen
+
+
+def test_the_seed_reaches_perception_and_a_negative_one_stops_at_the_command_line(tmp_path, capsys, monkeypatch):
+    with pytest.raises(SystemExit) as e:
+        bench.main(["--seed", "-1"])
+    assert e.value.code == 2 and "--seed" in capsys.readouterr().err
+    seen = _stub_folders(monkeypatch)
     bench.main([str(tmp_path), "--seed", "5", "--modalities", "depth"])
-    assert seen == [(5,)] and "per seed" not in capsys.readouterr().out
+    assert [s for s, _ in seen] == [(5,)] and "per seed" not in capsys.readouterr().out
     # several seeds: every frame perceived once per seed, the counts pooled (and the tables say so)
     bench.main([str(tmp_path), "--seed", "0,1,2", "--modalities", "depth"])
-    assert seen[-1] == (0, 1, 2) and "once per seed 0,1,2" in capsys.readouterr().out
+    assert seen[-1][0] == (0, 1, 2) and "once per seed 0,1,2" in capsys.readouterr().out
     for bad in ("1,1", "0,x"):
         with pytest.raises(SystemExit) as e:
             bench.main(["--seed", bad])
@@ -230,19 +237,11 @@ def test_depth_settings_reach_perception_and_a_wrong_one_is_named(tmp_path, caps
     s = bench.depth_settings(["stride=2", "quadrics.fit_cells=400", "unread.max_behind=2"])
     assert (s.stride, s.quadrics.fit_cells, s.unread.max_behind) == (2, 400, 2)
     assert s.curved == DEFAULT.curved and DEFAULT.stride == 1  # the rest, and the default, as they were
-    seen = []
-
-    def run_folder(folder, mods, limit, rows, overlays=None, seeds=(0,), settings=None):
-        seen.append(settings)
-        return {m: [] for m in mods}
-
-    monkeypatch.setattr(bench, "run_folder", run_folder)
-    monkeypatch.setattr(bench, "labelled_folder", lambda folder: None)
-    monkeypatch.setattr(bench, "summarise", lambda rows, m: {k: None for k in bench.KEYS + bench.EXTRA_KEYS})
+    seen = _stub_folders(monkeypatch)
     bench.main([str(tmp_path), "--modalities", "depth", "--set", "stride=2"])
-    assert seen[-1].stride == 2 and "stride=2" in capsys.readouterr().out
+    assert seen[-1][1].stride == 2 and "stride=2" in capsys.readouterr().out
     bench.main([str(tmp_path), "--modalities", "depth"])
-    assert seen[-1] is None
+    assert seen[-1][1] is None
     for bad, said in (("strid=2", "unknown setting 'strid'"), ("stride=0", "stride must be"),
                       ("nothing.x=1", "no part"), ("stride", "key=value")):
         assert bench.main([str(tmp_path), "--set", bad]) == 2
