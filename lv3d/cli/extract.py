@@ -61,7 +61,7 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
     k, scale = read_intrinsics(intrinsics, frame_name) if intrinsics is not None else (None, 0.001)
     frame = load_frame(color, depth if modality != "rgb" else None, k,
                        depth_scale if depth_scale is not None else scale, name=frame_name)
-    scene = perceive(frame, modality, scene_id=scene_id, **({"max_objects": max_objects} if max_objects else {}))
+    scene = perceive(frame, modality, scene_id=scene_id, max_objects=max_objects)
     if not scene.objects:
         raise InputError(color, "no object found in this frame")
     facts_obj = None
