@@ -502,6 +502,10 @@ def depth_settings(overrides: list[str]):
         if name not in {f.name for f in fields(parts[-1])}:
             known = ", ".join(f.name for f in fields(parts[-1]))
             raise InputError("--set", f"{key}: unknown setting {name!r}; known here: {known}")
+        was = getattr(parts[-1], name)
+        if not _same_kind(value, was):
+            raise InputError("--set", f"{key}: must be of type {type(was).__name__}, as its default {was!r}, "
+                                      f"got {value!r}")
         try:
             new = replace(parts[-1], **{name: value})
             for outer, p in zip(reversed(parts[:-1]), reversed(path)):
@@ -510,6 +514,16 @@ def depth_settings(overrides: list[str]):
             raise InputError("--set", f"{key}: {e}") from None
         settings = new
     return settings
+
+
+def _same_kind(value, default) -> bool:
+    """Whether ``value`` may stand for a setting whose default is ``default``: a bool for a bool, a whole number
+    (not a bool) for a whole number, any number (not a bool) for a float, else the default's own type."""
+    if isinstance(default, bool) or isinstance(value, bool):
+        return isinstance(value, bool) and isinstance(default, bool)
+    if isinstance(default, float):
+        return isinstance(value, (int, float))
+    return isinstance(value, type(default))
 
 
 def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dict[str, list[dict]],
