@@ -29,7 +29,7 @@ import numpy as np
 from ..rgbd import RGBD
 from ..scene import Face
 from .edges import channel_edges, channels, edge_distance, edge_support
-from .depth.holes import UnreadFace, add_hole_faces
+from .depth.holes import HOLES, HoleSettings, UnreadFace, add_hole_faces
 from .depth.quadrics import surface_fields
 from .polygons import area, rasterize
 
@@ -48,12 +48,13 @@ def colour_edge_distance(color: np.ndarray, box: tuple[int, int, int, int]) -> n
 
 
 def fused_faces(frame: RGBD, o, object_px: np.ndarray, box: tuple[int, int, int, int], unread: list[UnreadFace],
-                timings: dict[str, float]) -> tuple[list[Face], list[tuple[int, int]]]:
+                timings: dict[str, float], holes: HoleSettings = HOLES) -> tuple[list[Face], list[tuple[int, int]]]:
     """The faces of depth object ``o`` (depth.DepthObjectResult) under rgbd, and the pairs of them (indices) that
     share an edge: its planes and its cylindrical faces (each where its cells gave an outline), 'rgbd' where colour
     edges confirm the outline (``CONFIRMED_SUPPORT``) and 'depth' where not, then the faces depth could not read
     (holes.add_hole_faces, from ``unread``, the faces depth infers from holes beside the object, and colour's).
-    ``object_px``: the object's pixels in ``box`` = (u0, v0, u1, v1), the crop the colour edges are searched in.
+    ``object_px``: the object's pixels in ``box`` = (u0, v0, u1, v1), the crop the colour edges are searched in;
+    ``holes``: which regions without depth readings may be faces (holes.HoleSettings).
     The colour edges' time is added to ``timings['edges']``."""
     t0 = time.perf_counter()
     dist = colour_edge_distance(frame.color, box)
@@ -74,7 +75,7 @@ def fused_faces(frame: RGBD, o, object_px: np.ndarray, box: tuple[int, int, int,
     pairs |= {(index[i], curved[j]) for i, j in o.curved_adjacency if i in index and j in curved}
     masks = {i: rasterize(f.polygon - off, dist.shape) for i, f in enumerate(faces)}
     add_hole_faces(faces, pairs, list(masks), frame, box, object_px, dist, masks=masks, unread=unread,
-                   min_unread_support=CONFIRMED_SUPPORT)  # appends to faces and pairs
+                   min_unread_support=CONFIRMED_SUPPORT, settings=holes)  # appends to faces and pairs
     return faces, sorted({tuple(sorted(p)) for p in pairs})
 
 

@@ -157,7 +157,7 @@ def _unread(frame: RGBD, dres: DepthResult, o: DepthObjectResult, box: tuple[int
     known = [p.plane for p in o.planes] + ([dres.support] if dres.support is not None else [])
     # a face of the object lies within its reach: its median depth and extent (holes.unread_faces)
     return unread_faces(frame.depth, dres.grid, object_px, [p.mask for p in o.planes], known, box, seed=seed,
-                        reach=o.scale, settings=dres.settings.unread)
+                        reach=o.scale, settings=dres.settings.unread, holes=dres.settings.holes)
 
 
 def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[str, float]) -> list[SceneObject]:
@@ -173,7 +173,8 @@ def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[
         edges_before = timings["edges"]
         box = _crop_box(o, (h, w))
         object_px = grid_to_pixels(o.obj.mask, stride, box)
-        faces, pairs = fused_faces(frame, o, object_px, box, _unread(frame, dres, o, box, object_px, seed=k), timings)
+        faces, pairs = fused_faces(frame, o, object_px, box, _unread(frame, dres, o, box, object_px, seed=k), timings,
+                                   dres.settings.holes)
         order = largest_first(faces)
         rank = {i: r for r, i in enumerate(order)}
         for i in order:

@@ -30,6 +30,7 @@ from scipy import ndimage
 from ..distance import euclidean_distance
 from .cloud import PointGrid
 from .planes import DepthPlane
+from .ranges import check_ranges
 
 
 @dataclass(frozen=True)
@@ -56,6 +57,10 @@ class ConvexitySettings:
     max_gap_rel: float = 0.01
     band_frac: float = 0.08
     contact_frac: float = 0.05
+
+    def __post_init__(self) -> None:
+        check_ranges(self, angles=("concave_min_deg", "concave_tol_deg"),
+                     fractions=("max_gap_rel", "band_frac", "contact_frac"))
 
 
 DEFAULT = ConvexitySettings()

@@ -35,6 +35,7 @@ from skimage.segmentation import watershed
 
 from ..distance import euclidean_distance
 from .cloud import PointGrid
+from .ranges import check_ranges
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,10 @@ class CreaseSettings:
     inset_share: float = 0.5
     max_crease_frac: float = 0.15
     bend_deg: float = 22.5
+
+    def __post_init__(self) -> None:
+        check_ranges(self, angles=("crease_deg", "bend_deg"),
+                     fractions=("baseline_frac", "dynamics_frac", "crease_share", "inset_share", "max_crease_frac"))
 
 
 DEFAULT = CreaseSettings()

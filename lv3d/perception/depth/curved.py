@@ -35,6 +35,7 @@ from ...cylinder import Cylinder
 from ...plane import row_norms
 from ...sphere import algebraic_sphere
 from .planes import largest_piece_on
+from .ranges import check_ranges
 
 
 @dataclass(frozen=True)
@@ -86,6 +87,13 @@ class CurvedSettings:
     trials: int = 256
     score_cells: int = 800
     refits: int = 3
+
+    def __post_init__(self) -> None:
+        check_ranges(self, angles=("max_step_deg",), acute=("normal_deg",),
+                     fractions=("min_cover", "min_share", "plane_ratio", "min_dip"),
+                     arcs=("min_arc_deg", "max_gap_deg", "sample_arc_deg"),
+                     positive=("inlier_dists", "max_radius_frac", "min_radius_cells"),
+                     counts={"bin_cells": 1, "max_faces": 1, "trials": 1, "score_cells": 1, "refits": 0})
 
 
 DEFAULT = CurvedSettings()

@@ -34,25 +34,61 @@ from ...scene import Face
 from ..boundary import grow_convex
 from .cloud import PointGrid
 from ..edges import edge_support
+from .ranges import check_ranges
 from .face_plane import angle_deg
 from ..polygons import area, clockwise, drop_short_sides, rasterize
 from .support import noise_threshold, ransac_plane
 
 
-_FILL = (0.85, 1.15)  # region area over its polygon's area: a convex region that the polygon describes
 # a plane seen within this angle of face-on is one the sensor reads: a RealSense reads to about 78 degrees
 _UNREAD_DEG = 70.0
-# sizes as fractions of the image diagonal (d, px), so that a frame of another resolution takes the same holes;
-# at 640x480 (d = 800 px) they are 150 px, 30 px and 4 px. A hole that may be a face covers at least
-# _MIN_HOLE_AREA * d^2 px (a face seen edge-on is a strip a few px wide and tens long; smaller gaps are the
-# sensor's speckle); a hole's rim needs at least _MIN_RIM * d read pixels for a plane to be fitted to it; a face
-# meets another (and a hole touches a face) along at least _MIN_TOUCH * d px
-_MIN_HOLE_AREA = 150.0 / 800.0 ** 2
-_MIN_RIM = 30.0 / 800.0
-_MIN_TOUCH = 4.0 / 800.0
 # a pixel's neighbourhood (px, not a scale): a band of a pixel or two between two regions drawn apart on the pixel
 # grid (rasterised outlines, a hole and the readings round it) is where they touch
 _RIM_PX = 2
+
+
+@dataclass(frozen=True)
+class HoleSettings:
+    """Which regions without depth readings beside an object may be faces (:func:`hole_regions`), and when colour
+    takes one for a face (:func:`hole_faces`, :func:`add_hole_faces`). Sizes are fractions of the image diagonal
+    d (px), so that a frame of another resolution takes the same holes (at 640x480, d = 800 px).
+
+    ``min_area_frac`` (fraction of d squared): the least area of a hole that may be a face, 150 px at 640x480: a
+    face seen edge-on is a strip a few px wide and tens long; smaller gaps are the sensor's speckle.
+    ``min_rim_frac`` (fraction of d): the least read pixels around a hole for a plane to be fitted to them, 30 px.
+    ``min_touch_frac`` (fraction of d): a face meets another, and a hole touches a face, along at least this
+    many px, 4 px.
+    ``min_contact`` (fraction of the hole's outline): the share of it that must touch the object; a hole beside
+    the object, not a blob elsewhere in the crop.
+    ``min_fill`` / ``max_fill`` (ratio): the hole's area over its polygon's: a convex region that the polygon
+    describes.
+    ``min_support`` (fraction of the outline): the share of a hole's polygon on colour edges for colour to take it
+    for a face; a hole of missing readings on a plain surface has none along the part that crosses it.
+    ``max_taken`` (fraction of the hole's pixels): a hole the object's faces cover for more is a face found
+    already.
+    ``graze_deg`` (degrees from face-on): a face seen at least this obliquely, which a hole beside it continues,
+    is extended over the hole (the sensor read part of it); the sensor reads a plane seen within it.
+    """
+
+    min_area_frac: float = 150.0 / 800.0 ** 2
+    min_rim_frac: float = 30.0 / 800.0
+    min_touch_frac: float = 4.0 / 800.0
+    min_contact: float = 0.25
+    min_fill: float = 0.85
+    max_fill: float = 1.15
+    min_support: float = 0.55
+    max_taken: float = 0.3
+    graze_deg: float = _UNREAD_DEG
+
+    def __post_init__(self) -> None:
+        check_ranges(self, fractions=("min_area_frac", "min_rim_frac", "min_touch_frac", "min_contact", "min_fill",
+                                      "min_support", "max_taken"),
+                     positive=("max_fill",), acute=("graze_deg",))
+        if not self.min_fill <= self.max_fill:
+            raise ValueError(f"min_fill must not exceed max_fill, got {self.min_fill!r} and {self.max_fill!r}")
+
+
+HOLES = HoleSettings()
 
 
 @dataclass(frozen=True)
@@ -85,53 +121,44 @@ class UnreadSettings:
     max_behind: float = 1.0
 
     def __post_init__(self) -> None:
-        for name in ("min_graze_deg", "min_apart_deg"):
-            if not 0 <= getattr(self, name) <= 90:
-                raise ValueError(f"{name} is an angle in [0, 90] degrees, got {getattr(self, name)!r}")
-        for name in ("min_on_plane", "max_on_object"):
-            if not 0 <= getattr(self, name) <= 1:
-                raise ValueError(f"{name} is a fraction in [0, 1], got {getattr(self, name)!r}")
-        if not isinstance(self.max_planes, int) or self.max_planes < 0:
-            raise ValueError(f"max_planes must be a whole number of at least 0, got {self.max_planes!r}")
-        if not self.max_behind > 0:
-            raise ValueError(f"max_behind is a positive multiple of the object's extent, got {self.max_behind!r}")
+        check_ranges(self, acute=("min_graze_deg", "min_apart_deg"), fractions=("min_on_plane", "max_on_object"),
+                     counts={"max_planes": 0}, positive=("max_behind",))
 
 
 UNREAD = UnreadSettings()
 
 
-def hole_sizes(shape: tuple[int, ...]) -> tuple[float, int, int]:
+def hole_sizes(shape: tuple[int, ...], settings: HoleSettings = HOLES) -> tuple[float, int, int]:
     """(least hole area px, least read rim px, least contact px) for an image of ``shape`` (H, W, ...)."""
     d = float(np.hypot(shape[0], shape[1]))
-    return _MIN_HOLE_AREA * d * d, int(np.ceil(_MIN_RIM * d - 1e-9)), int(np.ceil(_MIN_TOUCH * d - 1e-9))
+    return (settings.min_area_frac * d * d, int(np.ceil(settings.min_rim_frac * d - 1e-9)),
+            int(np.ceil(settings.min_touch_frac * d - 1e-9)))
 
 
 def hole_faces(no_reading: np.ndarray, object_px: np.ndarray, edge_dist: np.ndarray, min_area_px: float,
-               min_contact: float = 0.25, min_support: float = 0.55,
-               fill: tuple[float, float] = _FILL) -> list[np.ndarray]:
+               settings: HoleSettings = HOLES) -> list[np.ndarray]:
     """Polygons (n, 2) pixels, clockwise, of the faces that are holes in the depth image, all in one crop.
 
     ``no_reading``: (H, W) bool, pixels without a depth reading; ``object_px``: (H, W) bool, the depth object's
     pixels; ``edge_dist``: (H, W) float, distance (px) to the nearest colour edge pixel; ``min_area_px``: the
-    least hole area (:func:`hole_sizes` of the whole image). A hole qualifies when
-    it is one of :func:`hole_regions` (``min_area_px``, ``min_contact``, ``fill``) and at least ``min_support`` of
-    its polygon's outline is on colour edges."""
-    return [poly for poly, _ in hole_regions(no_reading, object_px, min_area_px, min_contact, fill)
-            if edge_support(poly, edge_dist) >= min_support]
+    least hole area (:func:`hole_sizes` of the whole image). A hole qualifies when it is one of
+    :func:`hole_regions` and at least ``settings.min_support`` of its polygon's outline is on colour edges."""
+    return [poly for poly, _ in hole_regions(no_reading, object_px, min_area_px, settings)
+            if edge_support(poly, edge_dist) >= settings.min_support]
 
 
 def hole_regions(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float,
-                 min_contact: float = 0.25, fill: tuple[float, float] = _FILL) -> list[tuple[np.ndarray, np.ndarray]]:
+                 settings: HoleSettings = HOLES) -> list[tuple[np.ndarray, np.ndarray]]:
     """The holes in the depth image (H, W) that may be faces, as (polygon (n, 2) pixels clockwise, region (H, W)
     bool): connected regions of ``no_reading`` outside ``object_px`` (both (H, W) bool) of at least
-    ``min_area_px``, at least ``min_contact`` of whose outline pixels touch the object, not touching the crop's
-    border (the object or the hole is cut off there), whose area over their polygon's is within ``fill`` (a
-    convex region)."""
-    return _holes(no_reading, object_px, min_area_px, min_contact, fill)[0]
+    ``min_area_px``, at least ``settings.min_contact`` of whose outline pixels touch the object, not touching the
+    crop's border (the object or the hole is cut off there), whose area over their polygon's is within
+    ``settings.min_fill`` and ``max_fill`` (a convex region)."""
+    return _holes(no_reading, object_px, min_area_px, settings)[0]
 
 
-def _holes(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float, min_contact: float = 0.25,
-           fill: tuple[float, float] = _FILL) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[np.ndarray]]:
+def _holes(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float, settings: HoleSettings = HOLES
+           ) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[np.ndarray]]:
     """The regions of ``no_reading`` along the object as :func:`hole_regions` takes them, and the regions (H, W)
     bool it leaves (touching the crop's border, or not convex)."""
     h, w = no_reading.shape
@@ -145,12 +172,13 @@ def _holes(no_reading: np.ndarray, object_px: np.ndarray, min_area_px: float, mi
         m = lab[y:y + bh, x:x + bw] == k
         ring = m & ~cv2.erode(m.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
                               borderValue=0).astype(bool)
-        if np.count_nonzero(ring & near_obj[y:y + bh, x:x + bw]) < min_contact * max(1, np.count_nonzero(ring)):
+        touching = np.count_nonzero(ring & near_obj[y:y + bh, x:x + bw])
+        if touching < settings.min_contact * max(1, np.count_nonzero(ring)):
             continue
         poly = None if x == 0 or y == 0 or x + bw >= w or y + bh >= h else _outline(m)
         if poly is not None:
             poly += np.array([x, y], float)
-            if not fill[0] <= a / max(area(poly), 1e-9) <= fill[1]:
+            if not settings.min_fill <= a / max(area(poly), 1e-9) <= settings.max_fill:
                 poly = None
         region = lab == k
         if poly is None:
@@ -174,7 +202,8 @@ class UnreadFace(NamedTuple):
 
 def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plane_masks: list[np.ndarray],
                  known: list[Plane], box: tuple[int, int, int, int], seed: int = 0,
-                 reach: tuple[float, float] | None = None, settings: UnreadSettings = UNREAD) -> list[UnreadFace]:
+                 reach: tuple[float, float] | None = None, settings: UnreadSettings = UNREAD,
+                 holes: HoleSettings = HOLES) -> list[UnreadFace]:
     """Faces of one object that depth alone infers from the holes beside it where no colour confirms them: the
     readings stop at a face's own edges, on the object's neighbouring faces and on the table, so the points just
     outside a hole that is an unread face lie on the face's plane.
@@ -200,10 +229,10 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
     ``depth``: (H, W) metres (0 = no reading); ``grid``: its point grid; ``object_px``: (v1 - v0, u1 - u0) bool,
     the object's pixels in ``box`` = (u0, v0, u1, v1); ``plane_masks``: the object's planes' grid masks, for the
     planes each face meets (at least the least contact of :func:`hole_sizes` in rim points on a plane's mask).
-    Polygons are in full-frame pixels."""
+    ``holes``: which regions without readings may be faces. Polygons are in full-frame pixels."""
     min_graze_deg, min_apart_deg, max_behind = settings.min_graze_deg, settings.min_apart_deg, settings.max_behind
     min_on_plane, max_on_object, max_planes = settings.min_on_plane, settings.max_on_object, settings.max_planes
-    min_area_px, min_rim, min_contact = hole_sizes(depth.shape)
+    min_area_px, min_rim, min_contact = hole_sizes(depth.shape, holes)
     u0, v0, u1, v1 = box
     crop = depth[v0:v1, u0:u1]
     read = np.isfinite(crop) & (crop > 0)
@@ -243,7 +272,7 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
         return UnreadFace(poly + off, plane, pts, rms, meets)
 
     out = []
-    convex, merged = _holes(~read, object_px, min_area_px)
+    convex, merged = _holes(~read, object_px, min_area_px, holes)
     for poly, region in convex:
         r = rim(region)
         if r is None or len(r[3]) < min_rim:
@@ -266,7 +295,7 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
             plane, inl = found
             hull = np.zeros(read.shape, np.uint8)
             cv2.fillPoly(hull, [cv2.convexHull(np.stack([uu[inl], vv[inl]], axis=1).astype(np.int32))], 1)
-            part = hole_regions(region & hull.astype(bool), object_px, min_area_px)
+            part = hole_regions(region & hull.astype(bool), object_px, min_area_px, holes)
             if len(part) == 1 and rim(part[0][1]) is not None:
                 known = known + [plane]
                 out.append(face(part[0][0], plane, pts[inl], ij[:, inl]))
@@ -276,8 +305,8 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
 
 def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[int], frame: RGBD,
                    box: tuple[int, int, int, int], object_px: np.ndarray, edge_dist: np.ndarray,
-                   max_taken: float = 0.3, masks: dict[int, np.ndarray] | None = None, unread: list[UnreadFace] = (),
-                   min_unread_support: float = 0.5) -> list[int]:
+                   masks: dict[int, np.ndarray] | None = None, unread: list[UnreadFace] = (),
+                   min_unread_support: float = 0.5, settings: HoleSettings = HOLES) -> list[int]:
     """The faces depth has no reading of, appended to ``faces``: first the ``unread`` faces (:func:`unread_faces`,
     full-frame polygons, each with the plane through its rim) whose outline lies on colour edges for at least
     ``min_unread_support`` of its length, with provenance 'rgbd'; then the holes whose outline colour edges confirm
@@ -288,8 +317,8 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
     ``masks``: the ``keep`` faces' masks in that crop when the caller has them already (index -> (H, W) bool;
     updated in place), else they are drawn here.
 
-    A hole that the kept faces cover for at most ``max_taken`` of its pixels is a face beside them; otherwise a
-    face there was found already."""
+    A hole that the kept faces cover for at most ``settings.max_taken`` of its pixels is a face beside them;
+    otherwise a face there was found already (``settings``: :class:`HoleSettings`)."""
     u0, v0, u1, v1 = box
     depth = frame.depth[v0:v1, u0:u1]
     no_reading = ~(np.isfinite(depth) & (depth > 0))
@@ -305,16 +334,17 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
     # it crosses the table. One that colour confirms comes first: it has a plane, a colour hole there has none
     found = [(u.polygon - off, Face("", u.polygon, "rgbd", plane=u.plane, points=u.points, plane_rms_m=u.rms_m))
              for u in unread if edge_support(u.polygon - off, edge_dist) >= min_unread_support]
-    min_area_px, _, touch = hole_sizes(frame.shape)
-    found += [(poly, Face("", poly + off, "rgb")) for poly in hole_faces(no_reading, object_px, edge_dist, min_area_px)]
+    min_area_px, _, touch = hole_sizes(frame.shape, settings)
+    found += [(poly, Face("", poly + off, "rgb"))
+              for poly in hole_faces(no_reading, object_px, edge_dist, min_area_px, settings)]
     for poly, face in found:
         hole = rasterize(poly, shape)
         a = max(1, np.count_nonzero(hole))
         cover = {i: np.count_nonzero(hole & m) for i, m in masks.items()}
-        if sum(cover.values()) > max_taken * a:
+        if sum(cover.values()) > settings.max_taken * a:
             continue  # a face there was found already
         grown = cv2.dilate(hole.astype(np.uint8), np.ones((2 * _RIM_PX + 1, 2 * _RIM_PX + 1), np.uint8)).astype(bool)
-        if face.plane is None and _extend(faces, masks, hole, grown, off, touch):
+        if face.plane is None and _extend(faces, masks, hole, grown, off, touch, settings):
             continue
         new = len(faces)
         faces.append(face)
@@ -325,15 +355,15 @@ def add_hole_faces(faces: list[Face], pairs: set[tuple[int, int]], keep: list[in
 
 
 def _extend(faces: list[Face], masks: dict[int, np.ndarray], hole: np.ndarray, grown: np.ndarray, off: np.ndarray,
-            touch: int, min_graze_deg: float = _UNREAD_DEG, fill: tuple[float, float] = _FILL) -> bool:
+            touch: int, settings: HoleSettings = HOLES) -> bool:
     """Extends over ``hole`` (a region without readings, crop pixels; ``grown``: it dilated) the one face it touches
-    (along ``touch`` px or more) whose plane is seen at ``min_graze_deg`` or more from face-on, when the two make
-    one convex region (their union over its hull's area within ``fill``): the sensor read that face on part of it
-    only, and the hole is the rest of it, not a face of its own. Updates the face's polygon and ``masks`` in place;
-    True when it did."""
+    (along ``touch`` px or more) whose plane is seen at ``settings.graze_deg`` or more from face-on, when the two
+    make one convex region (their union over its hull's area within ``settings.min_fill`` and ``max_fill``): the
+    sensor read that face on part of it only, and the hole is the rest of it, not a face of its own. Updates the
+    face's polygon and ``masks`` in place; True when it did."""
     touching = [i for i, m in masks.items() if np.count_nonzero(grown & m) >= touch]
     grazing = [i for i in touching if faces[i].plane is not None and faces[i].points is not None
-               and len(faces[i].points) and _graze_deg(faces[i]) >= min_graze_deg]
+               and len(faces[i].points) and _graze_deg(faces[i]) >= settings.graze_deg]
     if len(grazing) != 1:
         return False
     i = grazing[0]
@@ -341,7 +371,7 @@ def _extend(faces: list[Face], masks: dict[int, np.ndarray], hole: np.ndarray, g
     # the closing fills the rim of a pixel or two the two outlines may leave between them
     union = cv2.morphologyEx(union.astype(np.uint8), cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8)).astype(bool)
     poly = _outline(union)
-    if poly is None or not fill[0] <= np.count_nonzero(union) / max(area(poly), 1e-9) <= fill[1]:
+    if poly is None or not settings.min_fill <= np.count_nonzero(union) / max(area(poly), 1e-9) <= settings.max_fill:
         return False
     faces[i].polygon = poly + off
     masks[i] = rasterize(poly, hole.shape)

@@ -15,6 +15,7 @@ import numpy as np
 
 from .objects import DepthObject
 from .planes import DepthPlane
+from .ranges import check_ranges
 from .support import noise_threshold
 
 
@@ -32,6 +33,9 @@ class OcclusionSettings:
     coplanar_deg: float = 8.0
     hidden_share: float = 0.8
     samples: int = 64
+
+    def __post_init__(self) -> None:
+        check_ranges(self, acute=("coplanar_deg",), fractions=("hidden_share",), counts={"samples": 1})
 
 
 DEFAULT = OcclusionSettings()

@@ -36,6 +36,7 @@ from .curved import axis_basis, axis_terms
 from .curved import explained_share as _share
 from .curved import plane_ms
 from .planes import largest_piece_on
+from .ranges import check_ranges
 
 
 @dataclass(frozen=True)
@@ -114,11 +115,12 @@ class QuadricSettings:
     fit_cells: int = 800
 
     def __post_init__(self) -> None:
-        for name in ("min_share", "min_cone_share", "plane_ratio", "max_radius_frac", "min_dip", "min_cover",
-                     "free_share"):
-            v = getattr(self, name)
-            if not 0 <= v <= 1:
-                raise ValueError(f"{name} is a fraction in [0, 1], got {v!r}")
+        check_ranges(self, fractions=("min_share", "min_cone_share", "plane_ratio", "max_radius_frac", "min_dip",
+                                      "min_cover", "free_share"),
+                     acute=("normal_deg", "normal_fit_deg"), angles=("min_spread_deg", "max_step_deg"),
+                     arcs=("min_arc_deg", "bin_deg"), positive=("inlier_dists", "min_radius_cells"),
+                     counts={"max_flat_faces": 0, "max_faces": 1, "trials": 1, "score_cells": 1, "refits": 0,
+                             "fit_cells": 1})
         if not 0 < self.min_half_angle_deg < self.max_half_angle_deg < 90:
             raise ValueError("half-angles must satisfy 0 < min_half_angle_deg < max_half_angle_deg < 90, got "
                              f"{self.min_half_angle_deg!r} and {self.max_half_angle_deg!r}")

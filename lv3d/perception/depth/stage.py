@@ -23,8 +23,9 @@ from .cloud import PointGrid, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
 from .creases import CreaseSettings, split_at_creases
 from .curved import CurvedFace, CurvedSettings, object_cylinders
-from .holes import UnreadSettings
+from .holes import HoleSettings, UnreadSettings
 from .occlusion import OcclusionSettings, join_occluded
+from .ranges import check_ranges
 from .quadrics import QuadricFace, QuadricSettings, leaves_room, quadric_faces
 from .objects import DepthObject, heavy_noise, object_scale, segment_objects, support_band
 from .planes import DepthPlane, largest_piece, merge_coplanar, object_planes, plane_adjacency
@@ -69,6 +70,8 @@ class DepthSettings:
     ``occlusion``: two pieces of one solid seen around an occluder joined (occlusion.OcclusionSettings).
     ``unread``: the faces beside an object that depth did not read, inferred from the holes its readings leave
     (holes.UnreadSettings; perceive asks it of each object).
+    ``holes``: which regions without readings beside an object may be faces, for those and for the faces colour
+    confirms under rgbd (holes.HoleSettings).
     """
 
     stride: int = 1
@@ -89,17 +92,12 @@ class DepthSettings:
     quadrics: QuadricSettings = field(default_factory=QuadricSettings)
     occlusion: OcclusionSettings = field(default_factory=OcclusionSettings)
     unread: UnreadSettings = field(default_factory=UnreadSettings)
+    holes: HoleSettings = field(default_factory=HoleSettings)
 
     def __post_init__(self) -> None:
-        if not isinstance(self.stride, int) or self.stride < 1:
-            raise ValueError(f"stride must be a whole number of at least 1, got {self.stride!r}")
-        if not isinstance(self.max_objects, int) or self.max_objects < 1:
-            raise ValueError(f"max_objects must be a whole number of at least 1, got {self.max_objects!r}")
-        for name in ("min_object_frac", "max_border", "regrow_frac", "plane_share", "noisy_plane_share",
-                     "plane_max_frac", "plane_min_frac", "support_stand_rel", "support_inner"):
-            v = getattr(self, name)
-            if not 0 <= v <= 1:
-                raise ValueError(f"{name} is a fraction in [0, 1], got {v!r}")
+        check_ranges(self, counts={"stride": 1, "max_objects": 1}, positive=("seed_bands",),
+                     fractions=("min_object_frac", "max_border", "regrow_frac", "plane_share", "noisy_plane_share",
+                                "plane_max_frac", "plane_min_frac", "support_stand_rel", "support_inner"))
 
 
 DEFAULT = DepthSettings()
@@ -178,7 +176,8 @@ def depth_scene(frame: RGBD, seed: int = 0, max_objects: int | None = None,
         # whether the planes leave room for a curved surface: asked once, of the planes both searches start from
         room = _room(o.mask, normals(o.mask), planes, adj, settings.quadrics)
         # a sphere or a cone first: the cylinder search would read a cone's side as a cylinder
-        scale = object_scale(grid.xyz[o.mask].astype(np.float64))
+        own = grid.xyz[o.mask]  # the object's points, (m, 3) metres
+        scale = object_scale(own.astype(np.float64))
         planes, adj, quads, failed = quadric_faces(grid.xyz, o.mask, normals(o.mask), planes, adj,
                                                    stride / frame.intrinsics.fx, _plane_need(o, plane_args), seed + k,
                                                    scale, settings.quadrics, room=room)
@@ -208,7 +207,7 @@ def depth_scene(frame: RGBD, seed: int = 0, max_objects: int | None = None,
         (i0, j0), (i1, j1) = ij.min(axis=0), ij.max(axis=0)
         box = (int(j0 * stride), int(i0 * stride), min(w, int((j1 + 1) * stride)), min(h, int((i1 + 1) * stride)))
         curved_polys = [mask_polygon(c.mask, stride, (h, w), convex=False) for c in curved]
-        results.append(DepthObjectResult(o, planes, polys, adj, grid.xyz[o.mask].mean(axis=0).astype(np.float64), box,
+        results.append(DepthObjectResult(o, planes, polys, adj, own.mean(axis=0).astype(np.float64), box,
                                          scale, curved, curved_polys, curved_adj))
     timings = {"cloud": (t1 - t0) * 1e3, "support": (t2 - t1) * 1e3, "objects": (t3 - t2) * 1e3,
                "planes": t_planes * 1e3, "boundary": t_boundary * 1e3}
