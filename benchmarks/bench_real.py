@@ -5,6 +5,7 @@
     .venv/bin/python -m benchmarks.bench_real --json out/bench_real.json
     .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --seed 0,1,2     # pooled over perception seeds
     .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --set stride=2   # depth settings other than the defaults
+    .venv/bin/python -m benchmarks.bench_real --objects out/objects.csv               # and a row per labelled object
 
 A folder is in the real layout of ../shared/data/real/README.md: ``<frame>_rgb.*`` and ``<frame>_depth*`` images,
 ``intrinsics.json``, ``objects.csv`` (one row per labelled object: frame, object, a pixel u,v inside it, shape,
@@ -103,6 +104,15 @@ Loading the images and computing the figures are not timed. ``cpu_ms_median`` (a
 median CPU time of the same work (time.process_time): on a busy machine the wall clock counts the waits for a
 core, the CPU time does not.
 
+``--objects FILE`` writes what the figures count, object by object: one CSV row per labelled object, folder,
+modality and seed, with what perception made of it (found, merged and with which labelled objects, the IoU of its
+perceived object with its mask, its faces by surface, the best ``perpendicular`` confidence of an adjacent pair,
+the best ``cylindrical`` and ``elliptical`` confidence) and the verdict of each figure that counts it (yes/no;
+empty where the figure does not count it, e.g. ``box_perpendicular`` for a partial box). A figure is its
+verdicts' yes over yes + no, summed over rows; the objects a figure misses on are its rows with the verdict its
+target does not want (no for ``box_perpendicular`` and ``cylinder_read``, yes for ``box_overfaced``, ``as_prism``
+and ``box_curved``).
+
 Targets (issue 39; pooled over the dev folders, depth and rgbd each): object recall >= 0.90, merged <= 0.05,
 split: none, support right on every frame (1.0), box perpendicular >= 0.90, boxes with > 3 faces <= 0.10,
 cylinders as prisms <= 0.10, perpendicular ECE <= 0.10, median <= 100 ms for rgbd. Issue 40: cylinders read
@@ -121,6 +131,7 @@ if __name__ == "__main__":  # one core: before numpy, OpenCV, JAX and torch star
     os.environ.setdefault("JAX_PLATFORMS", "cpu")
 
 import argparse
+import csv
 import json
 import sys
 import time
@@ -136,7 +147,7 @@ from lv3d.calibrate.real import BOX_PERP, PRISM_PERP, ROUND, SHAPES, perpendicul
 from lv3d.errors import InputError
 from lv3d.facts import MODALITIES, PREDICATES
 from lv3d.frame_folder import FrameFolder, LabelledObject
-from lv3d.object_facts import HOLD_SHARE, face_cover, held_object, merged_flags, object_under, region_pixels
+from lv3d.object_facts import HOLD_SHARE, face_cover, held_object, holds, merged_flags, object_under, region_pixels
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -293,9 +304,81 @@ def face_confidences(facts, pred: str) -> dict[str, float]:
     return out
 
 
+def _surfaces(obj) -> str:
+    """An object's faces by surface, e.g. ``plane*3+cylinder*1`` (planes first, then by name)."""
+    kinds: dict[str, int] = {}
+    for f in obj.faces:
+        kinds[f.surface] = kinds.get(f.surface, 0) + 1
+    order = sorted(kinds, key=lambda k: (k != "plane", k))
+    return "+".join(f"{k}*{kinds[k]}" for k in order)
+
+
+# the record keys a modality can only fill when it can say the predicate (summarise's null figures)
+_MEASURED_BY = {"perpendicular": ("best_perpendicular", "box_perpendicular", "as_prism"),
+                "cylindrical": ("cylindrical", "cylinder_read", "box_curved", "bowl_curved"),
+                "elliptical": ("elliptical", "cylinder_elliptical", "box_elliptical")}
+
+
+def object_records(scene, facts, frame, labels: list[LabelledObject], label_img: np.ndarray | None,
+                   held: list[int | None], masks: list[np.ndarray], merged: list[bool],
+                   pairs: list[list[float]]) -> list[dict]:
+    """One record per labelled object: what perception made of it (module docstring's definitions). Each verdict
+    is None where the figure does not count the object (a partial box for ``box_perpendicular``, a box for
+    ``as_prism``, ...) or the modality cannot measure it (``perpendicular`` under rgb, ...), so that the verdicts
+    summed over the records of a folder are the figures' counts. Its
+    perceived object is the one holding its pixel (``held``) for found, merged, iou, faces, surfaces,
+    best_perpendicular and the box and prism verdicts, and the one under its pixel as the learner's example takes
+    it (object_under) for the curved-face figures, as in the figures."""
+    shape = frame.depth.shape
+    cyl_conf = face_confidences(facts, "cylindrical")
+    ell_conf = face_confidences(facts, "elliptical")
+    regions = [region_pixels(lab, label_img) for lab in labels]
+    out = []
+    for i, (lab, k) in enumerate(zip(labels, held)):
+        obj = None if k is None else scene.objects[k]
+        rec: dict = {"frame": lab.frame, "object": lab.object, "shape": lab.shape, "partial": lab.partial,
+                     "stacked": lab.stacked, "found": k is not None, "merged": merged[i],
+                     "merged_with": ";".join(str(labels[j].object) for j in range(len(labels))
+                                             if j != i and k is not None and holds(masks[k], regions[j])),
+                     "iou": None, "faces": None if obj is None else len(obj.faces),
+                     "surfaces": None if obj is None else _surfaces(obj),
+                     "best_perpendicular": max(pairs[k]) if k is not None and pairs[k] else None,
+                     "cylindrical": None, "elliptical": None, "box_perpendicular": None, "box_overfaced": None,
+                     "as_prism": None, "cylinder_read": None, "box_curved": None, "bowl_curved": None,
+                     "cylinder_elliptical": None, "box_elliptical": None}
+        if label_img is not None and obj is not None and np.any(label_img == lab.object):
+            gt = label_img == lab.object
+            rec["iou"] = float(np.count_nonzero(gt & masks[k]) / np.count_nonzero(gt | masks[k]))
+        if lab.shape == "box":
+            rec["box_overfaced"] = obj is not None and len(obj.faces) > BOX_MAX_FACES
+            if not lab.partial:
+                rec["box_perpendicular"] = obj is not None and any(c >= BOX_PERP for c in pairs[k])
+        if lab.shape in ROUND:
+            rec["as_prism"] = obj is not None and any(c >= PRISM_PERP for c in pairs[k])
+        if lab.shape in ("cylinder", "box", "bowl"):
+            under, _ = object_under(scene, lab.u, lab.v, shape)
+            faces = [] if under is None else under.faces
+            rec["cylindrical"] = max((cyl_conf.get(f.id, 0.0) for f in faces), default=0.0)
+            rec["elliptical"] = max((ell_conf.get(f.id, 0.0) for f in faces), default=0.0)
+            if lab.shape == "bowl":
+                rec["bowl_curved"] = any(f.surface != "plane" for f in faces)
+            elif lab.shape == "box":
+                rec["box_curved"] = any(f.surface == "cylinder" for f in faces)
+                rec["box_elliptical"] = rec["elliptical"] >= ELL_READ
+            elif not lab.partial:
+                rec["cylinder_read"] = rec["cylindrical"] >= CYL_READ
+                rec["cylinder_elliptical"] = rec["elliptical"] >= ELL_READ
+        for pred, keys in _MEASURED_BY.items():
+            if scene.modality not in PREDICATES[pred][1]:
+                rec.update(dict.fromkeys(keys))
+        out.append(rec)
+    return out
+
+
 def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img: np.ndarray | None) -> dict:
     """Counts of one frame and modality (no perception here: ``scene`` and ``facts`` are given), summed over
-    frames by :func:`summarise`. ``frame`` supplies the depth and intrinsics; ``label_img`` the masks or None."""
+    frames by :func:`summarise`, and the per-object records they count (``objects``: :func:`object_records`).
+    ``frame`` supplies the depth and intrinsics; ``label_img`` the masks or None."""
     shape = frame.depth.shape
     for lab in labels:
         if not (0 <= lab.u < shape[1] and 0 <= lab.v < shape[0]):
@@ -327,36 +410,22 @@ def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img:
 
     perp = {tuple(f.args): f.conf for f in facts.facts if f.pred == "perpendicular"}
     pairs = [pair_confidences(o, perp) for o in scene.objects]
-    boxes = [(lab, k) for lab, k in zip(labels, held) if lab.shape == "box"]
-    rounds = [(lab, k) for lab, k in zip(labels, held) if lab.shape in ROUND]
-    row["boxes"] = len(boxes)
-    row["box_over"] = sum(k is not None and len(scene.objects[k].faces) > BOX_MAX_FACES for _, k in boxes)
-    row["box_unocc"] = sum(not lab.partial for lab, _ in boxes)
-    row["box_perp"] = sum(not lab.partial and k is not None and any(c >= BOX_PERP for c in pairs[k])
-                          for lab, k in boxes)
-    row["round"] = len(rounds)
-    row["round_prism"] = sum(k is not None and any(c >= PRISM_PERP for c in pairs[k]) for _, k in rounds)
+    records = object_records(scene, facts, frame, labels, label_img, held, masks, merged, pairs)
+    row["objects"] = records
+    # denominators from the labels, numerators from the records' verdicts (None, a figure the modality cannot
+    # measure, counts as no: summarise leaves that figure null)
+    row["boxes"] = sum(lab.shape == "box" for lab in labels)
+    row["box_unocc"] = sum(lab.shape == "box" and not lab.partial for lab in labels)
+    row["round"] = sum(lab.shape in ROUND for lab in labels)
+    row["cyl_unocc"] = sum(lab.shape == "cylinder" and not lab.partial for lab in labels)
+    row["bowls"] = sum(lab.shape == "bowl" for lab in labels)
+    for key, verdict_key in (("box_over", "box_overfaced"), ("box_perp", "box_perpendicular"),
+                             ("round_prism", "as_prism"), ("cyl_read", "cylinder_read"), ("box_curved", "box_curved"),
+                             ("bowl_curved", "bowl_curved"), ("cyl_ellipse", "cylinder_elliptical"),
+                             ("box_ellipse", "box_elliptical")):
+        row[key] = sum(r[verdict_key] is True for r in records)
     # calibration pairs: each perceived object once, with one truth; merged objects left out
     truth = perpendicular_truth(labels, held, merged)
-    # curved faces: the object under each labelled pixel, as the learner's example takes it
-    cyl_conf, ell_conf = face_confidences(facts, "cylindrical"), face_confidences(facts, "elliptical")
-    row["cyl_unocc"] = row["cyl_read"] = row["box_curved"] = row["cyl_ellipse"] = row["box_ellipse"] = 0
-    row["bowls"] = row["bowl_curved"] = 0
-    for lab in labels:
-        if lab.shape == "bowl":
-            obj, _ = object_under(scene, lab.u, lab.v, shape)
-            row["bowls"] += 1
-            row["bowl_curved"] += obj is not None and any(f.surface != "plane" for f in obj.faces)
-        if lab.shape not in ("cylinder", "box") or (lab.shape == "cylinder" and lab.partial):
-            continue
-        obj, _ = object_under(scene, lab.u, lab.v, shape)
-        if lab.shape == "cylinder":
-            row["cyl_unocc"] += 1
-            row["cyl_read"] += obj is not None and any(cyl_conf.get(f.id, 0.0) >= CYL_READ for f in obj.faces)
-        else:
-            row["box_curved"] += obj is not None and any(f.surface == "cylinder" for f in obj.faces)
-        ellipse = obj is not None and any(ell_conf.get(f.id, 0.0) >= ELL_READ for f in obj.faces)
-        row["cyl_ellipse" if lab.shape == "cylinder" else "box_ellipse"] += ellipse
     row["pairs_p"], row["pairs_y"] = [], []
     for k, y in sorted(truth.items()):
         row["pairs_p"] += pairs[k]
@@ -404,6 +473,33 @@ def summarise(rows: list[dict], modality: str) -> dict:
 
 
 # ---------------------------------------------------------------------------------------------- output
+
+
+# --objects: one row per labelled object, folder, modality and seed (object_records' keys, in this order)
+OBJECT_COLUMNS = ("folder", "frame", "object", "shape", "partial", "stacked", "modality", "seed", "found", "merged",
+                  "merged_with", "iou", "faces", "surfaces", "best_perpendicular", "cylindrical", "elliptical",
+                  "box_perpendicular", "box_overfaced", "as_prism", "cylinder_read", "box_curved", "bowl_curved",
+                  "cylinder_elliptical", "box_elliptical")
+
+
+def write_objects(path: Path, records: list[dict]) -> None:
+    """The per-object records as CSV (``OBJECT_COLUMNS``): booleans as yes/no, confidences and IoU to 3 decimals,
+    empty where a record has no value (the figure does not count the object, or nothing was found)."""
+    def cell(v):
+        if v is None:
+            return ""
+        if isinstance(v, (bool, np.bool_)):
+            return "yes" if v else "no"
+        if isinstance(v, float):
+            return f"{v:.3f}"
+        return v
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(OBJECT_COLUMNS)
+        for rec in records:
+            w.writerow([cell(rec[c]) for c in OBJECT_COLUMNS])
 
 
 def verdict(key: str, modality: str, value: float | None) -> str:
@@ -600,6 +696,9 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="a depth-stage setting other than its default (lv3d.perception.depth.DepthSettings; "
                          "repeatable): stride=2, quadrics.fit_cells=400, unread.max_behind=2")
+    ap.add_argument("--objects", type=Path, metavar="FILE",
+                    help="also write one CSV row per labelled object, folder, modality and seed: what perception "
+                         "made of it and the verdict of every figure that counts it (OBJECT_COLUMNS)")
     ap.add_argument("--overlays", type=Path, metavar="DIR",
                     help="also write each frame's overlay (perceived faces, true masks and labelled pixels in white) "
                          "to DIR/<folder>/<frame>_<modality>.png")
@@ -619,9 +718,10 @@ def main(argv=None) -> int:
     if args.overlays is not None and args.overlays.exists() and not args.overlays.is_dir():
         print(f"bench_real.py: error: {args.overlays}: is a file; --overlays names a folder", file=sys.stderr)
         return 2
-    if args.json is not None and args.json.is_dir():
-        print(f"bench_real.py: error: {args.json}: is a folder; --json names a file", file=sys.stderr)
-        return 2
+    for opt, path in (("--json", args.json), ("--objects", args.objects)):
+        if path is not None and path.is_dir():
+            print(f"bench_real.py: error: {path}: is a folder; {opt} names a file", file=sys.stderr)
+            return 2
 
     _one_core()
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
@@ -630,6 +730,7 @@ def main(argv=None) -> int:
     mods = args.modalities
     pooled_rows: dict[str, list[dict]] = {m: [] for m in mods}
     result: dict = {"pooled": {}, "folders": {}}
+    records: list[dict] = []
     pixels = "a perceived object's pixels: its segment (depth, rgbd), else the union of its faces' polygons (rgb)"
     seeds_text = "" if len(args.seed) == 1 else \
         f", each frame perceived once per seed {','.join(map(str, args.seed))} (counts pooled)"
@@ -641,6 +742,8 @@ def main(argv=None) -> int:
         except InputError as e:
             print(f"bench_real.py: error: {e}", file=sys.stderr)
             return 2
+        records += [{"folder": name, "modality": m, "seed": r["seed"], **rec}
+                    for m in mods for r in mine[m] for rec in r["objects"]]
         figures = {m: summarise(mine[m], m) for m in mods}
         result["folders"][name] = {m: {k: figures[m][k] for k in KEYS + EXTRA_KEYS} for m in mods}
         any_rows = [r for r in mine[mods[0]] if r["seed"] == args.seed[0]]  # each frame once
@@ -659,6 +762,8 @@ def main(argv=None) -> int:
     if args.json is not None:
         args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps(result, indent=1) + "\n")
+    if args.objects is not None:
+        write_objects(args.objects, records)
     return 0
 
 

@@ -154,6 +154,46 @@ def test_a_frame_counts_each_labelled_object_once_and_the_figures_follow():
     assert f["ms_median"] == 100.0 and f["labelled_found"] == 0.75
 
 
+def test_each_labelled_object_has_a_record_whose_verdicts_sum_to_the_frame_counts(tmp_path):
+    scene, facts, frame = _scene()
+    scene.objects[1].faces[1].surface = "cylinder"
+    facts = SceneFacts("s0", "depth", list(facts.facts) + [Fact("cylindrical", ("s0_o2_f2",), 0.8)])
+    labels = [_lab(1, 10, 10, "box"), _lab(2, 50, 20, "cylinder"), _lab(3, 78, 58, "bowl"),
+              _lab(4, 30, 10, "box", partial=True)]
+    label = np.zeros((H, W), np.uint16)
+    label[_mask(2, 2, 20, 30)] = 1
+    label[_mask(45, 5, 75, 40)] = 2
+    label[_mask(70, 50, 79, 59)] = 3
+    label[_mask(21, 2, 35, 20)] = 4
+    row = bench.evaluate_frame(scene, facts, frame, labels, label)
+    box, cyl, bowl, part = row["objects"]
+    assert [r["object"] for r in row["objects"]] == [1, 2, 3, 4]
+    assert box["found"] and box["merged"] and box["merged_with"] == "4" and part["merged_with"] == "1"
+    assert box["faces"] == 3 and box["surfaces"] == "plane*3" and box["best_perpendicular"] == 0.9
+    assert box["box_perpendicular"] is True and part["box_perpendicular"] is None  # a partial box is not counted
+    assert box["box_overfaced"] is False and box["as_prism"] is None and box["box_curved"] is False
+    assert box["iou"] == pytest.approx(19 * 29 / (19 * 19 + 15 * 19 + 19 * 10))  # its mask: two of its three faces
+    assert cyl["surfaces"] == "plane*1+cylinder*1" and cyl["as_prism"] is True and cyl["cylinder_read"] is True
+    assert cyl["cylindrical"] == 0.8 and cyl["box_perpendicular"] is None
+    assert not bowl["found"] and bowl["faces"] is None and bowl["iou"] is None and bowl["bowl_curved"] is False
+    assert (row["box_perp"], row["box_unocc"], row["round_prism"], row["round"]) == (1, 1, 1, 2)
+    assert (row["cyl_read"], row["cyl_unocc"], row["bowl_curved"], row["bowls"]) == (1, 1, 0, 1)
+
+    rgb_scene, rgb_facts, _ = _scene("rgb")
+    rgb = bench.evaluate_frame(rgb_scene, rgb_facts, frame, labels, label)["objects"][0]
+    assert rgb["found"] and rgb["box_overfaced"] is False
+    assert rgb["box_perpendicular"] is None and rgb["best_perpendicular"] is None  # colour alone has no planes
+    assert rgb["box_curved"] is None and rgb["box_elliptical"] is False
+
+    out = tmp_path / "sub" / "objects.csv"
+    bench.write_objects(out, [{"folder": "f", "modality": "depth", "seed": 0, **r} for r in row["objects"]])
+    lines = out.read_text().splitlines()
+    assert lines[0] == ",".join(bench.OBJECT_COLUMNS) and len(lines) == 5
+    first = dict(zip(bench.OBJECT_COLUMNS, lines[1].split(",")))
+    assert (first["found"], first["box_perpendicular"], first["as_prism"], first["best_perpendicular"]) == \
+        ("yes", "yes", "", "0.900")
+
+
 def test_ece_pools_box_and_cylinder_pairs_and_rgb_leaves_plane_figures_null():
     scene, facts, frame = _scene()
     labels = [_lab(1, 10, 10, "box"), _lab(2, 50, 20, "cylinder")]
@@ -229,6 +269,15 @@ def test_the_seed_reaches_perception_and_a_negative_one_stops_at_the_command_lin
         with pytest.raises(SystemExit) as e:
             bench.main(["--seed", bad])
         assert e.value.code == 2 and "--seed" in capsys.readouterr().err
+
+
+def test_objects_names_a_file_not_a_folder(tmp_path, capsys, monkeypatch):
+    _stub_folders(monkeypatch)
+    assert bench.main([str(tmp_path), "--modalities", "depth", "--objects", str(tmp_path)]) == 2
+    assert "--objects names a file" in capsys.readouterr().err
+    out = tmp_path / "o.csv"
+    assert bench.main([str(tmp_path), "--modalities", "depth", "--objects", str(out)]) == 0
+    assert out.read_text().splitlines() == [",".join(bench.OBJECT_COLUMNS)]  # no frame, no object
 
 
 def test_depth_settings_reach_perception_and_a_wrong_one_is_named(tmp_path, capsys, monkeypatch):
