@@ -320,19 +320,18 @@ _MEASURED_BY = {"perpendicular": ("best_perpendicular", "box_perpendicular", "as
 
 
 def object_records(scene, facts, frame, labels: list[LabelledObject], label_img: np.ndarray | None,
-                   held: list[int | None], masks: list[np.ndarray], merged: list[bool],
-                   pairs: list[list[float]]) -> list[dict]:
+                   held: list[int | None], masks: list[np.ndarray], regions: list[tuple[np.ndarray, np.ndarray]],
+                   merged: list[bool], pairs: list[list[float]]) -> list[dict]:
     """One record per labelled object: what perception made of it (module docstring's definitions). Each verdict
     is None where the figure does not count the object (a partial box for ``box_perpendicular``, a box for
     ``as_prism``, ...) or the modality cannot measure it (``perpendicular`` under rgb, ...), so that the verdicts
-    summed over the records of a folder are the figures' counts. Its
-    perceived object is the one holding its pixel (``held``) for found, merged, iou, faces, surfaces,
-    best_perpendicular and the box and prism verdicts, and the one under its pixel as the learner's example takes
-    it (object_under) for the curved-face figures, as in the figures."""
+    summed over the records of a folder are the figures' counts. Its perceived object is the one holding its
+    pixel (``held``) for found, merged, iou, faces, surfaces, best_perpendicular and the box and prism verdicts,
+    and the one under its pixel as the learner's example takes it (object_under) for the curved-face figures, as
+    in the figures. ``held``, ``masks``, ``regions``, ``merged`` and ``pairs`` are :func:`evaluate_frame`'s."""
     shape = frame.depth.shape
     cyl_conf = face_confidences(facts, "cylindrical")
     ell_conf = face_confidences(facts, "elliptical")
-    regions = [region_pixels(lab, label_img) for lab in labels]
     out = []
     for i, (lab, k) in enumerate(zip(labels, held)):
         obj = None if k is None else scene.objects[k]
@@ -410,7 +409,7 @@ def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img:
 
     perp = {tuple(f.args): f.conf for f in facts.facts if f.pred == "perpendicular"}
     pairs = [pair_confidences(o, perp) for o in scene.objects]
-    records = object_records(scene, facts, frame, labels, label_img, held, masks, merged, pairs)
+    records = object_records(scene, facts, frame, labels, label_img, held, masks, regions, merged, pairs)
     row["objects"] = records
     # denominators from the labels, numerators from the records' verdicts (None, a figure the modality cannot
     # measure, counts as no: summarise leaves that figure null)
