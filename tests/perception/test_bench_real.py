@@ -127,15 +127,20 @@ def _scene(modality="depth"):
     return scene, SceneFacts("s0", modality, facts), frame
 
 
+def _labelled():
+    """Labels and masks for :func:`_scene`: box 1, cylinder 2, a bowl 3 where nothing was found, and a partial box 4
+    lying on box 1's perceived object."""
+    labels = [_lab(1, 10, 10, "box"), _lab(2, 50, 20, "cylinder"), _lab(3, 78, 58, "bowl"),
+              _lab(4, 30, 10, "box", partial=True)]
+    label = np.zeros((H, W), np.uint16)
+    for k, rect in enumerate([(2, 2, 20, 30), (45, 5, 75, 40), (70, 50, 79, 59), (21, 2, 35, 20)], start=1):
+        label[_mask(*rect)] = k
+    return labels, label
+
+
 def test_a_frame_counts_each_labelled_object_once_and_the_figures_follow():
     scene, facts, frame = _scene()
-    labels = [_lab(1, 10, 10, "box"), _lab(2, 50, 20, "cylinder"), _lab(3, 78, 58, "bowl"),
-              _lab(4, 30, 10, "box", partial=True)]  # the bowl is not found; box 4 lies on box 1's object
-    label = np.zeros((H, W), np.uint16)
-    label[_mask(2, 2, 20, 30)] = 1
-    label[_mask(45, 5, 75, 40)] = 2
-    label[_mask(70, 50, 79, 59)] = 3
-    label[_mask(21, 2, 35, 20)] = 4
+    labels, label = _labelled()
     row = bench.evaluate_frame(scene, facts, frame, labels, label)
     assert (row["labelled"], row["found"]) == (4, 3)
     assert row["merged"] == 2          # boxes 1 and 4 share one perceived object
@@ -158,13 +163,7 @@ def test_each_labelled_object_has_a_record_whose_verdicts_sum_to_the_frame_count
     scene, facts, frame = _scene()
     scene.objects[1].faces[1].surface = "cylinder"
     facts = SceneFacts("s0", "depth", list(facts.facts) + [Fact("cylindrical", ("s0_o2_f2",), 0.8)])
-    labels = [_lab(1, 10, 10, "box"), _lab(2, 50, 20, "cylinder"), _lab(3, 78, 58, "bowl"),
-              _lab(4, 30, 10, "box", partial=True)]
-    label = np.zeros((H, W), np.uint16)
-    label[_mask(2, 2, 20, 30)] = 1
-    label[_mask(45, 5, 75, 40)] = 2
-    label[_mask(70, 50, 79, 59)] = 3
-    label[_mask(21, 2, 35, 20)] = 4
+    labels, label = _labelled()
     row = bench.evaluate_frame(scene, facts, frame, labels, label)
     box, cyl, bowl, part = row["objects"]
     assert [r["object"] for r in row["objects"]] == [1, 2, 3, 4]
