@@ -1,5 +1,6 @@
 """The real-frame benchmark's figures on tiny hand-made scenes and masks, and its command line."""
 
+import csv
 import json
 from pathlib import Path
 
@@ -303,8 +304,9 @@ def test_one_osd_frame_end_to_end_writes_every_figure(tmp_path, capsys):
     osd = OSD
     if not (osd / "objects.csv").is_file():
         pytest.skip(f"real OSD frames not found at {osd} (../shared/data/real/osd-learn)")
-    out = tmp_path / "bench.json"
-    assert bench.main([str(osd), "--limit", "1", "--modalities", "depth", "--json", str(out)]) == 0
+    out, objects = tmp_path / "bench.json", tmp_path / "objects.csv"
+    assert bench.main([str(osd), "--limit", "1", "--modalities", "depth", "--json", str(out),
+                       "--objects", str(objects)]) == 0
     d = json.loads(out.read_text())
     keys = set(bench.KEYS) | set(bench.EXTRA_KEYS)
     assert set(d) == {"pooled", "folders"} and set(d["folders"]) == {"osd-learn"}
@@ -313,6 +315,15 @@ def test_one_osd_frame_end_to_end_writes_every_figure(tmp_path, capsys):
     assert set(fig) == keys
     assert fig["object_recall"] is not None and fig["ms_median"] > 0 and fig["cylinder_as_prism_frac"] is None
     assert "object_recall" in capsys.readouterr().out
+    # a row per labelled object of the frame, whose verdicts give the figures
+    rows = list(csv.DictReader(objects.open()))
+    first = FrameFolder(osd).frames[0]
+    labelled = [lab for lab in FrameFolder(osd).labels(bench.SHAPES).get(first, [])]
+    assert [int(r["object"]) for r in rows] == [lab.object for lab in labelled]
+    assert {r["frame"] for r in rows} == {first} and {r["modality"] for r in rows} == {"depth"}
+    perp = [r["box_perpendicular"] for r in rows if r["box_perpendicular"]]
+    assert fig["box_perpendicular_frac"] == pytest.approx(perp.count("yes") / len(perp))
+    assert fig["labelled_found"] == pytest.approx([r["found"] for r in rows].count("yes") / len(rows))
 
 
 def test_objects_csv_naming_a_missing_frame_stops_before_any_work(tmp_path, capsys):
