@@ -412,7 +412,8 @@ def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img:
     records = object_records(scene, facts, frame, labels, label_img, held, masks, regions, merged, pairs)
     row["objects"] = records
     # denominators from the labels, numerators from the records' verdicts (None, a figure the modality cannot
-    # measure, counts as no: summarise leaves that figure null)
+    # measure, counts as no: summarise leaves that figure null; a verdict may be a numpy bool, so it is tested, not
+    # compared with True)
     row["boxes"] = sum(lab.shape == "box" for lab in labels)
     row["box_unocc"] = sum(lab.shape == "box" and not lab.partial for lab in labels)
     row["round"] = sum(lab.shape in ROUND for lab in labels)
@@ -422,7 +423,7 @@ def evaluate_frame(scene, facts, frame, labels: list[LabelledObject], label_img:
                              ("round_prism", "as_prism"), ("cyl_read", "cylinder_read"), ("box_curved", "box_curved"),
                              ("bowl_curved", "bowl_curved"), ("cyl_ellipse", "cylinder_elliptical"),
                              ("box_ellipse", "box_elliptical")):
-        row[key] = sum(r[verdict_key] is True for r in records)
+        row[key] = sum(1 for r in records if r[verdict_key])
     # calibration pairs: each perceived object once, with one truth; merged objects left out
     truth = perpendicular_truth(labels, held, merged)
     row["pairs_p"], row["pairs_y"] = [], []
@@ -741,8 +742,9 @@ def main(argv=None) -> int:
         except InputError as e:
             print(f"bench_real.py: error: {e}", file=sys.stderr)
             return 2
-        records += [{"folder": name, "modality": m, "seed": r["seed"], **rec}
-                    for m in mods for r in mine[m] for rec in r["objects"]]
+        if args.objects is not None:
+            records += [{"folder": name, "modality": m, "seed": r["seed"], **rec}
+                        for m in mods for r in mine[m] for rec in r["objects"]]
         figures = {m: summarise(mine[m], m) for m in mods}
         result["folders"][name] = {m: {k: figures[m][k] for k in KEYS + EXTRA_KEYS} for m in mods}
         any_rows = [r for r in mine[mods[0]] if r["seed"] == args.seed[0]]  # each frame once

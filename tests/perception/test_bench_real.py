@@ -179,6 +179,10 @@ def test_each_labelled_object_has_a_record_whose_verdicts_sum_to_the_frame_count
     assert (row["box_perp"], row["box_unocc"], row["round_prism"], row["round"]) == (1, 1, 1, 2)
     assert (row["cyl_read"], row["cyl_unocc"], row["bowl_curved"], row["bowls"]) == (1, 1, 0, 1)
 
+    # a confidence held as a numpy float gives a numpy bool verdict, counted all the same
+    np_facts = SceneFacts("s0", "depth", list(facts.facts[:-1]) + [Fact("cylindrical", ("s0_o2_f2",), np.float64(0.8))])
+    assert bench.evaluate_frame(scene, np_facts, frame, labels, label)["cyl_read"] == 1
+
     rgb_scene, rgb_facts, _ = _scene("rgb")
     rgb = bench.evaluate_frame(rgb_scene, rgb_facts, frame, labels, label)["objects"][0]
     assert rgb["found"] and rgb["box_overfaced"] is False
