@@ -134,3 +134,27 @@ def test_depth_scene_is_deterministic(box_frame):
     a, b = depth_scene(frame, seed=5), depth_scene(frame, seed=5)
     assert a.support == b.support
     assert [p.plane for p in a.objects[0].planes] == [p.plane for p in b.objects[0].planes]
+
+
+def test_largest_piece_is_the_largest_8_connected_piece_wherever_the_mask_lies():
+    import cv2
+
+    from lv3d.perception.depth.planes import largest_piece
+
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        mask = np.zeros((60, 80), bool)
+        i, j = rng.integers(0, 50), rng.integers(0, 70)
+        mask[i:i + 10, j:j + 10] = rng.random((min(10, 60 - i), min(10, 80 - j))) < 0.6
+        got = largest_piece(mask)
+        n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
+        assert got.dtype == bool and got.shape == mask.shape
+        if n > 1:
+            assert np.count_nonzero(got) == stats[1:, cv2.CC_STAT_AREA].max()
+            assert len(np.unique(lab[got])) == 1 and not (got & ~mask).any()
+    two = np.zeros((8, 8), bool)
+    two[1, 1:3] = two[5, 5:7] = True          # two pieces as large: the one a row-by-row scan meets first
+    assert largest_piece(two)[1, 1] and not largest_piece(two)[5, 5]
+    assert not largest_piece(np.zeros((4, 4), bool)).any()
+    one = np.ones((3, 3), bool)
+    assert largest_piece(one).all() and largest_piece(one) is not one

@@ -26,12 +26,21 @@ class DepthPlane:
 
 
 def largest_piece(mask: np.ndarray) -> np.ndarray:
-    """The largest 8-connected piece of ``mask`` (h, w) bool."""
-    n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
-    if n <= 1:
+    """The largest 8-connected piece of ``mask`` (h, w) bool (of two as large, the one a row-by-row scan meets
+    first). The pieces are labelled on the mask's bounding box only: an object's mask covers a small part of the
+    grid, and labelling the whole grid for every plane took a tenth of the depth stage's time."""
+    rows = np.flatnonzero(mask.any(axis=1))
+    if len(rows) == 0:
         return mask
+    cols = np.flatnonzero(mask.any(axis=0))
+    i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(mask[i0:i1, j0:j1].astype(np.uint8), connectivity=8)
+    if n <= 2:
+        return mask.astype(bool)  # one piece: a copy, as the labelled one would be
     best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
-    return lab == best
+    out = np.zeros_like(mask)
+    out[i0:i1, j0:j1] = lab == best
+    return out
 
 
 def largest_piece_on(sel: np.ndarray, box: np.ndarray) -> np.ndarray:
