@@ -295,10 +295,10 @@ def test_depth_settings_reach_perception_and_a_wrong_one_is_named(tmp_path, caps
     assert seen[-1][1].stride == 2 and "stride=2" in capsys.readouterr().out
     bench.main([str(tmp_path), "--modalities", "depth"])
     assert seen[-1][1] is None
-    assert bench.depth_settings(["curved.plane_ratio=1"]).curved.plane_ratio == 1  # a whole number for a float
+    assert bench.depth_settings(["curved.misfit_ratio=1"]).curved.misfit_ratio == 1  # a whole number for a float
     for bad, said in (("strid=2", "unknown setting 'strid'"), ("stride=0", "stride must be"),
                       ("nothing.x=1", "no part"), ("stride", "key=value"), ("stride=true", "must be of type int"),
-                      ("quadrics.trials=abc", "must be of type int"), ("curved.plane_ratio=x", "must be of type float")):
+                      ("quadrics.trials=abc", "must be of type int"), ("curved.misfit_ratio=x", "must be of type float")):
         assert bench.main([str(tmp_path), "--set", bad]) == 2
         assert said in capsys.readouterr().err
 

@@ -58,8 +58,12 @@ class CurvedSettings:
     cells they are averaged over (a box's edge, rounded by the sensor, fits one).
     ``min_share`` (fraction): the share of one plane's residual variance over the face's cells the cylinder must
     explain (describe.curved_evidence, the fact's confidence; 0.5: curved is the likelier reading).
-    ``plane_ratio`` (fraction): a sampled cylinder's RMS residual over its cells must be at most this share of
-    the RMS distance of those cells from their own planes (it explains them better than the planes do).
+    ``misfit_ratio`` (fraction): a sampled cylinder's systematic misfit over the cells the object's planes held
+    must be at most this share of the planes' own (:func:`misfit`: the part of the residuals that does not average
+    out over bins around the axis). On a real sensor's depth both surfaces fit a can within the noise, so their
+    RMS residuals are alike, but planes fitted to a curved side bow away from it in the middle of each facet and
+    a cylinder fitted across a box's faces bows away at the edge: the surface that is the wrong model leaves
+    residuals that keep their sign bin after bin.
     ``sample_arc_deg`` / ``min_dip`` (degrees / fraction): the normals of a sampled cylinder's cells, binned every
     ``max_gap_deg / 2`` around the axis, must spread over this arc, its emptiest bin holding this share of its
     fullest (curved.normal_profile): RealSense normals scatter by 7-10 deg on a flat face, which fills the gaps a
@@ -79,7 +83,7 @@ class CurvedSettings:
     max_radius_frac: float = 1.0
     min_radius_cells: float = 4.0
     min_share: float = 0.5
-    plane_ratio: float = 0.9
+    misfit_ratio: float = 0.7
     sample_arc_deg: float = 60.0
     min_dip: float = 0.1
     bin_cells: int = 10
@@ -90,7 +94,7 @@ class CurvedSettings:
 
     def __post_init__(self) -> None:
         check_ranges(self, angles=("max_step_deg",), acute=("normal_deg",),
-                     fractions=("min_cover", "min_share", "plane_ratio", "min_dip"),
+                     fractions=("min_cover", "min_share", "misfit_ratio", "min_dip"),
                      arcs=("min_arc_deg", "max_gap_deg", "sample_arc_deg"),
                      positive=("inlier_dists", "max_radius_frac", "min_radius_cells"),
                      counts={"bin_cells": 1, "max_faces": 1, "trials": 1, "score_cells": 1, "refits": 0})
@@ -294,8 +298,9 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
 
     First a fan of planes that a cylinder fits (:func:`fan_cylinder`); then, on the cells of no face found, the
     cylinder a seeded sample consensus over the cells' points and normals finds (:func:`sample_cylinder`),
-    refitted on every free cell on its surface in one connected piece. A sampled cylinder stands when it fits its
-    cells better than the object's planes do (``plane_ratio``) and passes :func:`_stands`: a fan of planes 60 deg
+    refitted on every free cell on its surface in one connected piece. A sampled cylinder stands when its
+    systematic misfit over the cells the planes held is well below the planes' (``misfit_ratio``) and it passes
+    :func:`_stands`: a fan of planes 60 deg
     apart on a small can, a can whose planes took cells of its lid, a can in a clutter of objects. Returns
     (cylinder, its cells (m,) bool, the planes it replaces: those with half their cells or more on it) per face,
     at most ``settings.max_faces``. ``sample`` False: the fan of planes only (the caller found that the object's
@@ -308,9 +313,13 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
     dist = settings.inlier_dists * dist_m
     r_min, r_max = settings.min_radius_cells * cell_m, settings.max_radius_frac * extent_m
     plane_cells = np.bincount(plane_of[known & (plane_of >= 0)], minlength=n_planes)
-    res = np.full(len(pts), np.nan)
+    res = np.full(len(pts), np.nan)  # each cell's signed distance from its plane, positive towards the camera
     for k, p in enumerate(planes):
-        res[plane_of == k] = p.distance(pts[plane_of == k])
+        mine = plane_of == k
+        if mine.any():
+            res[mine] = p.distance(pts[mine])
+            if float(p.n @ pts[mine].mean(axis=0)) > 0:
+                res[mine] *= -1.0
     out = []
 
     def replaced(on: np.ndarray) -> list[int]:
@@ -347,7 +356,7 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
         on = largest_piece_on(free & _inliers(cyl, pts, nrm, dist, cos_min, side), box)
         ok = on & (plane_of >= 0)
         gone = replaced(on) if ok.any() else []
-        if gone and _stands(cyl, pts[on], nrm[on], res[ok], dist, min_cells, settings, side):
+        if gone and _stands(cyl, pts[on], nrm[on], (pts[ok], res[ok]), dist, min_cells, settings, side):
             out.append((cyl, on, gone))
             free &= ~on
         elif on.any():
@@ -357,11 +366,12 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
     return out
 
 
-def _stands(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarray | None, dist_m: float,
-            min_cells: int, settings: CurvedSettings, side: float = 1.0) -> bool:
+def _stands(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, plane_fit: tuple[np.ndarray, np.ndarray] | None,
+            dist_m: float, min_cells: int, settings: CurvedSettings, side: float = 1.0) -> bool:
     """Whether a cylinder's cells (points and normals) make a curved face: enough of them, within the inlier
-    distance of it on average and closer to it than to the object's planes (``plane_res``: each cell's distance
-    from its own plane, None for a fan of planes already read as a cylinder), spread around the axis through a
+    distance of it on average and with a systematic misfit well below the object's planes' (``plane_fit``: the
+    points of its cells that lie on planes and their signed distances from them, positive towards the camera
+    (:func:`misfit`); None for a fan of planes already read as a cylinder), spread around the axis through a
     wide arc without a gap (:func:`track`), and a cylinder that explains most of one plane's residual over them
     (:func:`curved_share`). Cells that show a cylinder's inside (``side`` -1: a pot's or a cup's inner wall over
     its rim) must also be explained better by it than by a sphere (the share of the algebraic sphere's residual
@@ -373,8 +383,13 @@ def _stands(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarr
     rms = float(np.sqrt(np.mean((r - cyl.radius) ** 2)))
     if rms > dist_m:
         return False
-    if plane_res is not None and rms > settings.plane_ratio * float(np.sqrt(np.mean(plane_res ** 2))):
-        return False
+    if plane_fit is not None:
+        on_planes, plane_res = plane_fit
+        bin_deg = settings.max_gap_deg / 2
+        theirs = misfit(cyl, on_planes, plane_res, bin_deg)
+        if misfit(cyl, on_planes, side * (cyl.radial(on_planes)[0] - cyl.radius), bin_deg) > \
+                settings.misfit_ratio * theirs:
+            return False
     _, arc, gap = track(cyl, pts, nrm, settings.max_gap_deg / 2, settings.bin_cells)
     if arc < settings.min_arc_deg or gap > settings.max_gap_deg:
         return False
@@ -388,6 +403,25 @@ def _stands(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarr
             if over_sphere is None or over_sphere < settings.min_share:
                 return False
     return curved_share(pts, cyl) >= settings.min_share
+
+
+def misfit(cyl: Cylinder, pts: np.ndarray, res: np.ndarray, bin_deg: float) -> float:
+    """The systematic part of the residuals ``res`` (m,) (metres, signed) of points (m, 3) on or near a
+    cylinder: the points binned by their angle around its axis, ``bin_deg`` wide, the RMS over the points of
+    their bin's mean residual. Noise averages out in a bin's mean (to its sigma over the root of the bin's count,
+    alike for any surface fitted to the same points); a surface of the wrong shape leaves residuals of one sign
+    across a bin: a plane fitted to a curved side lies behind it at the facet's middle and in front at its ends,
+    a cylinder fitted across a box's two faces in front of the faces and behind their edge. 0 for no point."""
+    if len(pts) == 0:
+        return 0.0
+    a, b1, b2 = axis_basis(cyl.axis)
+    d = pts - np.asarray(cyl.point)
+    bins = ((np.degrees(np.arctan2(d @ b2, d @ b1)) + 180.0) // bin_deg).astype(int)
+    count = np.bincount(bins)
+    total = np.bincount(bins, weights=res)
+    full = count > 0
+    mean = total[full] / count[full]
+    return float(np.sqrt(np.sum(count[full] * mean * mean) / len(pts)))
 
 
 def plane_ms(pts: np.ndarray) -> float:
