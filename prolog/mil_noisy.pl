@@ -21,32 +21,69 @@
 
 %!  learn_noisy(+Ctx, +Settings, +Pos, +Neg, -Prog, -Score) is semidet.
 %   Pos and Neg are l/3 atoms.  Hypotheses from seeded random samples of the examples, each scored
-%   on all of them (score/6, then support/4, literal_cost/3); the best is kept.  Fails when no
-%   sample gives any hypothesis.  Each sample's search has an equal share of the time limit; a
-%   sample that runs out gives no hypothesis (a mislabelled example can make a sample's search
-%   exhaustive), and only when every sample runs out is it an error.
+%   on all of them (score/6, then support/4, literal_cost/3); the best is kept if it is better than
+%   chance on them (J > 0).  Fails when no sample, down to the smallest (sampled_hypotheses/10),
+%   gives any hypothesis, or the best is no better than chance.  Each sample's search has an equal
+%   share of the time limit; a sample that runs out gives no hypothesis (a mislabelled example can
+%   make a sample's search exhaustive), and only when every sample runs out is it an error.
 learn_noisy(Ctx, Settings, Pos, Neg, Best, Score) :-
     option(seed(Seed), Settings), set_random(seed(Seed)),
     option(samples(K), Settings), option(sample_pos(SP), Settings), option(sample_neg(SN), Settings),
-    samples(K, SP, SN, Pos, Neg, Samples),
-    option(time_limit(T), Settings), length(Samples, NS), TS is T / NS,
+    option(time_limit(T), Settings), get_time(Start), Deadline is Start + T,
     few_shot(Settings, Pos, SSettings),
-    foldl(sample_hypotheses(Ctx, SSettings, TS), Samples, r([], 0), r(Found0, TimedOut)),
-    (   TimedOut =:= NS -> throw(mil_error(time_limit(T))) ; true ),
-    append(Found0, Found),
-    list_to_set(Found, Unique),                     % in the order found: it breaks ties
     option(clause_penalty(Lambda), Settings),
     scoring(Settings, Ctx, SCtx, Ts),
-    findall(Key-(Prog-S), (nth1(Order, Unique, Prog),
-                           score(SCtx, Lambda-Ts, Prog, Pos, Neg, S),
-                           S = score(J, Soft, _, _, _), support(Ctx, Prog, Pos, W),
-                           literal_cost(Ctx, Prog, Cost), NCost is -Cost, NOrder is -Order,
-                           Key = k(J, Soft, W, NCost, NOrder)), Scored),
+    length(Pos, NP), length(Neg, NN), SP1 is min(SP, NP), SN1 is min(SN, NN),
+    Search = search(Ctx, SSettings, SCtx, Lambda-Ts, K, Deadline, T, Pos, Neg),
+    scored_hypotheses(Search, SP1-SN1, SP1-SN1, first, Scored, Round),
     Scored \== [],
     option(disjunctions(KD), Settings),
-    disjunctions(SCtx, Lambda-Ts, KD, Pos, Neg, Scored, Pairs),
+    disjunctions(SCtx, Lambda-Ts, KD, Pos, Neg, Scored, Pairs0),
+    kept(Round, SP1-SN1, Pairs0, Pairs),
     append(Scored, Pairs, All),
-    best_specific(SCtx, Settings, Pos, All, Best, Score).
+    best_specific(SCtx, Settings, Pos, All, Best, Score),
+    Score = score(JBest, _, _, _, _), JBest > 0.
+
+%   The distinct hypotheses of samples of Size = SP-SN (SP positives, SN negatives), each scored on
+%   all examples as Key-(Prog-Score) (keys: J, Soft, support, then literal cost and the order found,
+%   which break ties), and the round that found them (first, or smaller).  Each sample's search has
+%   an equal share of the time left before the deadline.  Where no sample of the first size (First)
+%   gives any hypothesis (each drawn sample held a positive whose facts no small program shares with
+%   the others', or a negative that shares them), samples half the size, positives rounded up and
+%   negatives down, down to one positive and no negative (each positive alone: the minimal samples
+%   of sample consensus, all of them), until one gives a hypothesis that is kept (kept/4).  Only
+%   when every sample of the first size runs out of time is it the time-limit error; a smaller size
+%   that runs out gives nothing.
+scored_hypotheses(Search, First, SP-SN, Round, Scored, Which) :-
+    Search = search(Ctx, Settings, SCtx, LT, K, Deadline, T, Pos, Neg),
+    samples(K, SP, SN, Pos, Neg, Drawn),
+    length(Drawn, ND), list_to_set(Drawn, Samples), length(Samples, NS),
+    get_time(Now), TS is (Deadline - Now) / ND,
+    foldl(sample_hypotheses(Ctx, Settings, TS), Samples, r([], 0), r(Found0, TimedOut)),
+    (   TimedOut =:= NS, Round == first -> throw(mil_error(time_limit(T))) ; true ),
+    append(Found0, Found),
+    list_to_set(Found, Unique),                     % in the order found: it breaks ties
+    findall(Key-(Prog-S), (nth1(Order, Unique, Prog),
+                           score(SCtx, LT, Prog, Pos, Neg, S),
+                           S = score(J, Soft, _, _, _), support(Ctx, Prog, Pos, W),
+                           literal_cost(Ctx, Prog, Cost), NCost is -Cost, NOrder is -Order,
+                           Key = k(J, Soft, W, NCost, NOrder)), Scored0),
+    kept(Round, First, Scored0, Scored1),
+    (   Scored1 == [], smaller(SP-SN, Smaller), get_time(Then), Then < Deadline
+    ->  scored_hypotheses(Search, First, Smaller, smaller, Scored, Which)
+    ;   Scored-Which = Scored1-Round
+    ).
+
+smaller(SP-SN, SP1-SN1) :- ( SP > 1 ; SN > 0 ), SP1 is max(1, (SP + 1) // 2), SN1 is SN // 2.
+
+%   A hypothesis of a smaller sample is kept only where a sample of the first size (SP positives, SN
+%   negatives) is consistent with it on the scores: it proves SP positives and leaves SN negatives
+%   unproved.  It is then one a luckier draw of the first size would have found: the smaller samples
+%   widen the draws, not what a hypothesis may get wrong.  Those of the first size are kept.
+kept(first, _, Hs, Hs) :- !.
+kept(smaller, Size, Hs0, Hs) :- include(first_size_consistent(Size), Hs0, Hs).
+
+first_size_consistent(SP-SN, _-(_-score(_, _, TP/_, FP/NN, _))) :- TP >= SP, NN - FP >= SN.
 
 %   Among the hypotheses of the best J, the most probable under the size principle (Tenenbaum
 %   1999; docs/learner.md): the positives are taken as drawn from the objects a hypothesis covers,
@@ -257,9 +294,12 @@ all_examples([E|Es], Ctx, Prog1, Prog3) :-
     distinct(Prog2, prove([E], Ctx, Sig, [], D, Prog1, Prog2, N0, _, 1.0, _, _, [])),
     all_examples(Es, Ctx, Prog2, Prog3).
 
-%   K samples: the whole set when it is small, else random subsets (seeded by the caller).
+%   K samples: the whole set when it is small, each positive alone for samples of one positive and no
+%   negative, else random subsets (seeded by the caller).
 samples(_, SP, SN, Pos, Neg, [Pos-Neg]) :-
     length(Pos, NP), NP =< SP, length(Neg, NN), NN =< SN, !.
+samples(_, 1, 0, Pos, _, Samples) :- !,
+    findall([P]-[], member(P, Pos), Samples).
 samples(K, SP, SN, Pos, Neg, Samples) :-
     length(Samples, K),
     maplist(sample(SP, SN, Pos, Neg), Samples).

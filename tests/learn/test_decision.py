@@ -121,27 +121,70 @@ def test_no_clause_repeats_a_literal():
     assert "triangle(B)" in fit(scenes, labels, "hit", settings={"metarules": ["part"]}).clauses[0]
 
 
+def _one_object(name: str, faces: list[list[tuple[str, float]]]) -> SceneFacts:
+    """A depth scene of one object whose faces hold the given unary facts."""
+    o = f"{name}_o1"
+    facts = [Fact("object", (o,), 1.0)]
+    for j, preds in enumerate(faces):
+        f = f"{o}_f{j}"
+        facts.append(Fact("face_of", (o, f), 0.99))
+        facts += [Fact(p, (f,), c) for p, c in preds]
+    return SceneFacts(name, "depth", facts, o)
+
+
 def test_one_negative_with_a_wrong_fact_does_not_veto_the_concept():
     """Three cans (a cylindrical face and a hexagonal cap) against three negatives, one of them a bowl that
     perception read as curved: every sample used to hold every negative, so the bowl vetoed `cylindrical` in
     all of them; a sample now holds two thirds of the negatives (model.few_negatives)."""
-    from lv3d.facts import Fact, SceneFacts
-    from lv3d.learn import Model
     from lv3d.learn.model import few_negatives
 
-    def scene(name, faces):
-        o = f"{name}_o1"
-        facts = [Fact("object", (o,), 1.0)]
-        for j, preds in enumerate(faces):
-            f = f"{o}_f{j}"
-            facts.append(Fact("face_of", (o, f), 0.99))
-            facts += [Fact(p, (f,), c) for p, c in preds]
-        return SceneFacts(name, "depth", facts, o)
-
-    cans = [scene(f"can{i}", [[("cylindrical", 0.95)], [("quadrilateral", 0.9)]]) for i in range(3)]
-    negs = [scene("bowl", [[("cylindrical", 0.8)]]),
-            scene("box1", [[("quadrilateral", 0.95)], [("rectangle", 0.9)]]),
-            scene("box2", [[("quadrilateral", 0.95)], [("triangle", 0.9)]])]
+    cans = [_one_object(f"can{i}", [[("cylindrical", 0.95)], [("quadrilateral", 0.9)]]) for i in range(3)]
+    negs = [_one_object("bowl", [[("cylindrical", 0.8)]]),
+            _one_object("box1", [[("quadrilateral", 0.95)], [("rectangle", 0.9)]]),
+            _one_object("box2", [[("quadrilateral", 0.95)], [("triangle", 0.9)]])]
     assert few_negatives(3) == 2 and few_negatives(1) == 1 and few_negatives(12) == 8
     model = Model.fit(cans + negs, ["can"] * 3 + ["not_can"] * 3, classes=["can"], seed=0)
     assert "cylindrical(B)" in str(model.programs["can"])
+
+
+def _cans_task(planar: int) -> tuple[list[SceneFacts], list[str]]:
+    """Four cans, ``planar`` of them with a side perception cut into planes (one hexagonal or pentagonal face,
+    no fact shared with another can), the others read as cylindrical; against six negatives: a bowl read as
+    cylindrical and five boxes."""
+    flat = [[("hexagon", 0.9)], [("pentagon", 0.9)], [("triangle", 0.9)]]
+    cans = [_one_object(f"can{i}", [flat[i]] if i < planar else [[("cylindrical", 0.95)]]) for i in range(4)]
+    negs = [_one_object("bowl", [[("cylindrical", 0.8)]])]
+    negs += [_one_object(f"box{i}", [[("quadrilateral", 0.95)], [("rectangle", 0.9)]]) for i in range(5)]
+    return cans + negs, ["can"] * 4 + ["not_can"] * 6
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_samples_shrink_when_no_sample_gives_a_hypothesis(seed):
+    """Two cans read as cylindrical, two cut into planes: a sample of two cans and four of the six negatives
+    gives `cylindrical` only when it draws both cylindrical cans and leaves the bowl out (one draw in 18), so
+    one sample seldom does. The smaller samples end with each can alone, which finds it whatever the draw,
+    and it is kept, since a sample of the first size is consistent with it (it proves two cans and leaves
+    five negatives unproved): J = 2/4 - 1/6, less the clause penalty of 0.02."""
+    scenes, labels = _cans_task(planar=2)
+    prog = fit(scenes, labels, "can", settings={"samples": 1, "disjunctions": 0}, seed=seed)
+    assert any("cylindrical(B)" in c for c in prog.clauses)
+    assert (prog.score["tp"], prog.score["fp"]) == (2, 1)
+    assert prog.score["j"] == pytest.approx(2 / 4 - 1 / 6 - 0.02)
+
+
+def test_a_hypothesis_no_sample_of_the_first_size_fits_is_not_kept():
+    """Three of the four cans cut into planes: `cylindrical` proves one can, and no sample of two cans is
+    consistent with any hypothesis, so the smaller samples' hypotheses (one can each) are not kept, though
+    their J is above 0."""
+    scenes, labels = _cans_task(planar=3)
+    with pytest.raises(LearnError, match="no program"):
+        fit(scenes, labels, "can", settings={"disjunctions": 0}, seed=0)
+
+
+def test_no_program_better_than_chance_is_no_program():
+    """Positives and negatives with the same facts: every hypothesis covers as many of one as of the other
+    (J <= 0), so there is nothing to learn, however small the samples."""
+    same = [[("cylindrical", 0.95)], [("quadrilateral", 0.9)]]
+    scenes = [_one_object(f"x{i}", same) for i in range(4)]
+    with pytest.raises(LearnError, match="no program"):
+        fit(scenes, ["can", "can", "not_can", "not_can"], "can", seed=0)
