@@ -55,6 +55,7 @@ default(combine(product)).      % how a proof's confidence combines its facts' c
 default(samples(8)).            % noisy learning: random samples of the examples
 default(sample_pos(2)).         % positives per sample
 default(sample_neg(12)).        % negatives per sample
+default(shrink_samples(false)). % learn_noisy: where no sample gives a hypothesis, try smaller samples
 default(solutions(200)).        % hypotheses kept per sample (smallest size found)
 default(clause_penalty(0.02)).  % score lost per clause (Occam), see docs/learner.md
 default(disjunctions(0)).       % learn_noisy: pair this many best one-clause hypotheses (0: off)
@@ -83,8 +84,8 @@ read_by(threshold, [exact, noisy, classify]).
 read_by(combine, [exact, noisy, classify]).
 read_by(miss, [classify]).
 read_by(O, [noisy]) :-
-    memberchk(O, [samples, sample_pos, sample_neg, solutions, clause_penalty, disjunctions, thresholds,
-                  reference, extra_literals, few_shot, size_principle, extension_miss, literal_prior,
+    memberchk(O, [samples, sample_pos, sample_neg, shrink_samples, solutions, clause_penalty, disjunctions,
+                  thresholds, reference, extra_literals, few_shot, size_principle, extension_miss, literal_prior,
                   predicate_prior, seed]).
 
 %!  metarule(?Name, ?Subs, ?Head, ?Body) is nondet.  The library of metarules, in Metagol's list

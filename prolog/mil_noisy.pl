@@ -47,8 +47,8 @@ learn_noisy(Ctx, Settings, Pos, Neg, Best, Score) :-
 %   The distinct hypotheses of samples of Size = SP-SN (SP positives, SN negatives), each scored on
 %   all examples as Key-(Prog-Score) (keys: J, Soft, support, then literal cost and the order found,
 %   which break ties), and the round that found them (first, or smaller).  Each sample's search has
-%   an equal share of the time left before the deadline.  Where no sample of the first size (First)
-%   gives any hypothesis (each drawn sample held a positive whose facts no small program shares with
+%   an equal share of the time left before the deadline.  With shrink_samples(true), where no sample
+%   of the first size (First) gives any hypothesis (each drawn sample held a positive whose facts no small program shares with
 %   the others', or a negative that shares them), samples half the size, positives rounded up and
 %   negatives down, down to one positive and no negative (each positive alone: the minimal samples
 %   of sample consensus, all of them), until one gives a hypothesis that is kept (kept/4).  Only
@@ -69,7 +69,8 @@ scored_hypotheses(Search, First, SP-SN, Round, Scored, Which) :-
                            literal_cost(Ctx, Prog, Cost), NCost is -Cost, NOrder is -Order,
                            Key = k(J, Soft, W, NCost, NOrder)), Scored0),
     kept(Round, First, Scored0, Scored1),
-    (   Scored1 == [], smaller(SP-SN, Smaller), get_time(Then), Then < Deadline
+    (   Scored1 == [], option(shrink_samples(true), Settings),
+        smaller(SP-SN, Smaller), get_time(Then), Then < Deadline
     ->  scored_hypotheses(Search, First, Smaller, smaller, Scored, Which)
     ;   Scored-Which = Scored1-Round
     ).

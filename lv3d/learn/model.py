@@ -210,12 +210,19 @@ class Model:
     def fit(cls, scenes: list[SceneFacts], labels: list[str], settings: dict | None = None, seed: int = 0,
             classes: list[str] | None = None) -> "Model":
         """A program for each class in ``classes`` (default: every label). A class whose search finds
-        nothing or runs out of time gets no program (it is never predicted); ``failures`` says why."""
+        nothing or runs out of time gets no program (it is never predicted); ``failures`` says why.
+        With several classes each search shrinks its samples where none gives a hypothesis
+        (``shrink_samples``, docs/learner.md), unless ``settings`` say otherwise: a class without a
+        program is never the answer, while one class's task without a program answers "no"."""
         settings = check_settings(settings) or None  # a bad setting stops here, not as every class's failure
+        classes = classes or sorted(set(labels))
+        search = dict(settings or {})
+        if len(classes) > 1:  # a class without a program is never named: its search shrinks its samples
+            search.setdefault("shrink_samples", True)
         programs, failures = {}, {}
-        for c in classes or sorted(set(labels)):
+        for c in classes:
             try:
-                programs[c] = fit(scenes, labels, c, settings=settings, seed=seed)
+                programs[c] = fit(scenes, labels, c, settings=search or None, seed=seed)
             except LearnError as e:
                 failures[c] = str(e)
         return cls(programs, settings, failures)

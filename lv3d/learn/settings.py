@@ -29,6 +29,7 @@ SETTINGS: dict[str, tuple] = {
     "samples": ("int", 1, 10000, "random samples of the examples"),
     "sample_pos": ("int", 1, BIG, "positives per sample"),
     "sample_neg": ("int", 0, BIG, "negatives per sample"),
+    "shrink_samples": ("bool", None, None, "where no sample gives a hypothesis, try smaller samples"),
     "solutions": ("int", 1, BIG, "hypotheses kept per sample"),
     "clause_penalty": ("number", 0, 10, "score lost per clause"),
     "disjunctions": ("int", 0, 10000, "best one-clause hypotheses paired (0: off)"),

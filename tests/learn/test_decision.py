@@ -166,7 +166,7 @@ def test_samples_shrink_when_no_sample_gives_a_hypothesis(seed):
     and it is kept, since a sample of the first size is consistent with it (it proves two cans and leaves
     five negatives unproved): J = 2/4 - 1/6, less the clause penalty of 0.02."""
     scenes, labels = _cans_task(planar=2)
-    prog = fit(scenes, labels, "can", settings={"samples": 1, "disjunctions": 0}, seed=seed)
+    prog = fit(scenes, labels, "can", settings={"samples": 1, "disjunctions": 0, "shrink_samples": True}, seed=seed)
     assert any("cylindrical(B)" in c for c in prog.clauses)
     assert (prog.score["tp"], prog.score["fp"]) == (2, 1)
     assert prog.score["j"] == pytest.approx(2 / 4 - 1 / 6 - 0.02)
@@ -178,7 +178,19 @@ def test_a_hypothesis_no_sample_of_the_first_size_fits_is_not_kept():
     their J is above 0."""
     scenes, labels = _cans_task(planar=3)
     with pytest.raises(LearnError, match="no program"):
-        fit(scenes, labels, "can", settings={"disjunctions": 0}, seed=0)
+        fit(scenes, labels, "can", settings={"disjunctions": 0, "shrink_samples": True}, seed=0)
+
+
+def test_only_a_multi_class_model_shrinks_its_samples():
+    """One class's task without a program answers "no", the conservative answer, so its search keeps the first
+    size (the unlucky single draw gives nothing); a multi-class model never names a class without a program,
+    so its searches shrink their samples, and the can class gets `cylindrical`."""
+    scenes, labels = _cans_task(planar=2)
+    with pytest.raises(LearnError, match="no program"):
+        fit(scenes, labels, "can", settings={"samples": 1, "disjunctions": 0}, seed=0)
+    model = Model.fit(scenes, labels, settings={"samples": 1, "disjunctions": 0}, seed=0)
+    assert "cylindrical(B)" in str(model.programs["can"])
+    assert "shrink_samples" not in model.settings  # a search setting, not one proving reads
 
 
 def test_no_program_better_than_chance_is_no_program():
