@@ -1,6 +1,7 @@
 """The runner on a tiny synthetic study: outputs, resume, seeding."""
 
 import json
+import math
 
 from lv3d.experiment.runner import run_study
 
@@ -32,10 +33,23 @@ def test_run_writes_folds_report_and_programs(tmp_path, tiny_config, fake_world)
     md = (out / "results.md").read_text()
     assert "| lv3d-rgbd | 100.0 ± 0.0" in md and "tree-rgbd" in md and "sign p" in md
     summary = json.loads((out / "results.json").read_text())["conditions"]["base"]
+    # a perfect learner is perfect on balanced accuracy too; the column sits between mean and multi
+    assert summary["systems"]["lv3d-rgbd"]["balanced"] == {"mean": 1.0, "std": 0.0}
+    assert "| mean | balanced | multi |" in md
     assert [t["a"] for t in summary["tests"]][:1] == ["lv3d-rgbd"]
     # the issue's margin: the best-seeing lv3d system against the best CNN (the only one here)
     best = summary["against_best_cnn"]
     assert (best["a"], best["b"]) == ("lv3d-rgbd", "cnn-rgb") and "lv3d-rgbd against the best CNN here (cnn-rgb" in md
+
+
+def test_balanced_accuracy_of_a_fold_is_the_mean_over_its_class_tasks_that_have_one():
+    from lv3d.experiment.report import _mean_balanced
+
+    tasks = {"a": {"balanced_accuracy": 0.5}, "b": {"balanced_accuracy": 1.0}, "c": {"balanced_accuracy": float("nan")},
+             "multiclass": {"accuracy": 0.2}}
+    assert _mean_balanced(tasks, ["a", "b", "c", "d"]) == 0.75
+    # a fold without a positive has none (NaN; a restored fold file holds an empty string): mean_std skips it
+    assert math.isnan(_mean_balanced({"c": {"balanced_accuracy": ""}, "d": {}}, ["c", "d"]))
 
 
 def test_rerun_skips_finished_folds(tmp_path, tiny_config, fake_world):
