@@ -22,10 +22,11 @@
 %!  learn_noisy(+Ctx, +Settings, +Pos, +Neg, -Prog, -Score) is semidet.
 %   Pos and Neg are l/3 atoms.  Hypotheses from seeded random samples of the examples, each scored
 %   on all of them (score/6, then support/4, literal_cost/3); the best is kept if it is better than
-%   chance on them (J > 0).  Fails when no sample, down to the smallest (sampled_hypotheses/10),
-%   gives any hypothesis, or the best is no better than chance.  Each sample's search has an equal
-%   share of the time limit; a sample that runs out gives no hypothesis (a mislabelled example can
-%   make a sample's search exhaustive), and only when every sample runs out is it an error.
+%   chance on them (J > 0).  Fails when no sample gives a hypothesis that is kept (with
+%   shrink_samples(true), down to the smallest samples: scored_hypotheses/6), or the best is no
+%   better than chance.  Each sample's search has an equal share of the time left; a sample that
+%   runs out gives no hypothesis (a mislabelled example can make a sample's search exhaustive), and
+%   only when every sample of the first size runs out is it an error.
 learn_noisy(Ctx, Settings, Pos, Neg, Best, Score) :-
     option(seed(Seed), Settings), set_random(seed(Seed)),
     option(samples(K), Settings), option(sample_pos(SP), Settings), option(sample_neg(SN), Settings),
@@ -44,16 +45,16 @@ learn_noisy(Ctx, Settings, Pos, Neg, Best, Score) :-
     best_specific(SCtx, Settings, Pos, All, Best, Score),
     Score = score(JBest, _, _, _, _), JBest > 0.
 
-%   The distinct hypotheses of samples of Size = SP-SN (SP positives, SN negatives), each scored on
-%   all examples as Key-(Prog-Score) (keys: J, Soft, support, then literal cost and the order found,
-%   which break ties), and the round that found them (first, or smaller).  Each sample's search has
-%   an equal share of the time left before the deadline.  With shrink_samples(true), where no sample
-%   of the first size (First) gives any hypothesis (each drawn sample held a positive whose facts no small program shares with
-%   the others', or a negative that shares them), samples half the size, positives rounded up and
-%   negatives down, down to one positive and no negative (each positive alone: the minimal samples
-%   of sample consensus, all of them), until one gives a hypothesis that is kept (kept/4).  Only
-%   when every sample of the first size runs out of time is it the time-limit error; a smaller size
-%   that runs out gives nothing.
+%   The distinct hypotheses of samples of SP positives and SN negatives, each scored on all examples
+%   as Key-(Prog-Score) (keys: J, Soft, support, then literal cost and the order found, which break
+%   ties), and the round that found them (first, or smaller).  Each sample's search has an equal
+%   share of the time left before the deadline.  With shrink_samples(true), where no sample of the
+%   first size (First) gives any hypothesis (each drawn sample held a positive whose facts no small
+%   program shares with the others', or a negative that shares them), samples half the size,
+%   positives rounded up and negatives down, down to one positive and no negative (each positive
+%   alone: the minimal samples of sample consensus, all of them), until one gives a hypothesis that
+%   is kept (kept/4).  Only when every sample of the first size runs out of time is it the
+%   time-limit error; a smaller size that runs out gives nothing.
 scored_hypotheses(Search, First, SP-SN, Round, Scored, Which) :-
     Search = search(Ctx, Settings, SCtx, LT, K, Deadline, T, Pos, Neg),
     samples(K, SP, SN, Pos, Neg, Drawn),
