@@ -148,9 +148,9 @@ def test_one_negative_with_a_wrong_fact_does_not_veto_the_concept():
 
 
 def _cans_task(planar: int) -> tuple[list[SceneFacts], list[str]]:
-    """Four cans, ``planar`` of them with a side perception cut into planes (one hexagonal or pentagonal face,
-    no fact shared with another can), the others read as cylindrical; against six negatives: a bowl read as
-    cylindrical and five boxes."""
+    """Four cans, ``planar`` (at most 3) of them with a side perception cut into planes (one hexagonal,
+    pentagonal or triangular face, no fact shared with another can), the others read as cylindrical; against
+    six negatives: a bowl read as cylindrical and five boxes."""
     flat = [[("hexagon", 0.9)], [("pentagon", 0.9)], [("triangle", 0.9)]]
     cans = [_one_object(f"can{i}", [flat[i]] if i < planar else [[("cylindrical", 0.95)]]) for i in range(4)]
     negs = [_one_object("bowl", [[("cylindrical", 0.8)]])]
