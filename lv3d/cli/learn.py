@@ -218,6 +218,9 @@ def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classe
             click.echo(f"% {c}: learned as {p.target}, since {c} names a body predicate")
         click.echo(f"% {c}: covers {p.score['tp']}/{p.score['n_pos']} positives, "
                    f"{p.score['fp']}/{p.score['n_neg']} negatives\n{p}\n")
+    for (c, r), p in model.arbiters.items():
+        click.echo(f"% {c} rather than {r} (where both programs prove an object): covers {p.score['tp']}/"
+                   f"{p.score['n_pos']} of the {c} examples, {p.score['fp']}/{p.score['n_neg']} of the {r} ones\n{p}\n")
     for c, why in model.failures.items():
         click.echo(f"no program for {c}: {why}", err=True)
 

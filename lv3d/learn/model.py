@@ -170,6 +170,10 @@ class Explanation:
     others: dict[str, float] = field(default_factory=dict)
     missing: list[str] = field(default_factory=list)  # facts the scene lacks (a near miss)
     near: bool = False  # no program proves the scene at its threshold: this is the nearest one
+    # the class whose program proved it too and ranked first or second, and the arbiter that told them apart
+    rival: str | None = None
+    rival_clauses: list[str] = field(default_factory=list)
+    rival_facts: list[tuple[str, float]] = field(default_factory=list)
 
     def __str__(self) -> str:
         if self.label == "unknown":
@@ -187,6 +191,10 @@ class Explanation:
         lines += [f"  with {a} ({c:.3f})" for a, c in self.facts]
         lines += [f"  but not {a} (absent)" for a in self.missing]
         lines += [f"  where {d} (background)" for d in self.derived]
+        if self.rival:
+            lines.append(f"  rather than a {self.rival} (whose program proves it too), because")
+            lines += ["    " + c.replace("\n", "\n    ") for c in self.rival_clauses]
+            lines += [f"    with {a} ({c:.3f})" for a, c in self.rival_facts]
         if self.others:
             lines.append("  also proved: " + ", ".join(f"{k} {v:.3f}" for k, v in self.others.items()))
         return "\n".join(lines)
@@ -195,16 +203,21 @@ class Explanation:
 class Model:
     """One program per class. ``predict`` names the class whose program proves the scene's target
     with the highest confidence times the program's training :func:`precision` (ties: the program with
-    the higher training J), answering with the proof's confidence. When none proves
+    the higher training J), answering with the proof's confidence. When the two first-ranked classes'
+    programs both prove it and the model holds arbiters for that pair (``arbiters``: (class, rival) ->
+    a program that proves the class's training examples and not the rival's, :meth:`fit`), the class
+    whose arbiter proves it while the other's does not comes first. When none proves
     it: with one program, "unknown" (the negative answer of a class task); with several, the class
     whose program it misses by least (the highest per-fact confidence, absent facts at NEAR_MISS),
     with that near proof's confidence, which is below the coverage threshold."""
 
     def __init__(self, programs: dict[str, Program], settings: dict | None = None,
-                 failures: dict[str, str] | None = None):
+                 failures: dict[str, str] | None = None,
+                 arbiters: dict[tuple[str, str], Program] | None = None):
         self.programs = dict(programs)
         self.settings = dict(settings or {})
         self.failures = dict(failures or {})  # class -> why no program was learned
+        self.arbiters = dict(arbiters or {})  # (class, rival) -> the program telling the class from the rival
 
     @classmethod
     def fit(cls, scenes: list[SceneFacts], labels: list[str], settings: dict | None = None, seed: int = 0,
@@ -225,27 +238,63 @@ class Model:
                 programs[c] = fit(scenes, labels, c, settings=search or None, seed=seed)
             except LearnError as e:
                 failures[c] = str(e)
-        return cls(programs, settings, failures)
+        model = cls(programs, settings, failures)
+        if len(programs) > 1:
+            model.arbiters = model._learn_arbiters(scenes, labels, search or None, seed)
+        return model
+
+    def _learn_arbiters(self, scenes: list[SceneFacts], labels: list[str], settings: dict | None, seed: int
+                        ) -> dict[tuple[str, str], Program]:
+        """Programs that tell rival classes apart: two classes are rivals where a training example's own
+        program proves it and the other's proof ranks above it (two classes' programs alike, such as "a
+        rectangle face with an obtuse neighbour" for both pentagonal and hexagonal prisms, which their
+        one-against-all tasks cannot tell from the better J of the general clause). For each class of a
+        rival pair, a program learned on the two classes' training examples alone, its own as positives
+        (the search of :func:`fit`, with the model's settings); none where that search finds none."""
+        rivals = set()
+        for scene, y in zip(scenes, labels):
+            proofs = self._proofs(scene)
+            if proofs and proofs[0]["label"] != y and any(p["label"] == y for p in proofs):
+                rivals.add(tuple(sorted((y, proofs[0]["label"]))))
+        arbiters = {}
+        for a, b in sorted(rivals):
+            pair = [(s, y) for s, y in zip(scenes, labels) if y in (a, b)]
+            for c, other in ((a, b), (b, a)):
+                name = f"{self.programs[c].target}_over_{self.programs[other].target}"
+                try:
+                    arbiters[(c, other)] = fit([s for s, _ in pair], [name if y == c else other for _, y in pair],
+                                               name, settings=settings, seed=seed)
+                except LearnError:
+                    continue
+        return arbiters
 
     def _proofs(self, scene: SceneFacts, near: bool = False) -> list[dict]:
         if scene.target is None:
             raise InputError(scene.scene, "scene has no target object")
+        arbiters = {} if near else self.arbiters  # a near answer is no proof for an arbiter to weigh
         progs = engine.plist(f"{p.target}-{engine.plist(engine.quote(c) for c in p.clauses)}"
-                             for p in self.programs.values())
+                             for p in [*self.programs.values(), *arbiters.values()])
         preds = engine.plist(f"{p}/{a}" for p, a in body_preds(scene.modality))
         opts = {k: v for k, v in {**SHAPE_SETTINGS, **self.settings}.items() if k not in ("metarules", "derived")}
         thr = self._thresholds(opts)
+        default = float(opts.get("threshold", 0.5))
+        arb_thr = {p.target: float(p.score.get("threshold", default)) for p in arbiters.values()}
+        thr_all = {**thr, **arb_thr}
         # every program proves it when near, missing facts at NEAR_MISS each
-        opts["threshold"] = 0.0 if near else min(thr.values(), default=0.5)
+        opts["threshold"] = 0.0 if near else min(thr_all.values(), default=0.5)
         if near:
             opts["miss"] = NEAR_MISS
         goal = (f"{_load(SCENE_MODULE, [scene])}, lv3d_bridge:classify({SCENE_MODULE}, {progs}, {preds}, "
                 f"{scene.target}, {engine.settings_term(opts)}, Rs), lv3d_bridge:drop_scene({SCENE_MODULE})")
         ans = engine.query(goal, where=f"classifying {scene.scene}")
         classes = {p.target: c for c, p in self.programs.items()}
-        out = []
+        out, settled = [], {}
         for r in ans[0]["Rs"] if ans else []:
             pred, conf, trace = _result_parts(r)
+            if pred in arb_thr:
+                if conf >= arb_thr[pred]:
+                    settled[pred] = trace
+                continue
             label = classes.get(pred, pred)
             if near or conf >= thr[label]:
                 # a near proof ranks by its per-fact (geometric mean) confidence: a program of two
@@ -258,7 +307,28 @@ class Model:
         for r in out:
             r["rank"] *= prec.get(r["label"], 1.0)
         out.sort(key=lambda r: (r["rank"], j.get(r["label"], 0.0)), reverse=True)
-        return out
+        return self._arbitrate(out, settled)
+
+    def _arbitrate(self, proofs: list[dict], settled: dict[str, list]) -> list[dict]:
+        """``proofs`` ranked, with the two first swapped where the pair's arbiters say so: the second's arbiter
+        proves the scene (``settled``: arbiter target -> its proof's trace) and the first's does not. The one
+        ranked first then carries ``rival`` (the other class) and ``rival_trace`` when an arbiter decided."""
+        if len(proofs) < 2:
+            return proofs
+        first, second = proofs[0]["label"], proofs[1]["label"]
+        told = {}
+        for c, other in ((first, second), (second, first)):
+            arb = self.arbiters.get((c, other))
+            if arb is not None and arb.target in settled:
+                told[c] = (arb, settled[arb.target])
+        if len(told) != 1:  # neither or both: the arbiters cannot tell them apart
+            return proofs
+        winner = next(iter(told))
+        ranked = proofs if winner == first else [proofs[1], proofs[0], *proofs[2:]]
+        loser = second if winner == first else first
+        arb, trace = told[winner]
+        ranked[0] = {**ranked[0], "rival": loser, "rival_program": arb, "rival_trace": trace}
+        return ranked
 
     def _decide(self, scene: SceneFacts) -> list[dict]:
         proofs = self._proofs(scene)
@@ -288,17 +358,31 @@ class Model:
             facts=[(a, c) for k, a, c in best["trace"] if k == "fact"],
             derived=[a for k, a, _ in best["trace"] if k == "derived"],
             others={p["label"]: p["conf"] for p in proofs[1:]},
-            missing=[a for k, a, _ in best["trace"] if k == "missing"], near=best.get("near", False))
+            missing=[a for k, a, _ in best["trace"] if k == "missing"], near=best.get("near", False),
+            **self._rival_parts(best))
+
+    @staticmethod
+    def _rival_parts(best: dict) -> dict:
+        """The Explanation fields of the arbiter that ranked ``best`` first, if one did."""
+        if "rival" not in best:
+            return {}
+        arb, trace = best["rival_program"], best["rival_trace"]
+        used = sorted({int(i) for k, i, _ in trace if k == "clause"})
+        return {"rival": best["rival"],
+                "rival_clauses": [arb.clauses[i - 1] for i in used if 0 < i <= len(arb.clauses)],
+                "rival_facts": [(a, c) for k, a, c in trace if k == "fact"]}
 
     def save(self, out_dir: Path) -> Path:
         out_dir = Path(out_dir)
         out_dir.mkdir(parents=True, exist_ok=True)
-        for p in self.programs.values():
+        for p in [*self.programs.values(), *self.arbiters.values()]:
             p.save(out_dir / f"{p.target}.pl")
         (out_dir / "model.json").write_text(json.dumps(
             {"classes": sorted(self.programs), "settings": self.settings,
              "scores": {k: p.score for k, p in self.programs.items()},
-             "predicates": {k: p.target for k, p in self.programs.items() if p.target != k}}, indent=1))
+             "predicates": {k: p.target for k, p in self.programs.items() if p.target != k},
+             "arbiters": [{"class": c, "rival": r, "predicate": p.target, "score": p.score}
+                          for (c, r), p in sorted(self.arbiters.items())]}, indent=1))
         return out_dir
 
     @classmethod
@@ -319,7 +403,17 @@ class Model:
             p = Program.load(in_dir / f"{pred}.pl", target=pred)
             programs[c] = Program(p.target, p.clauses, meta.get("scores", {}).get(c, {}), p.modality,
                                   label=c if pred != c else None)
-        return cls(programs, meta.get("settings", {}))
+        arbiters = {}
+        for a in meta.get("arbiters", []) if isinstance(meta.get("arbiters"), list) else []:
+            try:
+                c, r, pred = str(a["class"]), str(a["rival"]), str(a["predicate"])
+            except (KeyError, TypeError) as e:
+                raise InputError(index, f"malformed arbiter {a!r}: {e}") from None
+            if c not in programs or r not in programs:
+                raise InputError(index, f"an arbiter of {c!r} over {r!r}, a class the model does not hold")
+            p = Program.load(in_dir / f"{pred}.pl", target=pred)
+            arbiters[(c, r)] = Program(p.target, p.clauses, a.get("score", {}) or {}, p.modality)
+        return cls(programs, meta.get("settings", {}), arbiters=arbiters)
 
 
 def _result_parts(r) -> tuple[str, float, list[tuple[str, str, float]]]:
