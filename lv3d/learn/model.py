@@ -324,7 +324,7 @@ class Model:
         if len(told) != 1:  # neither or both: the arbiters cannot tell them apart
             return proofs
         winner = next(iter(told))
-        ranked = proofs if winner == first else [proofs[1], proofs[0], *proofs[2:]]
+        ranked = list(proofs) if winner == first else [proofs[1], proofs[0], *proofs[2:]]
         loser = second if winner == first else first
         arb, trace = told[winner]
         ranked[0] = {**ranked[0], "rival": loser, "rival_program": arb, "rival_trace": trace}
