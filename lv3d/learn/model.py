@@ -138,6 +138,7 @@ def fit(scenes: list[SceneFacts], labels: list[str], target: str, *, settings: d
     if "sample_neg" not in user:  # few negatives: a sample holds at most two thirds of them (docs/learner.md)
         opts["sample_neg"] = min(opts["sample_neg"], few_negatives(len(neg)))
     label, target = target, predicate_name(target)
+    opts.pop("arbiters", None)  # Model.fit's, not the search's
     preds = engine.plist(f"{p}/{a}" for p, a in body_preds(modality, opts.pop("derived", True)))
     mrs = engine.plist(opts.pop("metarules", SHAPE_METARULES))
     goal = (f"{_load(FIT_MODULE, scenes)}, "
@@ -226,7 +227,9 @@ class Model:
         nothing or runs out of time gets no program (it is never predicted); ``failures`` says why.
         With several classes each search shrinks its samples where none gives a hypothesis
         (``shrink_samples``, docs/learner.md), unless ``settings`` say otherwise: a class without a
-        program is never the answer, while one class's task without a program answers "no"."""
+        program is never the answer, while one class's task without a program answers "no". With several
+        classes the model also learns arbiters between rival classes (:meth:`_learn_arbiters`) unless
+        ``settings`` hold ``arbiters: false``."""
         settings = check_settings(settings) or None  # a bad setting stops here, not as every class's failure
         classes = classes or sorted(set(labels))
         search = dict(settings or {})
@@ -239,7 +242,7 @@ class Model:
             except LearnError as e:
                 failures[c] = str(e)
         model = cls(programs, settings, failures)
-        if len(programs) > 1:
+        if len(programs) > 1 and search.get("arbiters", True):
             model.arbiters = model._learn_arbiters(scenes, labels, search or None, seed)
         return model
 
@@ -275,7 +278,8 @@ class Model:
         progs = engine.plist(f"{p.target}-{engine.plist(engine.quote(c) for c in p.clauses)}"
                              for p in [*self.programs.values(), *arbiters.values()])
         preds = engine.plist(f"{p}/{a}" for p, a in body_preds(scene.modality))
-        opts = {k: v for k, v in {**SHAPE_SETTINGS, **self.settings}.items() if k not in ("metarules", "derived")}
+        opts = {k: v for k, v in {**SHAPE_SETTINGS, **self.settings}.items()
+                if k not in ("metarules", "derived", "arbiters")}
         thr = self._thresholds(opts)
         default = float(opts.get("threshold", 0.5))
         arb_thr = {p.target: float(p.score.get("threshold", default)) for p in arbiters.values()}

@@ -45,6 +45,7 @@ SETTINGS: dict[str, tuple] = {
     "seed": ("int", 0, 2 ** 32 - 1, "random seed (a study sets it per task)"),
     "metarules": ("metarules", None, None, "metarules, in search order"),
     "derived": ("bool", None, None, "shape learning: offer prolog/shape_bk.pl's derived predicates"),
+    "arbiters": ("bool", None, None, "a model of several classes learns arbiters between rival classes"),
 }
 
 

@@ -99,3 +99,10 @@ def test_only_one_arbiter_proving_reorders_the_first_two():
     assert model._arbitrate(ranked, {"a_over_b": trace, "b_over_a": trace}) == ranked  # both prove
     kept = model._arbitrate(ranked, {"b_over_a": trace})  # the first is confirmed, and says why
     assert [p["label"] for p in kept] == ["b", "a", "c"] and kept[0]["rival"] == "a"
+
+
+def test_the_arbiters_setting_turns_them_off():
+    scenes, labels = _task()
+    model = Model.fit(scenes, labels, settings={"disjunctions": 0, "arbiters": False}, seed=0)
+    assert model.arbiters == {} and model.settings["arbiters"] is False
+    assert model.predict(_prism("t5", "pentagon"))[0] in ("pent", "hex")  # proved by both, as the ranking has it
