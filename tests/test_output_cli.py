@@ -68,7 +68,7 @@ def test_learn_fit_replaces_its_own_output(tmp_path, capsys, monkeypatch):
     from lv3d.learn.model import Model
 
     class Fitted:
-        programs, failures = {}, {}
+        programs, failures, arbiters = {}, {}, {}
 
         def __init__(self, n):
             self.n = n
