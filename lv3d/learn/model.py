@@ -13,7 +13,7 @@ from ..facts import PREDICATES, SceneFacts
 from . import engine
 from .engine import LearnError
 from .program import Program
-from .settings import check_settings
+from .settings import NOT_MIL, check_settings
 
 # Metarules for shape concepts, in search order: a part with a property, a part with two, a
 # conjunction on the object, then a part in a relation with another part.
@@ -278,14 +278,11 @@ class Model:
         progs = engine.plist(f"{p.target}-{engine.plist(engine.quote(c) for c in p.clauses)}"
                              for p in [*self.programs.values(), *arbiters.values()])
         preds = engine.plist(f"{p}/{a}" for p, a in body_preds(scene.modality))
-        opts = {k: v for k, v in {**SHAPE_SETTINGS, **self.settings}.items()
-                if k not in ("metarules", "derived", "arbiters")}
+        opts = {k: v for k, v in {**SHAPE_SETTINGS, **self.settings}.items() if k not in NOT_MIL}
         thr = self._thresholds(opts)
-        default = float(opts.get("threshold", 0.5))
-        arb_thr = {p.target: float(p.score.get("threshold", default)) for p in arbiters.values()}
-        thr_all = {**thr, **arb_thr}
+        arb_thr = self._thresholds(opts, {p.target: p for p in arbiters.values()})
         # every program proves it when near, missing facts at NEAR_MISS each
-        opts["threshold"] = 0.0 if near else min(thr_all.values(), default=0.5)
+        opts["threshold"] = 0.0 if near else min([*thr.values(), *arb_thr.values()], default=0.5)
         if near:
             opts["miss"] = NEAR_MISS
         goal = (f"{_load(SCENE_MODULE, [scene])}, lv3d_bridge:classify({SCENE_MODULE}, {progs}, {preds}, "
@@ -340,10 +337,12 @@ class Model:
             proofs = [{**p, "near": True} for p in self._proofs(scene, near=True)]
         return proofs
 
-    def _thresholds(self, opts: dict) -> dict[str, float]:
-        """Each program's coverage threshold: the one it was learned with, else the settings'."""
+    def _thresholds(self, opts: dict, programs: dict[str, Program] | None = None) -> dict[str, float]:
+        """Each program's coverage threshold (of ``programs``, default the classes'), by the same keys: the one it
+        was learned with, else the settings'."""
         default = float(opts.get("threshold", 0.5))
-        return {k: float(p.score.get("threshold", default)) for k, p in self.programs.items()}
+        programs = self.programs if programs is None else programs
+        return {k: float(p.score.get("threshold", default)) for k, p in programs.items()}
 
     def predict(self, scene: SceneFacts) -> tuple[str, float]:
         proofs = self._decide(scene)
@@ -354,12 +353,9 @@ class Model:
         if not proofs:
             return Explanation("unknown", 0.0, scene.target)
         best = proofs[0]
-        prog = self.programs[best["label"]]
-        used = sorted({int(i) for k, i, _ in best["trace"] if k == "clause"})
+        clauses, facts = _proof_parts(self.programs[best["label"]], best["trace"])
         return Explanation(
-            best["label"], best["conf"], scene.target,
-            clauses=[prog.clauses[i - 1] for i in used if 0 < i <= len(prog.clauses)],
-            facts=[(a, c) for k, a, c in best["trace"] if k == "fact"],
+            best["label"], best["conf"], scene.target, clauses=clauses, facts=facts,
             derived=[a for k, a, _ in best["trace"] if k == "derived"],
             others={p["label"]: p["conf"] for p in proofs[1:]},
             missing=[a for k, a, _ in best["trace"] if k == "missing"], near=best.get("near", False),
@@ -370,11 +366,8 @@ class Model:
         """The Explanation fields of the arbiter that ranked ``best`` first, if one did."""
         if "rival" not in best:
             return {}
-        arb, trace = best["rival_program"], best["rival_trace"]
-        used = sorted({int(i) for k, i, _ in trace if k == "clause"})
-        return {"rival": best["rival"],
-                "rival_clauses": [arb.clauses[i - 1] for i in used if 0 < i <= len(arb.clauses)],
-                "rival_facts": [(a, c) for k, a, c in trace if k == "fact"]}
+        clauses, facts = _proof_parts(best["rival_program"], best["rival_trace"])
+        return {"rival": best["rival"], "rival_clauses": clauses, "rival_facts": facts}
 
     def save(self, out_dir: Path) -> Path:
         out_dir = Path(out_dir)
@@ -418,6 +411,13 @@ class Model:
             p = Program.load(in_dir / f"{pred}.pl", target=pred)
             arbiters[(c, r)] = Program(p.target, p.clauses, a.get("score", {}) or {}, p.modality)
         return cls(programs, meta.get("settings", {}), arbiters=arbiters)
+
+
+def _proof_parts(program: Program, trace: list[tuple[str, str, float]]) -> tuple[list[str], list[tuple[str, float]]]:
+    """The clauses of ``program`` a proof's ``trace`` used, in order, and the facts it used with their confidences."""
+    used = sorted({int(i) for k, i, _ in trace if k == "clause"})
+    return ([program.clauses[i - 1] for i in used if 0 < i <= len(program.clauses)],
+            [(a, c) for k, a, c in trace if k == "fact"])
 
 
 def _result_parts(r) -> tuple[str, float, list[tuple[str, str, float]]]:

@@ -47,6 +47,8 @@ SETTINGS: dict[str, tuple] = {
     "derived": ("bool", None, None, "shape learning: offer prolog/shape_bk.pl's derived predicates"),
     "arbiters": ("bool", None, None, "a model of several classes learns arbiters between rival classes"),
 }
+# the settings lv3d's Python side reads itself (lv3d.learn.model), which are no options of prolog/mil.pl
+NOT_MIL = frozenset({"metarules", "derived", "arbiters"})
 
 
 def _num(v) -> bool:
