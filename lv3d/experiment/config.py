@@ -80,7 +80,8 @@ def _is_int(v) -> bool:
     return isinstance(v, int) and not isinstance(v, bool)
 
 
-def _is_num(v) -> bool:
+def is_number(v) -> bool:
+    """A finite int or float (not a bool)."""
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
@@ -103,7 +104,7 @@ def check_value(value, meta: dict, key: str, where: str):
         return None
     lo, hi, lo_open = meta["lo"], meta["hi"], meta["lo_open"]
     if kind in ("int", "number"):
-        ok = _is_int(value) if kind == "int" else _is_num(value)
+        ok = _is_int(value) if kind == "int" else is_number(value)
         if not ok:
             bad("must be a whole number" if kind == "int" else "must be a number")
         if (lo is not None and (value <= lo if lo_open else value < lo)) or (hi is not None and value > hi):
@@ -331,7 +332,7 @@ def check_noise(data: DataConfig, where: str) -> None:
     except TypeError as e:
         raise InputError(where, f"data.noise_overrides: {e}") from None
     for knob, value in data.noise_overrides.items():
-        if knob in KNOB_RANGES and _is_num(value):
+        if knob in KNOB_RANGES and is_number(value):
             lo, hi = KNOB_RANGES[knob]
             if not lo <= value <= hi:
                 raise InputError(where, f"data.noise_overrides.{knob}: must be from {lo:g} to {hi:g}, got {value!r}")

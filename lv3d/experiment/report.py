@@ -14,7 +14,7 @@ import math
 from pathlib import Path
 
 from ..output import write_atomic
-from .config import LOGIC_SYSTEMS, StudyConfig
+from .config import LOGIC_SYSTEMS, StudyConfig, is_number
 from .folds import fold_path
 from .stats import ece, mean_std, paired, reliability_bins
 
@@ -135,7 +135,7 @@ def _against_best(summary: dict, prefix: str) -> dict | None:
 def _mean_balanced(tasks: dict, classes: list[str]) -> float:
     """The mean balanced accuracy of one fold's class tasks that have one (NaN for none)."""
     vals = [tasks[c].get("balanced_accuracy") for c in classes if c in tasks]
-    vals = [v for v in vals if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)]
+    vals = [v for v in vals if is_number(v)]
     return sum(vals) / len(vals) if vals else float("nan")
 
 
