@@ -209,8 +209,9 @@ class Model:
     a program that proves the class's training examples and not the rival's, :meth:`fit`), the class
     whose arbiter proves it while the other's does not comes first. When none proves
     it: with one program, "unknown" (the negative answer of a class task); with several, the class
-    whose program it misses by least (the highest per-fact confidence, absent facts at NEAR_MISS),
-    with that near proof's confidence, which is below the coverage threshold."""
+    whose program it misses by least (:func:`_near_rank`: the largest share of the program's facts present,
+    then the highest per-fact confidence of those, times precision; absent facts at NEAR_MISS), with
+    that near proof's confidence, which is below the coverage threshold."""
 
     def __init__(self, programs: dict[str, Program], settings: dict | None = None,
                  failures: dict[str, str] | None = None,
@@ -298,16 +299,13 @@ class Model:
                 continue
             label = classes.get(pred, pred)
             if near or conf >= thr[label]:
-                # a near proof ranks by its per-fact (geometric mean) confidence: a program of two
-                # facts missing one is half matched, one of four missing one three-quarters, where
-                # the product would rank them alike and favour the fewer present facts
-                n = sum(k in ("fact", "missing") for k, _, _ in trace) if near else 1
-                out.append({"label": label, "conf": conf, "trace": trace, "rank": conf ** (1 / max(n, 1))})
+                matched, rank = _near_rank(trace) if near else (1.0, conf)
+                out.append({"label": label, "conf": conf, "trace": trace, "matched": matched, "rank": rank})
         j = {k: p.score.get("j", 0.0) for k, p in self.programs.items()}
         prec = {k: precision(p.score) for k, p in self.programs.items()}
         for r in out:
             r["rank"] *= prec.get(r["label"], 1.0)
-        out.sort(key=lambda r: (r["rank"], j.get(r["label"], 0.0)), reverse=True)
+        out.sort(key=lambda r: (r["matched"], r["rank"], j.get(r["label"], 0.0)), reverse=True)
         return self._arbitrate(out, settled)
 
     def _arbitrate(self, proofs: list[dict], settled: dict[str, list]) -> list[dict]:
@@ -418,6 +416,19 @@ def _proof_parts(program: Program, trace: list[tuple[str, str, float]]) -> tuple
     used = sorted({int(i) for k, i, _ in trace if k == "clause"})
     return ([program.clauses[i - 1] for i in used if 0 < i <= len(program.clauses)],
             [(a, c) for k, a, c in trace if k == "fact"])
+
+
+def _near_rank(trace: list[tuple[str, str, float]]) -> tuple[float, float]:
+    """How nearly a near proof (``trace`` of a proof with absent facts at NEAR_MISS) proves its scene: the share
+    of its program's facts the scene holds, and the per-fact (geometric mean) confidence of those it holds
+    (1 when it holds none). The share ranks first: a program whose every fact is there, believed below its
+    threshold, is a weak proof where one missing a fact is no proof; a program of four facts missing one
+    matches more of the scene than one of two missing one, where the product would rank them alike."""
+    held = [c for k, _, c in trace if k == "fact"]
+    missing = sum(k == "missing" for k, _, _ in trace)
+    if not held:
+        return 0.0, 1.0
+    return len(held) / (len(held) + missing), math.exp(sum(math.log(max(c, 1e-12)) for c in held) / len(held))
 
 
 def _result_parts(r) -> tuple[str, float, list[tuple[str, str, float]]]:

@@ -61,6 +61,21 @@ def test_near_miss_ranks_by_the_share_of_facts_missed():
     assert label == "tri" and abs(conf - 0.081) < 1e-6
 
 
+def test_a_weak_proof_with_every_fact_ranks_above_a_near_miss():
+    # tri's every fact is there, each doubtful (per fact 0.027 ** (1 / 4) = 0.41); pent's face is a sure
+    # pentagon but not regular (per fact (1 * 1 * 0.1) ** (1 / 3) = 0.46): a missing fact is no evidence at all,
+    # a doubtful one is some, so the share of the program's facts present ranks first
+    scene = _scene(8, [[("triangle", 0.3), ("pentagon", 1.0)], [("square", 0.3)]],
+                   pairs=[("perpendicular", 1, 2, 0.3)])
+    model = _model()
+    assert model._proofs(scene) == []
+    near = {p["label"]: p for p in model._proofs(scene, near=True)}
+    assert near["tri"]["matched"] == 1.0 and abs(near["pent"]["matched"] - 2 / 3) < 1e-9
+    assert near["tri"]["rank"] < near["pent"]["rank"]  # per fact pent is ahead, yet
+    label, conf = model.predict(scene)
+    assert label == "tri" and abs(conf - 0.027) < 1e-6
+
+
 def test_near_answer_with_every_fact_says_it_is_below_threshold():
     # every fact of tri's clause is there, but the right angle is too doubtful for the threshold
     scene = _scene(6, [[("triangle", 1.0)], [("square", 1.0)]], pairs=[("perpendicular", 1, 2, 0.3)])
