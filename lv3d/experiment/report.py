@@ -1,6 +1,7 @@
 """The study's report, regenerated from the fold files (never edited by hand):
 ``results.csv`` (one row per condition x system x fold x task), ``results.json`` (means, standard
-deviations, paired tests and the calibration of the multi-class answers), ``results.md`` (the tables),
+deviations, paired tests, the calibration of the multi-class answers and, for lv3d systems, how they were
+reached: by a proof, an arbiter, a near proof or none), ``results.md`` (the tables),
 ``accuracy.png``, ``reliability.png`` (the answers' reliability diagram, last condition) and ``sweep.png``
 when the study has several conditions.
 """
@@ -13,6 +14,7 @@ import json
 import math
 from pathlib import Path
 
+from ..learn.model import ANSWER_KINDS
 from ..output import write_atomic
 from .config import LOGIC_SYSTEMS, StudyConfig, is_number
 from .folds import fold_path
@@ -80,6 +82,9 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
         calibration = answer_calibration(recs)
         if calibration:
             per["calibration"] = calibration
+        reached = answer_kinds(recs)
+        if reached:
+            per["answered_by"] = reached
         left = next((r["left_out"] for r in recs if r.get("left_out") is not None), None)
         if left is not None:
             summary["left_out"] = left
@@ -116,6 +121,22 @@ def answer_calibration(recs: list[dict]) -> dict | None:
     if not conf:
         return None
     return {"ece": ece(conf, right), "answers": len(conf), "bins": reliability_bins(conf, right)}
+
+
+def answer_kinds(recs: list[dict]) -> dict | None:
+    """How a system's multi-class answers were reached (the fold files' ``answered_by``, lv3d systems), over
+    every fold and draw: {kind: (answers, right)}; None where the fold files do not say."""
+    out: dict[str, list[int]] = {}
+    for r in recs:
+        truth, preds, hows = r.get("test_classes"), r.get("predictions", {}).get("multiclass"), r.get("answered_by")
+        if not truth or not preds or not hows:
+            continue
+        for draw, how in zip(preds if isinstance(preds[0][0], list) else [preds], hows):
+            for (_, label, _), y, kind in zip(draw, truth, how):
+                n = out.setdefault(kind, [0, 0])
+                n[0] += 1
+                n[1] += label == y
+    return {k: tuple(v) for k, v in out.items()} or None
 
 
 def _against_best(summary: dict, prefix: str) -> dict | None:
@@ -196,6 +217,17 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
                 mc = sum(b[1] * b[2] for b in c["bins"]) / n
                 mr = sum(b[1] * b[3] for b in c["bins"]) / n
                 lines.append(f"| {s} | {c['answers']} | {c['ece']:.3f} | {mc:.3f} | {mr:.3f} |")
+        reached = {s: per["answered_by"] for s, per in summ["systems"].items() if per.get("answered_by")}
+        if reached:
+            lines += ["", "How the lv3d systems reached their multi-class answers (answers, and the share right): "
+                      "*proof*, a class's program proves the object and ranks first; *arbiter*, two classes' "
+                      "programs prove it and an arbiter between them chose; *near*, no program proves it and the "
+                      "one it misses by least names the class; *unknown*, no answer (no object, or no program):", "",
+                      "| system | " + " | ".join(ANSWER_KINDS) + " |", "|---|" + "---|" * len(ANSWER_KINDS)]
+            for s, kinds in reached.items():
+                cols = [f"{kinds[k][0]} ({100 * kinds[k][1] / kinds[k][0]:.0f} %)" if kinds.get(k, (0,))[0] else "0"
+                        for k in ANSWER_KINDS]
+                lines.append(f"| {s} | " + " | ".join(cols) + " |")
         left = summ.get("left_out")
         if left is not None:
             other = ", ".join(f"{k} {v}" for k, v in sorted(left["other_classes"].items())) or "none"

@@ -121,7 +121,9 @@ def run_fold(system, cfg: StudyConfig, train: list[Item], test: list[Item], fold
     With ``train.draws`` > 1 each task is trained on that many independently seeded samples: its accuracies
     are their means, its counts their sums, ``per_draw`` lists each draw's accuracy, its predictions and
     programs are per draw (``draw<d>``); draw 0 is the sample one draw takes. ``learn_failures`` maps a
-    task (``task`` or ``task/draw<d>``) to {class: why no program was learned}."""
+    task (``task`` or ``task/draw<d>``) to {class: why no program was learned}. For a system that says how it
+    reached each answer (an lv3d model's ``answer``), ``answered_by`` lists, per draw, how each multi-class
+    answer was reached, in the order of ``test_ids`` (lv3d.learn.model.ANSWER_KINDS)."""
     t = cfg.train
     draws = t.draws
     classes = list(cfg.data.classes)
@@ -169,7 +171,12 @@ def run_fold(system, cfg: StudyConfig, train: list[Item], test: list[Item], fold
             examples = multiclass_task(train, t.positives, seed)
             t0 = time.perf_counter()
             fitted = system.fit([it.id for it in examples], [it.cls for it in examples], seed)
-            preds.append(fitted.predict(test_ids))
+            if hasattr(fitted, "answer"):  # an lv3d model says how it reached each answer
+                answers = fitted.answer(test_ids)
+                preds.append([(label, conf) for label, conf, _ in answers])
+                record.setdefault("answered_by", []).append([how for *_, how in answers])
+            else:
+                preds.append(fitted.predict(test_ids))
             correct = [label == it.cls for (label, _), it in zip(preds[-1], test)]
             scores.append({"accuracy": float(np.mean(correct)), "n": len(correct), "n_train": len(examples),
                            "seconds": round(time.perf_counter() - t0, 3)})

@@ -68,10 +68,15 @@ class FittedLogic:
     def predict(self, ids: list[str]) -> list[tuple[str, float]]:
         """(label, confidence of the best proof); "unknown" where no program proves the target (or
         perception found no object)."""
+        return [(label, conf) for label, conf, _ in self.answer(ids)]
+
+    def answer(self, ids: list[str]) -> list[tuple[str, float, str]]:
+        """:meth:`predict`'s answers with how each was reached (lv3d.learn.model.Model.answer: "proof",
+        "arbiter", "near" or "unknown"; "unknown" too where perception found no object)."""
         out = []
         for i in ids:
             scene = self.facts[i]
-            out.append(("unknown", 0.0) if scene.target is None else tuple(self.model.predict(scene)))
+            out.append(("unknown", 0.0, "unknown") if scene.target is None else tuple(self.model.answer(scene)))
         return out
 
     def explain(self, scene_id: str):

@@ -22,6 +22,7 @@ SHAPE_METARULES = ("part", "part2", "part_pair")
 # misses by least (docs/learner.md, "Classifying"): a fact the scene lacks counts as holding with
 # this confidence, the chance that perception missed a true fact.
 NEAR_MISS = 0.1
+ANSWER_KINDS = ("proof", "arbiter", "near", "unknown")  # how Model.answer reached an answer
 # Learning from many examples (docs/learner.md, "Imperfect labels"): 16 samples of 2 positives and
 # 6 negatives; with 20 % wrong labels, 3 to 7 of them hold none, where 8 samples of 2 + 12 held 0.3 to 2.
 # In few-shot tasks a `regular` literal costs 0.5 nats of prior (docs/learner.md, Settings): every class
@@ -343,8 +344,19 @@ class Model:
         return {k: float(p.score.get("threshold", default)) for k, p in programs.items()}
 
     def predict(self, scene: SceneFacts) -> tuple[str, float]:
+        label, conf, _ = self.answer(scene)
+        return label, conf
+
+    def answer(self, scene: SceneFacts) -> tuple[str, float, str]:
+        """:meth:`predict`'s (label, confidence) and how the answer was reached (``ANSWER_KINDS``): "proof" (a
+        program proves the scene and ranks first), "arbiter" (two classes' programs prove it and an arbiter put
+        this one first), "near" (no program proves it: the nearest, several programs only) or "unknown"."""
         proofs = self._decide(scene)
-        return (proofs[0]["label"], proofs[0]["conf"]) if proofs else ("unknown", 0.0)
+        if not proofs:
+            return "unknown", 0.0, "unknown"
+        best = proofs[0]
+        how = "near" if best.get("near") else "arbiter" if "rival" in best else "proof"
+        return best["label"], best["conf"], how
 
     def explain(self, scene: SceneFacts) -> Explanation:
         proofs = self._decide(scene)

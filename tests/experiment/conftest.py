@@ -85,6 +85,10 @@ class FakeModel:
         label = max(sorted(votes), key=votes.get)
         return label, votes[label] / sum(votes.values())
 
+    def answer(self, scene):
+        label, conf = self.predict(scene)
+        return label, conf, "unknown" if label == "none" else "proof"
+
     def explain(self, scene):
         return f"{self.predict(scene)[0]} because {sorted(self._sig(scene))}"
 

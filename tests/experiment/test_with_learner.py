@@ -17,6 +17,14 @@ def test_real_learner_learns_side_counts(tmp_path, tiny_config, synthetic_facts,
     # each class has its own side count, so a one-literal program separates it
     assert all(rec["tasks"][c]["accuracy"] == 1.0 for c in ("cube", "square_pyramid", "triangular_prism"))
     assert rec["tasks"]["multiclass"]["accuracy"] == 1.0
+    # every multi-class answer came from a proof, and the report counts how the answers were reached
+    assert [set(draw) for draw in rec["answered_by"]] == [{"proof"}] * len(rec["answered_by"])
+    assert len(rec["answered_by"][0]) == len(rec["test_ids"])
+    summary = json.loads((out / "results.json").read_text())
+    kinds = next(iter(summary["conditions"].values()))["systems"]["lv3d-rgb"]["answered_by"]
+    assert set(kinds) == {"proof"} and kinds["proof"][0] == kinds["proof"][1] > 0
+    md = (out / "results.md").read_text()
+    assert "How the lv3d systems reached their multi-class answers" in md and "(100 %)" in md
     programs = out / "programs" / "base" / "lv3d-rgb" / "fold0"
     assert (programs / "cube" / "cube.pl").is_file() and (programs / "multiclass" / "cube.pl").is_file()
     assert "quadrilateral" in (programs / "cube" / "cube.pl").read_text()

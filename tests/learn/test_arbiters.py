@@ -52,7 +52,7 @@ def test_rival_classes_get_arbiters_that_tell_them_apart():
     assert "hexagon(B)" in str(model.arbiters[("hex", "pent")])
     for name, end, label in (("t1", "pentagon", "pent"), ("t2", "hexagon", "hex")):
         scene = _prism(name, end)
-        assert model.predict(scene)[0] == label
+        assert model.predict(scene)[0] == label and model.answer(scene)[2] == "arbiter"
         e = model.explain(scene)
         assert e.rival == ("hex" if label == "pent" else "pent")
         assert f"{end}({name}_o1_f2)" in [a for a, _ in e.rival_facts]

@@ -37,6 +37,7 @@ def test_near_miss_names_the_class_missed_by_fewest_facts():
     assert model._proofs(scene) == []
     label, conf = model.predict(scene)
     assert label == "tri" and 0 < conf < 0.5
+    assert model.answer(scene) == (label, conf, "near")
     e = model.explain(scene)
     assert e.missing == ["perpendicular(s000001_o1_f1,s000001_o1_f2)"]  # the object's own faces only
     assert "misses by 1" in str(e) and "but not perpendicular" in str(e)
@@ -46,6 +47,7 @@ def test_near_miss_never_for_one_program_or_structure():
     scene = _scene(2, [[("triangle", 1.0)], [("square", 1.0)]])
     one = Model({"tri": _model().programs["tri"]})
     assert one.predict(scene) == ("unknown", 0.0)  # a class task's negative answer
+    assert one.answer(scene) == ("unknown", 0.0, "unknown")
     # an object with no faces: face_of is never assumed, so no near proof exists
     bare = SceneFacts("s000003", "rgbd", [Fact("object", ("s000003_o1",), 1.0)], target="s000003_o1")
     assert _model().predict(bare) == ("unknown", 0.0)
@@ -90,6 +92,7 @@ def test_proved_class_wins_over_near_misses():
     scene = _scene(4, [[("pentagon", 0.9), ("regular", 0.9)], [("triangle", 1.0)]])
     label, conf = _model().predict(scene)
     assert label == "pent" and abs(conf - 0.81) < 1e-6
+    assert _model().answer(scene)[2] == "proof"
 
 
 def test_a_program_that_covered_negatives_yields_to_a_precise_one():
