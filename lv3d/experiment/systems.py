@@ -2,7 +2,8 @@
 
 ``make_system(name, cfg, inputs)`` binds a system to what it sees of every image (``inputs``: id ->
 SceneFacts for lv3d-*, id -> (4, S, S) pixel tensor for the baselines). ``fit(ids, labels, seed)``
-returns a fitted system whose ``predict(ids)`` gives (label, confidence) per image, whose
+returns a fitted system whose ``predict(ids)`` gives (label, confidence) per image (an lv3d one's
+``answer(ids)`` adds how each answer was reached, which the runner keeps for multi-class answers), whose
 ``save(folder)`` writes what it learned that a person can read (the lv3d programs; nothing for
 the baselines) and whose ``failures`` says, per class it could learn no program for, why. Labels are strings: class names, or ``not_<class>`` for the negatives of a class task.
 """
