@@ -105,17 +105,23 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
     return summary, rows
 
 
+def _multiclass_draws(r: dict) -> list[list]:
+    """A fold record's multi-class predictions, one list of [id, label, confidence] per draw (a record of one
+    draw holds that list alone); none where it holds no multi-class predictions or no test classes."""
+    truth, preds = r.get("test_classes"), r.get("predictions", {}).get("multiclass")
+    if not truth or not preds:
+        return []
+    return preds if isinstance(preds[0][0], list) else [preds]
+
+
 def answer_calibration(recs: list[dict]) -> dict | None:
     """How well the confidences of a system's multi-class answers match how often they are right, over every
     fold and draw: {"ece", "answers", "bins": [(lower edge, answers, mean confidence, share right), ...]}; None
     where the fold files hold no multi-class predictions with the test classes beside them."""
     conf, right = [], []
     for r in recs:
-        truth, preds = r.get("test_classes"), r.get("predictions", {}).get("multiclass")
-        if not truth or not preds:
-            continue
-        for draw in (preds if isinstance(preds[0][0], list) else [preds]):
-            for (_, label, c), y in zip(draw, truth):
+        for draw in _multiclass_draws(r):
+            for (_, label, c), y in zip(draw, r["test_classes"]):
                 conf.append(min(1.0, max(0.0, float(c))))
                 right.append(label == y)
     if not conf:
@@ -128,11 +134,8 @@ def answer_kinds(recs: list[dict]) -> dict | None:
     every fold and draw: {kind: (answers, right)}; None where the fold files do not say."""
     out: dict[str, list[int]] = {}
     for r in recs:
-        truth, preds, hows = r.get("test_classes"), r.get("predictions", {}).get("multiclass"), r.get("answered_by")
-        if not truth or not preds or not hows:
-            continue
-        for draw, how in zip(preds if isinstance(preds[0][0], list) else [preds], hows):
-            for (_, label, _), y, kind in zip(draw, truth, how):
+        for draw, how in zip(_multiclass_draws(r), r.get("answered_by") or []):
+            for (_, label, _), y, kind in zip(draw, r["test_classes"], how):
                 n = out.setdefault(kind, [0, 0])
                 n[0] += 1
                 n[1] += label == y
