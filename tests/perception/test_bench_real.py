@@ -158,6 +158,9 @@ def test_a_frame_counts_each_labelled_object_once_and_the_figures_follow():
     assert f["box_overfaced_frac"] == 0.0 and f["cylinder_as_prism_frac"] == 0.5
     assert f["perpendicular_ece"] == pytest.approx(0.6)
     assert f["ms_median"] == 100.0 and f["labelled_found"] == 0.75
+    assert f["compile_s"] == 0.0  # rows without JIT work
+    assert bench.summarise([dict(row, ms=50.0, compile_ms=300.0), dict(row, ms=150.0, compile_ms=200.0)],
+                           "depth")["compile_s"] == 0.5
 
 
 def test_each_labelled_object_has_a_record_whose_verdicts_sum_to_the_frame_counts(tmp_path):
@@ -394,3 +397,17 @@ def test_bowls_read_as_curved_count_any_curved_face_of_the_object_under_the_pixe
     assert (row["bowls"], row["bowl_curved"]) == (2, 1)
     assert bench.summarise([dict(row, ms=1.0)], "depth")["bowl_curved_frac"] == 0.5
     assert bench.summarise([dict(row, ms=1.0)], "rgb")["bowl_curved_frac"] is None
+
+
+def test_the_compile_clock_hears_jit_work_and_starts_again_at_zero():
+    import jax
+    import jax.numpy as jnp
+
+    clock = bench.compile_clock()
+    assert bench.compile_clock() is clock  # one listener for the process
+    clock.start()
+    scale = float(np.random.default_rng().uniform(2.0, 3.0))  # a program no earlier test compiled
+    jax.jit(lambda x: jnp.sin(x) * scale)(jnp.ones(7)).block_until_ready()
+    assert clock.spent > 0.0
+    clock.start()
+    assert clock.spent == 0.0
