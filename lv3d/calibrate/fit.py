@@ -38,7 +38,10 @@ its perception errors): the raw probability unchanged, a shift in logit space, P
 logit p), and Platt plus face measurements (``FEATURES``; for predicates with a tolerance also ``tol_frac``, the
 measured value in tolerances), each with and without how well the faces fit a polygon and a plane
 (``FIT_FEATURES``) and with those and a slope on logit p that depends on them (``GATE_FEATURES``: the measured
-probability counts as far as the outlines are straight and the corners sharp); for facts about two faces
+probability counts as far as the outlines are straight and the corners sharp), and Platt plus the fit measures
+alone, with and without a slope that also depends on how flat the faces are (``PLANE_GATE``), none of the other
+measurements (where those read differently on a sensor's frames than on rendered ones, as the edge support of
+the colour + depth edge field does under rgbd); for facts about two faces
 (``PAIR_PREDS``) also those plus the side the two share (``PAIR_FEATURES``), for parallel (``PLANE_GAP_PREDS``)
 plus how far the faces are from one plane. The winner is refitted on all rows (L2-regularised logistic
 regression, inputs standardised, the standardisation folded into the coefficients); a map whose slope on logit p
@@ -91,6 +94,9 @@ FIT_FEATURES = ["edge_scale2", "plane_rms_mm"]
 # the slope on logit p may grow or shrink with how straight the outlines are and how sharp the weakest corner:
 # the measured probability is trusted as far as the faces look like faces of a polyhedron (grounding._calibration)
 GATE_FEATURES = ["logit_p*edge_scale2", "logit_p*min_turn_z"]
+# ... and with how flat the faces are: an angle between planes measured on faces that depart from their planes by
+# a sensor's noise (or by a curved surface's sagitta) says less than one measured on flat faces
+PLANE_GATE = ["logit_p*plane_rms_mm"]
 MIN_ROWS = 12        # fewer rows (or one class of label only): keep the raw probability
 C_REG = 0.5          # inverse L2 strength of the logistic fits (standardised inputs, weights averaging 1)
 MIN_CONF = 0.05      # facts below this confidence are not emitted (lv3d.describe.MIN_CONF): ECE is over the rest
@@ -239,6 +245,8 @@ def candidate_maps(pred: str) -> dict:
     cands = {"raw": "raw", "shift": None, "platt": ["logit_p"], "platt+measures": ["logit_p"] + FEATURES + tol,
              "platt+measures+fit": ["logit_p"] + FEATURES + FIT_FEATURES + tol}
     cands["platt+measures+fit+gated"] = ["logit_p"] + FEATURES + FIT_FEATURES + tol + GATE_FEATURES
+    cands["platt+fit"] = ["logit_p"] + FIT_FEATURES
+    cands["platt+fit+gated"] = ["logit_p"] + FIT_FEATURES + GATE_FEATURES + PLANE_GATE
     if pred in PAIR_PREDS:
         cands["platt+measures+shared"] = ["logit_p"] + FEATURES + PAIR_FEATURES + tol
         cands["platt+measures+shared+fit"] = ["logit_p"] + FEATURES + PAIR_FEATURES + FIT_FEATURES + tol
