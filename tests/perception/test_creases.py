@@ -1,6 +1,7 @@
 """The cut at concave creases of the depth surface (perception/depth/creases.py): touching curved solids part
 along the valley between them; one convex or gently concave surface, and a piece set into another, stay whole."""
 
+import cv2
 import numpy as np
 import pytest
 
@@ -109,3 +110,26 @@ def test_a_surface_covered_in_creases_by_noise_is_not_cut():
     assert 2 <= len(pieces) < len(loose)
     left, right = (H // 2, W // 2 - 45), (H // 2, W // 2 + 45)
     assert not any(p[left] and p[right] for p in pieces)
+
+
+def test_h_maxima_marks_the_cells_skimage_marks():
+    """The crease cut's seeds: creases.h_maxima against skimage's on distance maps with plateaus, ties and
+    several peaks, on noise, and where h exceeds the image's range."""
+    from skimage.morphology import h_maxima as skimage_h_maxima
+
+    from lv3d.perception.depth.creases import h_maxima
+    from lv3d.perception.distance import euclidean_distance
+
+    rng = np.random.default_rng(0)
+    for trial in range(30):
+        shape = tuple(rng.integers(8, 90, size=2))
+        blobs = np.zeros(shape, np.uint8)
+        for _ in range(rng.integers(1, 5)):
+            centre = (int(rng.integers(0, shape[1])), int(rng.integers(0, shape[0])))
+            cv2.circle(blobs, centre, int(rng.integers(2, 30)), 1, -1)
+        images = [euclidean_distance(blobs), rng.random(shape).astype(np.float32) * 10]
+        for image in images:
+            for h in (1.0, 2.5, float(np.ptp(image)) + 1.0):
+                want = skimage_h_maxima(image, h)
+                got = h_maxima(image, h)
+                assert got.dtype == want.dtype and np.array_equal(got, want), (trial, h)

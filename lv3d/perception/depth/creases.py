@@ -30,7 +30,6 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 from scipy import ndimage
-from skimage.morphology import h_maxima
 from skimage.segmentation import watershed
 
 from ..distance import euclidean_distance
@@ -235,3 +234,29 @@ def _join(pieces: np.ndarray, n: int, near_crease: np.ndarray, min_cells: int, s
             a, b = max(weak, key=lambda ab: total[ab[0], ab[1]])  # the longest weak border first
             labels = np.where(labels == b, a, labels)
     return labels
+
+
+_SQUARE = np.ones((3, 3), np.uint8)
+
+
+def h_maxima(image: np.ndarray, h: float) -> np.ndarray:
+    """The regional maxima of float32 ``image`` that stand ``h`` or more above every path to a higher one (uint8
+    0/1, ``image``'s shape; 8-connected): the same cells as ``skimage.morphology.h_maxima(image, h)``, in a
+    fraction of its time on an object's distance map. Both reconstruct ``image - h`` (less a few units in the
+    last place, which keeps it below ``image - h`` after rounding) by dilation under ``image`` and keep the cells
+    the reconstruction leaves ``h`` or more below ``image``; skimage sorts every cell first (Vincent's queue
+    algorithm), here the 3x3 dilation is repeated until nothing changes (tens of steps on an object's box).
+    Maxima and minima of float32 values are float32 values, so the reconstruction is the same array."""
+    image = np.asarray(image, np.float32)
+    if image.size == 0 or h > np.ptp(image):
+        return np.zeros(image.shape, np.uint8)
+    h = np.float32(h)
+    shifted = image - h - 2 * np.finfo(np.float32).resolution * np.abs(image)
+    rec = shifted
+    while True:
+        prev = rec
+        for _ in range(4):  # a few steps between tests: the test costs as much as a step
+            rec = np.minimum(cv2.dilate(rec, _SQUARE), image)
+        if np.array_equal(rec, prev):
+            break
+    return ((image - rec.astype(np.float64)) >= h).astype(np.uint8)
