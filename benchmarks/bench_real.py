@@ -6,6 +6,7 @@
     .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --seed 0,1,2     # pooled over perception seeds
     .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --set stride=2   # depth settings other than the defaults
     .venv/bin/python -m benchmarks.bench_real --objects out/objects.csv               # and a row per labelled object
+    .venv/bin/python -m benchmarks.bench_real --modalities rgbd --profile out/real.prof  # where the time goes
 
 A folder is in the real layout of ../shared/data/real/README.md: ``<frame>_rgb.*`` and ``<frame>_depth*`` images,
 ``intrinsics.json``, ``objects.csv`` (one row per labelled object: frame, object, a pixel u,v inside it, shape,
@@ -117,6 +118,11 @@ verdicts' yes over yes + no, summed over rows; the objects a figure misses on ar
 target does not want (no for ``box_perpendicular`` and ``cylinder_read``, yes for ``box_overfaced``, ``as_prism``
 and ``box_curved``).
 
+``--profile FILE`` runs the timed frames under cProfile, prints the lv3d and grounding functions that take the
+most time per frame (cumulative and own ms, calls) and writes the statistics to FILE (``python -m pstats FILE``,
+or any viewer of pstats files). The profiler slows every Python call, so the ms figures of such a run are not the
+frame's time; compare code by timing runs without it.
+
 Targets (issue 39; pooled over the dev folders, depth and rgbd each): object recall >= 0.90, merged <= 0.05,
 split: none, support right on every frame (1.0), box perpendicular >= 0.90, boxes with > 3 faces <= 0.10,
 cylinders as prisms <= 0.10, perpendicular ECE <= 0.10, median <= 100 ms for rgbd. Issue 40: cylinders read
@@ -135,9 +141,11 @@ if __name__ == "__main__":  # one core: before numpy, OpenCV, JAX and torch star
     os.environ.setdefault("JAX_PLATFORMS", "cpu")
 
 import argparse
+import cProfile
 import csv
 import functools
 import json
+import pstats
 import sys
 import time
 from pathlib import Path
@@ -657,12 +665,13 @@ def compile_clock() -> CompileClock:
 
 
 def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dict[str, list[dict]],
-               overlays: Path | None = None, seeds: tuple[int, ...] = (0,), settings=None) -> dict:
+               overlays: Path | None = None, seeds: tuple[int, ...] = (0,), settings=None, profiler=None) -> dict:
     """Perceive, ground and evaluate every frame (the first ``limit``) of ``folder`` in each modality, once per
     perception seed of ``seeds`` (perceive's: its sample consensus); the rows (one per frame, seed and modality)
     are appended to ``rows[modality]``. ``settings``: the depth stage's (:func:`depth_settings`; default its own).
     With ``overlays``, each frame's overlay (:func:`write_overlay`) of the
-    first seed goes to ``overlays/<folder>/<frame>_<modality>.png``. Returns {modality: [rows of this folder]}."""
+    first seed goes to ``overlays/<folder>/<frame>_<modality>.png``. With ``profiler`` (a cProfile.Profile), each
+    timed frame's perception and grounding run under it. Returns {modality: [rows of this folder]}."""
     from lv3d.describe import describe
     from lv3d.perception import perceive
 
@@ -682,9 +691,13 @@ def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dic
         for seed in seeds:
             for m in modalities:
                 clock.start()
+                if profiler is not None:
+                    profiler.enable()
                 t, c = time.perf_counter(), time.process_time()
                 scene = perceive(frame, m, scene_id=f"s{i:06d}", seed=seed, **extra)
                 facts = describe(scene, frame)
+                if profiler is not None:
+                    profiler.disable()
                 jit_ms = 1e3 * clock.spent
                 ms = 1e3 * (time.perf_counter() - t) - jit_ms
                 cpu_ms = 1e3 * (time.process_time() - c) - jit_ms
@@ -696,6 +709,23 @@ def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dic
                     write_overlay(overlays / folder.name / f"{name}_{m}.png", frame, scene, labels.get(name, []),
                                   label_img)
     return mine
+
+
+PROFILED = ("/lv3d/", "/grounding/")  # the functions --profile lists: lv3d's own and grounding's
+
+
+def profile_table(stats: pstats.Stats, frames: int, top: int = 25) -> str:
+    """The ``top`` functions of lv3d and grounding (``PROFILED``) with the most cumulative time in ``stats``, per
+    timed frame (``frames``: perceptions timed, one per frame, modality and seed): cumulative and own ms, calls."""
+    root = str(Path(__file__).resolve().parents[1]) + "/"
+    mine = [(ct, tt, nc, f"{path.replace(root, '')}:{line}({name})")
+            for (path, line, name), (_, nc, tt, ct, _) in stats.stats.items() if any(p in path for p in PROFILED)]
+    mine.sort(reverse=True)
+    per = 1e3 / max(frames, 1)
+    lines = [f"\n== profile: per timed frame ({frames}), under cProfile (its overhead included)",
+             f"{'cum ms':>9} {'own ms':>8} {'calls':>8}  function"]
+    lines += [f"{ct * per:9.1f} {tt * per:8.1f} {nc / max(frames, 1):8.1f}  {where}" for ct, tt, nc, where in mine[:top]]
+    return "\n".join(lines)
 
 
 def default_folders() -> list[Path]:
@@ -737,6 +767,10 @@ def main(argv=None) -> int:
     ap.add_argument("--objects", type=Path, metavar="FILE",
                     help="also write one CSV row per labelled object, folder, modality and seed: what perception "
                          "made of it and the verdict of every figure that counts it (OBJECT_COLUMNS)")
+    ap.add_argument("--profile", type=Path, metavar="FILE",
+                    help="also run every timed frame under cProfile: print the lv3d and grounding functions with the "
+                         "most time per frame and write the statistics to FILE (python -m pstats FILE); the ms "
+                         "figures then include the profiler's overhead")
     ap.add_argument("--overlays", type=Path, metavar="DIR",
                     help="also write each frame's overlay (perceived faces, true masks and labelled pixels in white) "
                          "to DIR/<folder>/<frame>_<modality>.png")
@@ -756,7 +790,7 @@ def main(argv=None) -> int:
     if args.overlays is not None and args.overlays.exists() and not args.overlays.is_dir():
         print(f"bench_real.py: error: {args.overlays}: is a file; --overlays names a folder", file=sys.stderr)
         return 2
-    for opt, path in (("--json", args.json), ("--objects", args.objects)):
+    for opt, path in (("--json", args.json), ("--objects", args.objects), ("--profile", args.profile)):
         if path is not None and path.is_dir():
             print(f"bench_real.py: error: {path}: is a folder; {opt} names a file", file=sys.stderr)
             return 2
@@ -774,9 +808,11 @@ def main(argv=None) -> int:
         f", each frame perceived once per seed {','.join(map(str, args.seed))} (counts pooled)"
     seeds_text += "".join(f"; {t}" for t in args.set)
     t0 = time.perf_counter()
+    profiler = cProfile.Profile() if args.profile is not None else None
     for folder, name in zip(folders, names):
         try:
-            mine = run_folder(Path(folder), mods, args.limit, pooled_rows, args.overlays, args.seed, settings)
+            mine = run_folder(Path(folder), mods, args.limit, pooled_rows, args.overlays, args.seed, settings,
+                              profiler)
         except InputError as e:
             print(f"bench_real.py: error: {e}", file=sys.stderr)
             return 2
@@ -803,6 +839,10 @@ def main(argv=None) -> int:
         args.json.write_text(json.dumps(result, indent=1) + "\n")
     if args.objects is not None:
         write_objects(args.objects, records)
+    if profiler is not None:
+        args.profile.parent.mkdir(parents=True, exist_ok=True)
+        profiler.dump_stats(args.profile)
+        print(profile_table(pstats.Stats(profiler), sum(len(r) for r in pooled_rows.values())))
     return 0
 
 

@@ -252,7 +252,7 @@ def _stub_folders(monkeypatch) -> list:
     list returned."""
     seen = []
 
-    def run_folder(folder, mods, limit, rows, overlays=None, seeds=(0,), settings=None):
+    def run_folder(folder, mods, limit, rows, overlays=None, seeds=(0,), settings=None, profiler=None):
         seen.append((seeds, settings))
         return {m: [] for m in mods}
 
@@ -411,3 +411,28 @@ def test_the_compile_clock_hears_jit_work_and_starts_again_at_zero():
     assert clock.spent > 0.0
     clock.start()
     assert clock.spent == 0.0
+
+
+def test_the_profile_lists_lv3d_functions_per_frame_and_names_a_file_not_a_folder(tmp_path, capsys, monkeypatch):
+    import cProfile
+    import pstats
+
+    from lv3d.perception.depth import creases
+
+    _stub_folders(monkeypatch)
+    assert bench.main([str(tmp_path), "--modalities", "depth", "--profile", str(tmp_path)]) == 2
+    assert "--profile names a file" in capsys.readouterr().err
+    # two frames' worth of one lv3d function, and a call outside lv3d that the table leaves out
+    prof = cProfile.Profile()
+    prof.enable()
+    for _ in range(2):
+        creases.h_maxima(np.arange(100, dtype=np.float32).reshape(10, 10), 2.0)
+    sorted(range(10))
+    prof.disable()
+    text = bench.profile_table(pstats.Stats(prof), frames=2)
+    lines = text.strip().splitlines()
+    assert lines[0].startswith("== profile: per timed frame (2)") and lines[1].split()[-1] == "function"
+    rows = lines[2:]
+    assert rows and all(any(p.strip("/") in r for p in bench.PROFILED) for r in rows)
+    top = next(r for r in rows if "h_maxima" in r)
+    assert top.split()[2] == "1.0" and "lv3d/perception/depth/creases.py" in top  # calls per frame, path from the root
