@@ -3,7 +3,7 @@
     .venv/bin/python -m benchmarks.bench_creases                     # every frame of the real dev folders
     .venv/bin/python -m benchmarks.bench_creases ../shared/data/real/osd-learn --limit 5
 
-Perceives every frame of each folder (depth, seed 0) and keeps the distance maps and depths the crease cut asks
+Perceives every frame of each folder (depth, seed 0) and keeps the distance maps and heights the crease cut asks
 the h-maxima of (``creases.h_maxima``: one call per object the cut looks at), then times both functions on
 each of them (CPU time, one core, ``--repeats`` rounds) and checks that they mark the same cells. Prints per
 folder the calls, ms per call and ms per frame of each. Where the real frames are absent it says so and exits 0.
@@ -25,12 +25,12 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.bench_real import default_folders, labelled_folder
+from benchmarks.bench_real import _one_core, default_folders, labelled_folder
 from lv3d.errors import InputError
 
 
 def crease_maps(folder: Path, limit: int | None) -> tuple[list[tuple[np.ndarray, float]], int]:
-    """The (distance map, depth) of every h-maxima call of the crease cut on the folder's frames (the first
+    """The (distance map, height h) of every h-maxima call of the crease cut on the folder's frames (the first
     ``limit``), and the number of frames perceived."""
     from lv3d.perception import perceive
     from lv3d.perception.depth import creases
@@ -76,6 +76,7 @@ def main(argv=None) -> int:
 
     from lv3d.perception.depth.creases import h_maxima
 
+    _one_core()  # OpenCV's dilation, as perception's other calls, on one thread
     folders = args.folders or default_folders()
     if not folders:
         print("bench_creases.py: no real frames with objects.csv (../shared/data/real): nothing to time")

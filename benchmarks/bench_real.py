@@ -721,10 +721,10 @@ def profile_table(stats: pstats.Stats, frames: int, top: int = 25) -> str:
     mine = [(ct, tt, nc, f"{path.replace(root, '')}:{line}({name})")
             for (path, line, name), (_, nc, tt, ct, _) in stats.stats.items() if any(p in path for p in PROFILED)]
     mine.sort(reverse=True)
-    per = 1e3 / max(frames, 1)
+    n = max(frames, 1)
     lines = [f"\n== profile: per timed frame ({frames}), under cProfile (its overhead included)",
              f"{'cum ms':>9} {'own ms':>8} {'calls':>8}  function"]
-    lines += [f"{ct * per:9.1f} {tt * per:8.1f} {nc / max(frames, 1):8.1f}  {where}" for ct, tt, nc, where in mine[:top]]
+    lines += [f"{1e3 * ct / n:9.1f} {1e3 * tt / n:8.1f} {nc / n:8.1f}  {where}" for ct, tt, nc, where in mine[:top]]
     return "\n".join(lines)
 
 
