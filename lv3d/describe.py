@@ -27,6 +27,11 @@ CAP_PX = 30.0  # edge fields are clipped to +-this many pixels
 COLOUR_FIRST_PX = 6.0  # rgbd fields near a depth-found face: colour's edge stands where it is within this (px)
 SIDE_NAMES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
 _SIDE_PREDS = frozenset(SIDE_NAMES.values())
+# facts that describe a face as a polygon: its side count, its shape as a polygon, the kinds of its corners
+POLYGON_PREDS = frozenset(SIDE_NAMES.values()) | {"parallelogram", "square", "rectangle", "regular",
+                                                  "has_right_angle", "has_acute_angle", "has_obtuse_angle"}
+# facts that say a face is no polygon: a curved surface, or a planar face with a round outline
+ROUND_PREDS = frozenset({"cylindrical", "conical", "spherical", "circular", "elliptical"})
 
 
 @dataclass(frozen=True)
@@ -664,15 +669,39 @@ def _leaf_paths(treedef) -> list[tuple[str, ...]]:
     return [tuple(k.name for k in path) for path, _ in paths]
 
 
+def polygon_given_round(cands: list[tuple[str, tuple[str, ...], float, float | None]]
+                        ) -> list[tuple[str, tuple[str, ...], float, float | None]]:
+    """``cands`` (pred, args, conf, value) with each polygon fact of a face (``POLYGON_PREDS``: its side count,
+    its shape, its corners) weighed by the probability that the face is a polygon at all.
+
+    A face read as a curved surface (cylindrical, conical, spherical) or as a planar face with a round outline
+    (circular, elliptical: ``ROUND_PREDS``) is no polygon: the polygon its outline is drawn with (a can's lid as
+    a hexagon, a can's side as a quadrilateral with bowed ends) has as many corners as the outline's sampling
+    left, and they change from view to view. Each polygon fact's confidence measures the outline's shape given
+    that it is a polygon, so its confidence becomes that times 1 - r, r the face's strongest round reading
+    (the readings are of one outline, and the likelier one bounds the chance of the other)."""
+    round_conf: dict[str, float] = {}
+    for pred, args, p, _ in cands:
+        if pred in ROUND_PREDS and math.isfinite(p):
+            round_conf[args[0]] = max(round_conf.get(args[0], 0.0), min(max(p, 0.0), 1.0))
+    if not round_conf:
+        return cands
+    return [(pred, args, p * (1.0 - round_conf[args[0]]), value)
+            if pred in POLYGON_PREDS and args[0] in round_conf else (pred, args, p, value)
+            for pred, args, p, value in cands]
+
+
 def describe(scene: Scene, frame: RGBD, *, refine: bool = True, refine_ids: frozenset[str] | None = None
              ) -> SceneFacts:
     """Facts of ``scene`` (perceived in ``frame``) with confidences, for the scene's modality.
 
     ``refine=False`` keeps perception's polygons and planes but still computes their covariances and
-    the confidences from them. Facts whose probability is below ``MIN_CONF`` are absent. ``refine_ids``: the
+    the confidences from them. A face's polygon facts are weighed by the chance that it is a polygon at all
+    (:func:`polygon_given_round`). Facts whose probability is below ``MIN_CONF`` are absent. ``refine_ids``: the
     objects to refine (default: the scene's target), see :func:`ground`.
     """
     cands, _ = ground(scene, frame, refine=refine, refine_ids=refine_ids)
+    cands = polygon_given_round(cands)
     facts = []
     for pred, args, p, value in cands:
         if scene.modality not in PREDICATES[pred][1] or not math.isfinite(p) or p < MIN_CONF:

@@ -280,3 +280,27 @@ def test_a_refinement_without_spreads_gives_no_cap_reading():
     faces = [_face_result(side, fit=_cylinder_fit((0.0, -1.0, 0.0), np.nan)),
              _face_result(lid, (0.0, -1.0, 0.0, 0.1), 0.5)]
     assert cap_candidates(obj, faces) == []
+
+
+def test_a_round_face_keeps_its_polygon_facts_only_as_far_as_it_may_be_a_polygon():
+    # a can's lid read as a hexagon and as circular, a can's side as a quadrilateral and cylindrical, a box face
+    # with no round reading: each polygon fact times (1 - the face's strongest round reading); others unchanged
+    from lv3d.describe import POLYGON_PREDS, ROUND_PREDS, polygon_given_round
+
+    cands = [("hexagon", ("lid",), 0.96, 6.0), ("circular", ("lid",), 0.75, 3.0), ("regular", ("lid",), 0.8, 1.1),
+             ("quadrilateral", ("side",), 0.9, 4.0), ("cylindrical", ("side",), 0.99, 0.04),
+             ("conical", ("side",), 0.2, 5.0), ("rectangle", ("box",), 0.95, 1.5),
+             ("perpendicular", ("side", "lid"), 0.3, 80.0), ("face_of", ("o", "lid"), 0.9, None)]
+    got = {(c[0], c[1]): c for c in polygon_given_round(cands)}
+    assert got[("hexagon", ("lid",))][2] == pytest.approx(0.96 * 0.25)
+    assert got[("regular", ("lid",))][2] == pytest.approx(0.8 * 0.25)
+    assert got[("quadrilateral", ("side",))][2] == pytest.approx(0.9 * 0.01)
+    assert got[("quadrilateral", ("side",))][3] == 4.0  # the measured value stays
+    for key in [("circular", ("lid",)), ("cylindrical", ("side",)), ("conical", ("side",)), ("rectangle", ("box",)),
+                ("perpendicular", ("side", "lid")), ("face_of", ("o", "lid"))]:
+        assert got[key] == next(c for c in cands if (c[0], c[1]) == key)
+    assert polygon_given_round([("hexagon", ("f",), 0.9, 6.0)]) == [("hexagon", ("f",), 0.9, 6.0)]
+    # the two vocabularies are the contract's predicates about one face, and they do not overlap
+    assert POLYGON_PREDS <= set(PREDICATES) and ROUND_PREDS <= set(PREDICATES)
+    assert not POLYGON_PREDS & ROUND_PREDS
+    assert all(PREDICATES[p][0] == 1 for p in POLYGON_PREDS | ROUND_PREDS)
