@@ -1,9 +1,10 @@
 """The study's report, regenerated from the fold files (never edited by hand):
 ``results.csv`` (one row per condition x system x fold x task), ``results.json`` (means, standard
 deviations, paired tests, the calibration of the multi-class answers and, for lv3d systems, how they were
-reached: by a proof, an arbiter, a near proof or none), ``results.md`` (the tables),
-``accuracy.png``, ``reliability.png`` (the answers' reliability diagram, last condition) and ``sweep.png``
-when the study has several conditions.
+reached: by a proof, an arbiter, a near proof or none; which classes the answers confuse), ``results.md`` (the
+tables), ``accuracy.png``, ``reliability.png`` (the answers' reliability diagram, last condition),
+``confusion.png`` (the multi-class answers of each lv3d system against the true classes, last condition) and
+``sweep.png`` when the study has several conditions.
 """
 
 from __future__ import annotations
@@ -85,6 +86,9 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
         reached = answer_kinds(recs)
         if reached:
             per["answered_by"] = reached
+        confusion = answer_confusion(recs)
+        if confusion:
+            per["confusion"] = confusion
         left = next((r["left_out"] for r in recs if r.get("left_out") is not None), None)
         if left is not None:
             summary["left_out"] = left
@@ -142,6 +146,25 @@ def answer_kinds(recs: list[dict]) -> dict | None:
     return {k: tuple(v) for k, v in out.items()} or None
 
 
+def answer_confusion(recs: list[dict]) -> dict | None:
+    """A system's multi-class answers against the true classes, over every fold and draw: {"answers": {true
+    class: answers}, "pairs": [[true class, answer, answers], ...]} (``pairs`` holds each pair of a class and an
+    answer that names another, ``unknown`` among them, most frequent first, ties by name); None where the fold
+    files hold no multi-class predictions with the test classes beside them."""
+    answers: dict[str, int] = {}
+    wrong: dict[tuple[str, str], int] = {}
+    for r in recs:
+        for draw in _multiclass_draws(r):
+            for (_, label, _), y in zip(draw, r["test_classes"]):
+                answers[y] = answers.get(y, 0) + 1
+                if label != y:
+                    wrong[(y, str(label))] = wrong.get((y, str(label)), 0) + 1
+    if not answers:
+        return None
+    pairs = sorted(wrong.items(), key=lambda kv: (-kv[1], kv[0]))
+    return {"answers": dict(sorted(answers.items())), "pairs": [[y, a, n] for (y, a), n in pairs]}
+
+
 def _against_best(summary: dict, prefix: str) -> dict | None:
     """The paired test of the best-seeing lv3d system against the system named ``prefix``* (``cnn-``: the CNNs
     trained from scratch; ``effnet-``: the pretrained networks) with the highest mean binary accuracy, or None
@@ -161,6 +184,9 @@ def _mean_balanced(tasks: dict, classes: list[str]) -> float:
     vals = [tasks[c].get("balanced_accuracy") for c in classes if c in tasks]
     vals = [v for v in vals if is_number(v)]
     return sum(vals) / len(vals) if vals else float("nan")
+
+
+TOP_CONFUSIONS = 4  # pairs of a true class and a wrong answer named per system in results.md
 
 
 def _pct(x: dict) -> str:
@@ -231,6 +257,16 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
                 cols = [f"{kinds[k][0]} ({100 * kinds[k][1] / kinds[k][0]:.0f} %)" if kinds.get(k, (0,))[0] else "0"
                         for k in ANSWER_KINDS]
                 lines.append(f"| {s} | " + " | ".join(cols) + " |")
+        confused = {s: per["confusion"] for s, per in summ["systems"].items() if per.get("confusion")}
+        if confused:
+            lines += ["", f"Which classes the multi-class answers confuse (true class → answer: how many of that "
+                      f"class's answers, over folds and draws; *unknown*: no answer), the {TOP_CONFUSIONS} most "
+                      f"frequent per system (confusion.png: every pair, lv3d systems):", "",
+                      "| system | wrong | most frequent |", "|---|---|---|"]
+            for s, c in confused.items():
+                total, wrong = sum(c["answers"].values()), sum(n for *_, n in c["pairs"])
+                top = "; ".join(f"{y} → {a} {n} of {c['answers'][y]}" for y, a, n in c["pairs"][:TOP_CONFUSIONS])
+                lines.append(f"| {s} | {wrong} of {total} | {top or '–'} |")
         left = summ.get("left_out")
         if left is not None:
             other = ", ".join(f"{k} {v}" for k, v in sorted(left["other_classes"].items())) or "none"
@@ -294,6 +330,10 @@ def plot(out: Path, summaries: dict[str, dict], classes: list[str]) -> None:
         fig.tight_layout()
         fig.savefig(out / "reliability.png", dpi=110)
         plt.close(fig)
+    confused = {s: per["confusion"] for s, per in last["systems"].items()
+                if s in LOGIC_SYSTEMS and per.get("confusion")}
+    if confused:
+        _plot_confusion(out / "confusion.png", confused, classes, list(summaries)[-1])
     if len(summaries) > 1:
         fig, ax = plt.subplots(figsize=(7, 4))
         conds = list(summaries)
@@ -308,6 +348,50 @@ def plot(out: Path, summaries: dict[str, dict], classes: list[str]) -> None:
         fig.tight_layout()
         fig.savefig(out / "sweep.png", dpi=110)
         plt.close(fig)
+
+
+def confusion_matrix(confusion: dict, classes: list[str]) -> tuple[list[str], list[list[float]]]:
+    """The answers of :func:`answer_confusion` as a matrix: the answer columns (``classes``, then ``unknown``
+    and any other answer met) and one row per class of ``classes``, each the share of that class's answers
+    (a row of zeros for a class with none)."""
+    cols = list(classes) + ["unknown"]
+    cols += sorted({a for _, a, _ in confusion["pairs"]} - set(cols))
+    rows = []
+    for y in classes:
+        n = confusion["answers"].get(y, 0)
+        row = [0.0] * len(cols)
+        if n:
+            for yy, a, k in confusion["pairs"]:
+                if yy == y:
+                    row[cols.index(a)] = k / n
+            if y in cols:
+                row[cols.index(y)] = 1.0 - sum(row)
+        rows.append(row)
+    return cols, rows
+
+
+def _plot_confusion(path: Path, confused: dict[str, dict], classes: list[str], title: str) -> None:
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(confused), figsize=(0.55 * len(classes) * len(confused) + 2.5,
+                                                         0.5 * len(classes) + 2.2), squeeze=False)
+    for ax, (s, c) in zip(axes[0], confused.items()):
+        cols, rows = confusion_matrix(c, classes)
+        ax.imshow(rows, vmin=0, vmax=1, cmap="Blues")
+        for i, row in enumerate(rows):
+            for j, v in enumerate(row):
+                if v >= 0.005:
+                    ax.text(j, i, f"{100 * v:.0f}", ha="center", va="center", fontsize=6,
+                            color="white" if v > 0.5 else "black")
+        ax.set_xticks(range(len(cols)), cols, rotation=60, ha="right", fontsize=7)
+        ax.set_yticks(range(len(classes)), classes if ax is axes[0][0] else [""] * len(classes), fontsize=7)
+        ax.set_xlabel("answer")
+        ax.set_title(s, fontsize=9)
+    axes[0][0].set_ylabel("true class")
+    fig.suptitle(f"multi-class answers (% of the true class's), {title}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 def write_report(out: Path, cfg: StudyConfig, conds: dict[str, StudyConfig]) -> dict:

@@ -25,6 +25,10 @@ def test_real_learner_learns_side_counts(tmp_path, tiny_config, synthetic_facts,
     assert set(kinds) == {"proof"} and kinds["proof"][0] == kinds["proof"][1] > 0
     md = (out / "results.md").read_text()
     assert "How the lv3d systems reached their multi-class answers" in md and "(100 %)" in md
+    # every answer right: no class confused with another, and the matrix is drawn
+    confusion = next(iter(summary["conditions"].values()))["systems"]["lv3d-rgb"]["confusion"]
+    assert confusion["pairs"] == [] and sum(confusion["answers"].values()) == kinds["proof"][0]
+    assert (out / "confusion.png").is_file()
     programs = out / "programs" / "base" / "lv3d-rgb" / "fold0"
     assert (programs / "cube" / "cube.pl").is_file() and (programs / "multiclass" / "cube.pl").is_file()
     assert "quadrilateral" in (programs / "cube" / "cube.pl").read_text()
