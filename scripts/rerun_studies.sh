@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Rerun every study in experiments/ after a change to lv3d's code, retraining only the lv3d systems, with the
 # systems and conditions of the committed reports in experiments/results/, and the seed protocol's four
-# replicates (its lv3d systems on data seeds 1-4; scripts/pooled_replicates.py pools them). Each study's
+# replicates (its lv3d systems on data seeds 1-4; scripts/pooled_replicates.py pools them) and the real-objects
+# study's lv3d systems on perception seeds 1 and 2 (real_objects_pseed1, _pseed2). Each study's
 # baseline fold files are restored from its committed results.csv first (scripts/restore_baselines.py), then
 # `lv3d experiment run` computes the lv3d folds and rewrites the report.
 #
@@ -11,7 +12,7 @@
 # clean and realsense presets; the few-shot study with the lv3d systems, cnn-rgbd, the pretrained networks and
 # the tree; the real-objects study with the tuned CNN at one positive only (its two parts are joined by
 # `lv3d experiment report`). Three lanes run at once on two cores; the studies of the seed protocol's images
-# share one data cache, which the seed protocol fills before the ablations start. About 50 min on two cores.
+# share one data cache, which the seed protocol fills before the ablations start. About 75 min on two cores.
 #
 # Then copy each run's results.{csv,md} and plots into experiments/results/<study>/ (the script prints the
 # commands), rewrite the tables of experiments/README.md (scripts/readme_tables.py --write) and its text.
@@ -44,6 +45,12 @@ replicate() {  # replicate SEED: the seed protocol's lv3d systems on images of a
     log "seed_protocol_seed$1: $(grep -a 'fold results computed' "$RUNS/seed_protocol_seed$1.log" | tail -1)"
 }
 
+perception_seed() {  # perception_seed S: the real-objects study's lv3d systems with perception's seed S (no baselines)
+    OMP_NUM_THREADS=1 $LV3D experiment run experiments/real_objects.yaml --out "$RUNS/real_objects_pseed$1" \
+        --set "$REAL_CACHE" --set "$LV3D_ONLY" --set lv3d.perception_seed="$1" > "$RUNS/real_objects_pseed$1.log" 2>&1
+    log "real_objects_pseed$1: $(grep -a 'fold results computed' "$RUNS/real_objects_pseed$1.log" | tail -1)"
+}
+
 real_objects() {  # the lv3d systems, the pretrained networks and the tree at every size, the tuned CNN at one
     local out=$RUNS/real_objects all="systems=[lv3d-rgb,lv3d-depth,lv3d-rgbd,effnet-rgb,effnet-depth,effnet-rgbd,tree-rgbd]"
     local csv=experiments/results/real_objects/results.csv
@@ -64,7 +71,7 @@ pids=()
 ( study seed_protocol --set "$CACHE" --set "$TWO_PRESETS"; touch "$RUNS/.seed_protocol_done"
   study learning_curve --set "$CACHE"; study few_shot --set "$CACHE" --set "$FEW_SHOT"; replicate 1; replicate 2 ) & pids+=($!)
 ( for n in noise_depth noise_color noise_occlusion noise_clutter noise_lighting; do study $n --set "$NOISE_CACHE"; done
-  real_objects ) & pids+=($!)
+  real_objects; perception_seed 1; perception_seed 2 ) & pids+=($!)
 ( study ten_classes --set "$CACHE"
   until [ -e "$RUNS/.seed_protocol_done" ]; do sleep 10; done
   study ablations --set "$CACHE"; replicate 3; replicate 4 ) & pids+=($!)

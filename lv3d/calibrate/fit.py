@@ -9,8 +9,9 @@ The fit reads candidate facts with their truth from two kinds of data:
   hold curved solids the renderer has none of; the real rows teach the maps both.
 
 The whole fit, from the repository root (each rendered set of 840 scenes about 4 min on one core for both
-modalities, the two real folders 20 s each, the fit with its checks about 7 min; two sets run side by side on
-two cores)::
+modalities, the two real folders 20 s each, the fit with its checks about 7 min; ``bash
+scripts/refit_calibration.sh`` runs all of it, two sets side by side on two cores, and resumes where it
+stopped)::
 
     for a in "30000 s30000 realsense 120" "40000 s40000 realsense 120" "60000 s60000 realsense 120" \
              "70000 c70000 clean 120" "80000 r80000 realistic 120" "100000 chk100000 realsense 40" \
