@@ -18,7 +18,8 @@ folders (pooled = counts added over all frames, not an average of the folders' f
 writes them as ``{"pooled": {MODALITY: {...}}, "folders": {NAME: {MODALITY: {...}}}}`` with the keys
 object_recall, merged_frac, split_frac, support_ok_frac, box_perpendicular_frac, box_overfaced_frac,
 cylinder_as_prism_frac, perpendicular_ece, cylinder_read_frac, box_curved_frac, ms_median, ms_p90 and the extra
-labelled_found, cpu_ms_median, bowl_curved_frac, cylinder_elliptical_frac and box_elliptical_frac; a figure a
+labelled_found, cpu_ms_median, bowl_curved_frac, cylinder_elliptical_frac and box_elliptical_frac, and
+stage_ms_median, the median ms of each stage of a frame (perception's stages and grounding); a figure a
 folder or modality cannot measure is null (recall and split without masks; support, every ``perpendicular``
 figure and the curved-face figures under rgb, which has no planes and no curved faces; both elliptical figures
 under depth and rgbd, which do not say ``elliptical``).
@@ -185,6 +186,7 @@ KEYS = ("object_recall", "merged_frac", "split_frac", "support_ok_frac", "box_pe
         "ms_median", "ms_p90")
 EXTRA_KEYS = ("labelled_found", "cpu_ms_median", "bowl_curved_frac", "cylinder_elliptical_frac",
               "box_elliptical_frac", "compile_s")
+STAGES = "stage_ms_median"  # beside the figures: {stage: median ms} (stage_medians)
 # figure -> (comparison, target, modalities the target is for); None: no target
 TARGETS: dict[str, tuple[str, float, tuple[str, ...]] | None] = {
     "object_recall": (">=", 0.90, ("depth", "rgbd")),
@@ -488,7 +490,19 @@ def summarise(rows: list[dict], modality: str) -> dict:
         "box_elliptical_frac": _ratio(rows, "box_ellipse", "boxes") if elliptical else None,
         "compile_s": sum(r.get("compile_ms", 0.0) for r in rows) / 1e3 if ms else None,
     }
-    return {k: (None if v is None else round(float(v), 4)) for k, v in out.items()}
+    out = {k: (None if v is None else round(float(v), 4)) for k, v in out.items()}
+    out[STAGES] = stage_medians(rows)
+    return out
+
+
+def stage_medians(rows: list[dict]) -> dict[str, float]:
+    """The median wall-clock ms of each stage over the rows' frames (``stages_ms``: perception's own
+    ``Scene.timings_ms``, its depth stage's cloud, support, objects, planes and boundary and the colour path's
+    stages, and ``grounding``, lv3d.describe less JIT work), largest first; a stage a frame did not run counts
+    as 0 there. The stages' medians need not add up to the frame's."""
+    names = {k for r in rows for k in r.get("stages_ms", {})}
+    med = {k: round(float(np.median([r.get("stages_ms", {}).get(k, 0.0) for r in rows])), 1) for k in names}
+    return dict(sorted(med.items(), key=lambda kv: (-kv[1], kv[0])))
 
 
 # ---------------------------------------------------------------------------------------------- output
@@ -553,6 +567,13 @@ def table(title: str, figures: dict[str, dict], modalities: list[str]) -> str:
             cells.append(f"{num + (' ' + verdict(key, m, v) if verdict(key, m, v) else ''):>14}")
         lines.append(f"{key:24}" + "".join(cells) + "   " + target_text(key))
     return "\n".join(lines)
+
+
+def stage_lines(figures: dict[str, dict], modalities: list[str]) -> str:
+    """One line per modality: the median ms of each stage of a frame (:func:`stage_medians`)."""
+    return "\n".join(f"median ms by stage, {m}: " + ", ".join(f"{k} {v:.1f}" for k, v in
+                                                          figures[m][STAGES].items())
+                     for m in modalities if figures[m].get(STAGES))
 
 
 # ---------------------------------------------------------------------------------------------- running
@@ -695,14 +716,16 @@ def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dic
                     profiler.enable()
                 t, c = time.perf_counter(), time.process_time()
                 scene = perceive(frame, m, scene_id=f"s{i:06d}", seed=seed, **extra)
+                t_ground = time.perf_counter()
                 facts = describe(scene, frame)
                 if profiler is not None:
                     profiler.disable()
-                jit_ms = 1e3 * clock.spent
+                jit_ms = 1e3 * clock.spent  # JIT work is grounding's (JAX)
                 ms = 1e3 * (time.perf_counter() - t) - jit_ms
                 cpu_ms = 1e3 * (time.process_time() - c) - jit_ms
+                stages = {**scene.timings_ms, "grounding": 1e3 * (time.perf_counter() - t_ground) - jit_ms}
                 row = dict(evaluate_frame(scene, facts, frame, labels.get(name, []), label_img), ms=ms,
-                           cpu_ms=cpu_ms, compile_ms=jit_ms, frame=name, seed=seed)
+                           cpu_ms=cpu_ms, compile_ms=jit_ms, stages_ms=stages, frame=name, seed=seed)
                 mine[m].append(row)
                 rows[m].append(row)
                 if overlays is not None and seed == seeds[0]:
@@ -820,11 +843,13 @@ def main(argv=None) -> int:
             records += [{"folder": name, "modality": m, "seed": r["seed"], **rec}
                         for m in mods for r in mine[m] for rec in r["objects"]]
         figures = {m: summarise(mine[m], m) for m in mods}
-        result["folders"][name] = {m: {k: figures[m][k] for k in KEYS + EXTRA_KEYS} for m in mods}
+        result["folders"][name] = {m: {**{k: figures[m][k] for k in KEYS + EXTRA_KEYS},
+                                       STAGES: figures[m].get(STAGES)} for m in mods}
         any_rows = [r for r in mine[mods[0]] if r["seed"] == args.seed[0]]  # each frame once
         masks = sum(r["gt"] is not None for r in any_rows)
         print(table(f"\n== {name}: {len(any_rows)} frames ({masks} with masks), "
                     f"{sum(r['labelled'] for r in any_rows)} labelled objects{seeds_text}; {pixels}", figures, mods))
+        print(stage_lines(figures, mods))
         sys.stdout.flush()
     figures = {m: summarise(pooled_rows[m], m) for m in mods}
     result["pooled"] = figures
@@ -832,6 +857,7 @@ def main(argv=None) -> int:
     print(table(f"\n== pooled over {len(folders)} folder(s): {len(once)} frames, "
                 f"{sum(r['labelled'] for r in once)} labelled objects{seeds_text} "
                 f"({time.perf_counter() - t0:.0f} s)", figures, mods))
+    print(stage_lines(figures, mods))
     print("ok / MISS: the figure meets / misses its target (issues 39, 40); targets hold for the modalities named; "
           "ms: perception + grounding per frame, one core, warm")
     if args.json is not None:

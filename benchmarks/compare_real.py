@@ -8,7 +8,7 @@
 The figures are those of ``bench_real --json`` (its module docstring defines them); a row is printed for each
 figure and modality both runs measured. *better* / *worse*: the change moves the figure towards / away from
 its target (for a figure without one, only the change is shown); a verdict ``ok`` / ``MISS`` says whether each
-run meets the target. Timing figures depend on the machine's load: compare them only between runs made in one
+run meets the target. Where both runs hold the median ms of each stage (``stage_ms_median``), they follow. Timing figures depend on the machine's load: compare them only between runs made in one
 sitting (or with farm-bench). Exit status 0, or 2 with one line naming the file when a file cannot be read as
 bench_real's JSON.
 """
@@ -20,7 +20,7 @@ import json
 import sys
 from pathlib import Path
 
-from benchmarks.bench_real import EXTRA_KEYS, KEYS, TARGETS, verdict
+from benchmarks.bench_real import EXTRA_KEYS, KEYS, STAGES, TARGETS, verdict
 
 FIGURES = KEYS + EXTRA_KEYS
 SAME = 5e-4  # a change smaller than this (the JSON's figures are printed to 3 decimals) is no change
@@ -75,6 +75,17 @@ def table(title: str, a: dict, b: dict) -> str:
     return "\n".join(lines)
 
 
+def stage_table(a: dict, b: dict) -> str:
+    """The median ms of each stage (bench_real's ``stage_ms_median``) in both scopes, per modality both have."""
+    lines = []
+    for m in [m for m in a if m in b and a[m].get(STAGES) and b[m].get(STAGES)]:
+        sa, sb = a[m][STAGES], b[m][STAGES]
+        names = list(sa) + [k for k in sb if k not in sa]
+        lines.append(f"median ms by stage, {m} (A -> B): " +
+                     ", ".join(f"{k} {sa.get(k, 0.0):.1f} -> {sb.get(k, 0.0):.1f}" for k in names))
+    return "\n".join(lines)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="compare_real.py", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -88,6 +99,9 @@ def main(argv=None) -> int:
         print(f"compare_real.py: error: {e}", file=sys.stderr)
         return 2
     print(table(f"== pooled: A {args.a}, B {args.b}", a["pooled"], b["pooled"]))
+    stages = stage_table(a["pooled"], b["pooled"])
+    if stages:
+        print(stages)
     if args.folders:
         for name in [n for n in a["folders"] if n in b["folders"]]:
             print(table(f"\n== {name}", a["folders"][name], b["folders"][name]))

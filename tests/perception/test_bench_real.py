@@ -151,8 +151,10 @@ def test_a_frame_counts_each_labelled_object_once_and_the_figures_follow():
     assert (row["round"], row["round_prism"]) == (2, 1)
     assert row["pairs_p"] == [0.6] and row["pairs_y"] == [0.0]  # the merged box object is left out
 
-    f = bench.summarise([dict(row, ms=50.0), dict(row, ms=150.0)], "depth")
-    assert set(f) == set(bench.KEYS) | set(bench.EXTRA_KEYS)
+    f = bench.summarise([dict(row, ms=50.0, stages_ms={"objects": 30.0, "grounding": 10.0}),
+                         dict(row, ms=150.0, stages_ms={"objects": 50.0})], "depth")
+    assert set(f) == set(bench.KEYS) | set(bench.EXTRA_KEYS) | {bench.STAGES}
+    assert f[bench.STAGES] == {"objects": 40.0, "grounding": 5.0}  # a stage a frame did not run counts 0 there
     assert f["object_recall"] == 0.5 and f["merged_frac"] == 0.5 and f["split_frac"] == 0.0
     assert f["support_ok_frac"] == 1.0 and f["box_perpendicular_frac"] == 1.0
     assert f["box_overfaced_frac"] == 0.0 and f["cylinder_as_prism_frac"] == 0.5
@@ -315,13 +317,15 @@ def test_one_osd_frame_end_to_end_writes_every_figure(tmp_path, capsys):
     assert bench.main([str(osd), "--limit", "1", "--modalities", "depth", "--json", str(out),
                        "--objects", str(objects)]) == 0
     d = json.loads(out.read_text())
-    keys = set(bench.KEYS) | set(bench.EXTRA_KEYS)
+    keys = set(bench.KEYS) | set(bench.EXTRA_KEYS) | {bench.STAGES}
     assert set(d) == {"pooled", "folders"} and set(d["folders"]) == {"osd-learn"}
     assert set(d["pooled"]) == {"depth"} and set(d["pooled"]["depth"]) == keys
     fig = d["folders"]["osd-learn"]["depth"]
     assert set(fig) == keys
     assert fig["object_recall"] is not None and fig["ms_median"] > 0 and fig["cylinder_as_prism_frac"] is None
-    assert "object_recall" in capsys.readouterr().out
+    assert fig[bench.STAGES]["objects"] > 0 and fig[bench.STAGES]["grounding"] > 0
+    printed = capsys.readouterr().out
+    assert "object_recall" in printed and "median ms by stage, depth: objects" in printed
     # a row per labelled object of the frame, whose verdicts give the figures
     rows = list(csv.DictReader(objects.open()))
     first = FrameFolder(osd).frames[0]

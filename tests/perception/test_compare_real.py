@@ -6,7 +6,8 @@ from benchmarks.compare_real import direction, main, rows
 
 
 def _run(path, recall, prism, ms):
-    scope = {"depth": {"object_recall": recall, "cylinder_as_prism_frac": prism, "ms_median": ms, "split_frac": None}}
+    scope = {"depth": {"object_recall": recall, "cylinder_as_prism_frac": prism, "ms_median": ms, "split_frac": None,
+                       "stage_ms_median": {"objects": ms / 2, "grounding": ms / 4}}}
     path.write_text(json.dumps({"pooled": scope, "folders": {"osd-learn": scope}}))
     return path
 
@@ -30,6 +31,7 @@ def test_the_comparison_prints_every_figure_and_counts_what_got_worse(tmp_path, 
     line = next(l for l in out.splitlines() if l.startswith("cylinder_as_prism_frac"))
     assert "0.050 ok" in line and "0.120 MISS" in line and "worse" in line
     assert "1 worse: cylinder_as_prism_frac (depth)" in out  # time is left out of the count
+    assert "median ms by stage, depth (A -> B): objects 100.0 -> 75.0, grounding 50.0 -> 37.5" in out
 
 
 def test_a_file_that_is_no_bench_real_json_is_one_line(tmp_path, capsys):
