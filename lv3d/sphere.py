@@ -11,10 +11,13 @@ from .plane import row_norms
 
 @dataclass(frozen=True)
 class Sphere:
-    """A sphere in the camera frame: its ``centre`` and ``radius`` (metres)."""
+    """A sphere in the camera frame: its ``centre`` and ``radius`` (metres), and the ``side`` a face of it shows:
+    1 its outside (a ball; the surface's normals point away from the centre), -1 its inside (a bowl seen over its
+    rim; they point towards it)."""
 
     centre: tuple[float, float, float]
     radius: float
+    side: float = 1.0
 
     def radial(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Distances (m,) of ``points`` (m, 3) from the centre, and the unit directions (m, 3) away from it (the
@@ -23,12 +26,17 @@ class Sphere:
         r = row_norms(d)
         return r, d / np.maximum(r, 1e-12)[:, None]
 
+    def normals(self, points: np.ndarray) -> np.ndarray:
+        """The unit normals (m, 3) of the side the sphere shows at ``points`` (m, 3): the radial directions, turned
+        towards the centre for an inside."""
+        return self.side * self.radial(points)[1]
+
     def residual(self, points: np.ndarray) -> np.ndarray:
         """Signed distances (m,) of ``points`` (m, 3) from the surface, positive outside."""
         return self.radial(points)[0] - self.radius
 
     def to_dict(self) -> dict:
-        return {"centre": list(self.centre), "radius": self.radius}
+        return {"centre": list(self.centre), "radius": self.radius, "side": self.side}
 
 
 def algebraic_sphere(pts: np.ndarray) -> Sphere | None:

@@ -70,6 +70,28 @@ def test_a_noisy_sphere_is_one_spherical_face():
     assert res.faces[0][2].mean() > 0.9
 
 
+def _bowl_inside(rng, radius=0.07, n=60):
+    """A grid (n, n) of points on the inside of a bowl seen from above it (the far half of a sphere about CENTRE,
+    the camera looking down its axis z), with the normals of that side: towards the centre, to the camera."""
+    th, ph = np.meshgrid(np.radians(np.linspace(-60, 60, n)), np.radians(np.linspace(-60, 60, n)), indexing="ij")
+    out = np.stack([np.sin(ph) * np.cos(th), np.sin(th), np.cos(ph) * np.cos(th)], axis=-1)  # away from the camera
+    return _noisy(CENTRE + radius * out, -out, rng)
+
+
+def test_a_bowls_inside_is_one_spherical_face_seen_from_within():
+    pts, nrm = _bowl_inside(np.random.default_rng(2))
+    res = _search(pts, nrm)
+    assert [f[0] for f in res.faces] == ["sphere"]
+    s = res.faces[0][1]
+    assert s.side == -1.0 and abs(s.radius - 0.07) < 0.07 * 0.03
+    assert np.linalg.norm(np.asarray(s.centre) - CENTRE) < 0.003
+    assert res.faces[0][2].mean() > 0.9
+    # a ball's outside is still one (side 1), and the normals each side shows point to the camera
+    ball = _search(*_sphere_cap(np.random.default_rng(0))).faces[0][1]
+    assert ball.side == 1.0
+    assert np.all(s.normals(pts.reshape(-1, 3))[:, 2] < 0)
+
+
 def test_a_sphere_from_pairs_of_oriented_points_then_least_squares():
     rng = np.random.default_rng(1)
     pts, nrm = _sphere_cap(rng)

@@ -375,8 +375,8 @@ def _stands(cyl: Cylinder, pts: np.ndarray, nrm: np.ndarray, plane_fit: tuple[np
     wide arc without a gap (:func:`track`), and a cylinder that explains most of one plane's residual over them
     (:func:`curved_share`). Cells that show a cylinder's inside (``side`` -1: a pot's or a cup's inner wall over
     its rim) must also be explained better by it than by a sphere (the share of the algebraic sphere's residual
-    variance it explains at least ``min_share``): a bowl's inside is a sphere's, and no sphere search of the
-    outside kind (quadrics) takes it first, as it takes a ball's outside."""
+    variance it explains at least ``min_share``): a bowl's inside is a sphere's, which the sphere search
+    (quadrics, before this one) reads from either side, as it reads a ball's outside, and may have left."""
     if len(pts) < max(20, min_cells):
         return False
     r, _ = cyl.radial(pts)

@@ -3,9 +3,10 @@
 The plane search cuts a sphere or a cone's side into facets (or, under heavy noise, into a few small planes and
 cells of none); the cylinder search would read a cone's side as a cylinder. So before it, per object:
 
-- a **sphere** from a seeded sample consensus over pairs of cells with their normals: the lines back along two
-  outward normals of a sphere meet at its centre, ``c = p1 - r n1 = p2 - r n2``, which gives r (least squares,
-  one unknown) and c;
+- a **sphere** from a seeded sample consensus over pairs of cells with their normals: the lines along two
+  normals of a sphere meet at its centre, ``c = p1 - r n1 = p2 - r n2``, which gives r (least squares, one
+  unknown) and c; behind the cells for its outside (a ball), in front of them for its inside (a bowl seen over
+  its rim, whose normals point towards the centre);
 - a **cone** from triples of cells with their normals: every tangent plane of a cone passes through its apex
   (``n . apex = n . p``: three cells give the apex) and every normal makes the same angle with its axis
   (``n . axis = -sin(alpha)``: three normals give the axis and alpha);
@@ -25,7 +26,7 @@ the planes with half their cells or more on it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -285,9 +286,11 @@ def sample_sphere(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: floa
                   rng: np.random.Generator, trials: int = 192, score_points: int = 600,
                   min_pair_deg: float = 10.0) -> Sphere | None:
     """The sphere with most inliers (within ``dist_m`` of the surface, the normal within ``arccos(cos_min)`` of
-    the radial direction) among ``trials`` seeded pairs of the oriented points (m, 3) with outward unit normals
-    (m, 3), scored on a seeded sample of ``score_points``; its radius in [r_min, r_max]. None when no pair gives
-    one. A pair fixes the sphere where the lines back along its normals meet: ``p1 - r n1 = p2 - r n2``."""
+    the direction of the side it shows) among ``trials`` seeded pairs of the oriented points (m, 3) with unit
+    normals (m, 3) towards the camera, scored on a seeded sample of ``score_points``; its radius in [r_min,
+    r_max]. None when no pair gives one. A pair fixes the sphere where the lines along its normals meet:
+    ``p1 - r n1 = p2 - r n2``, behind the points (r > 0) for an outside, a ball's, and in front of them (r < 0) for
+    an inside, a bowl's seen over its rim (``Sphere.side``)."""
     m = len(pts)
     if m < 20:
         return None
@@ -298,11 +301,12 @@ def sample_sphere(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: floa
     ok = ee >= (2 * np.sin(np.radians(min_pair_deg) / 2)) ** 2
     r = np.einsum("ij,ij->i", d, e) / np.maximum(ee, 1e-12)
     miss = np.linalg.norm(d - r[:, None] * e, axis=1)  # how far the two lines pass from each other
-    ok &= (r >= r_min) & (r <= r_max) & (miss <= 0.25 * np.abs(r))
+    ok &= (np.abs(r) >= r_min) & (np.abs(r) <= r_max) & (miss <= 0.25 * np.abs(r))
     if not ok.any():
         return None
     r = r[ok]
     c = 0.5 * (pts[i][ok] - r[:, None] * nrm[i][ok] + pts[j][ok] - r[:, None] * nrm[j][ok])
+    side, r = np.sign(r), np.abs(r)
     # each centre k against each scored point s in (k, s) products (coordinates about the points' mean):
     # |p - c|^2 = |p|^2 - 2 c . p + |c|^2, and the normal's dot with p - c
     sp, sn = pts[score], nrm[score]
@@ -312,9 +316,9 @@ def sample_sphere(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: floa
     rr = np.sqrt(np.maximum(np.einsum("sj,sj->s", q, q)[None, :] - 2.0 * cq + np.einsum("kj,kj->k", co, co)[:, None],
                             0.0))
     dn = np.einsum("sj,sj->s", q, sn)[None, :] - co @ sn.T
-    count = np.count_nonzero((np.abs(rr - r[:, None]) <= dist_m) & (dn >= cos_min * rr), axis=1)
+    count = np.count_nonzero((np.abs(rr - r[:, None]) <= dist_m) & (side[:, None] * dn >= cos_min * rr), axis=1)
     b = int(np.argmax(count))
-    return Sphere(tuple(float(x) for x in c[b]), float(r[b]))
+    return Sphere(tuple(float(x) for x in c[b]), float(r[b]), float(side[b]))
 
 
 def sample_cone(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: float, alpha_min: float,
@@ -365,7 +369,7 @@ def sample_cone(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: float,
 
 def refine_sphere(pts: np.ndarray, start: Sphere) -> Sphere | None:
     """The least-squares sphere (geometric distances, Levenberg-Marquardt) through points (m, 3), started at
-    ``start``; None when it does not converge or its numbers are not finite."""
+    ``start``, showing its side; None when it does not converge or its numbers are not finite."""
     from scipy.optimize import least_squares
 
     @_last_call
@@ -386,7 +390,7 @@ def refine_sphere(pts: np.ndarray, start: Sphere) -> Sphere | None:
         return None
     if fit.status <= 0 or not np.all(np.isfinite(fit.x)) or fit.x[3] <= 0:
         return None
-    return Sphere(tuple(float(x) for x in fit.x[:3]), float(fit.x[3]))
+    return Sphere(tuple(float(x) for x in fit.x[:3]), float(fit.x[3]), start.side)
 
 
 def cone_from_normals(pts: np.ndarray, nrm: np.ndarray) -> Cone | None:
@@ -469,8 +473,8 @@ def refine_cone(pts: np.ndarray, start: Cone) -> Cone | None:
 
 def _residual_normal(model: Sphere | Cone, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if isinstance(model, Sphere):
-        r, out = model.radial(pts)
-        return r - model.radius, out
+        r, _ = model.radial(pts)
+        return r - model.radius, model.normals(pts)
     return model.residual(pts), model.normals(pts)
 
 
@@ -590,7 +594,7 @@ def object_quadrics(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of:
             start = algebraic_sphere(pts[idx])
             if start is None or not valid(start):
                 return False
-            return refine_sphere(pts[idx], start)
+            return refine_sphere(pts[idx], replace(start, side=model.side))
         start = cone_from_normals(pts[idx], nrm[idx])
         if start is None or not valid(start):
             return False
