@@ -28,8 +28,8 @@ COLOUR_FIRST_PX = 6.0  # rgbd fields near a depth-found face: colour's edge stan
 SIDE_NAMES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
 _SIDE_PREDS = frozenset(SIDE_NAMES.values())
 # facts that describe a face as a polygon: its side count, its shape as a polygon, the kinds of its corners
-POLYGON_PREDS = frozenset(SIDE_NAMES.values()) | {"parallelogram", "square", "rectangle", "regular",
-                                                  "has_right_angle", "has_acute_angle", "has_obtuse_angle"}
+POLYGON_PREDS = _SIDE_PREDS | {"parallelogram", "square", "rectangle", "regular",
+                              "has_right_angle", "has_acute_angle", "has_obtuse_angle"}
 # facts that say a face is no polygon: a curved surface, or a planar face with a round outline
 ROUND_PREDS = frozenset({"cylindrical", "conical", "spherical", "circular", "elliptical"})
 
