@@ -364,8 +364,7 @@ def confusion_matrix(confusion: dict, classes: list[str]) -> tuple[list[str], li
             for yy, a, k in confusion["pairs"]:
                 if yy == y:
                     row[cols.index(a)] = k / n
-            if y in cols:
-                row[cols.index(y)] = 1.0 - sum(row)
+            row[cols.index(y)] = 1.0 - sum(row)  # the right answers: every class is a column
         rows.append(row)
     return cols, rows
 
