@@ -31,7 +31,7 @@ import cv2
 import numpy as np
 
 from .errors import InputError
-from .rgbd import RGBD, load_real, read_intrinsics, real_frame_files
+from .rgbd import RGBD, load_real, read_intrinsics, real_frame_files, working_factor
 
 REQUIRED_COLUMNS = ("frame", "object", "u", "v", "shape")
 # a class becomes the name of a learned predicate: a lower-case word
@@ -42,7 +42,9 @@ _CLASS = re.compile(r"^[a-z][a-z0-9_]*$")
 class LabelledObject:
     """One row of objects.csv: the object ``object`` of ``frame``, whose pixel (u, v) (column, row) lies
     inside it, of class ``shape``; ``partial``/``stacked`` as the README defines them (False when absent).
-    ``line``: its line in objects.csv (0: not read from a file)."""
+    ``line``: its line in objects.csv (0: not read from a file). (u, v) is a pixel of the frame as lv3d reads it
+    (:meth:`FrameFolder.load`: a frame larger than perception's working size is read at 1/s of it,
+    lv3d.rgbd.to_working); ``file_uv``, where that differs, is the pixel as objects.csv gives it."""
 
     frame: str
     object: int
@@ -52,10 +54,17 @@ class LabelledObject:
     partial: bool
     stacked: bool
     line: int = 0
+    file_uv: tuple[int, int] | None = None
 
     @property
     def key(self) -> str:
         return f"{self.frame}#{self.object}"
+
+    @property
+    def pixel(self) -> str:
+        """The labelled pixel as objects.csv gives it, "(u, v)", for messages."""
+        u, v = self.file_uv or (self.u, self.v)
+        return f"({u}, {v})"
 
 
 @dataclass(frozen=True)
@@ -179,10 +188,16 @@ class FrameFolder:
         w, h = sizes[frame]
         if not (0 <= u < w and 0 <= v < h):
             raise ValueError(f"pixel ({u}, {v}) lies outside the {w}x{h} frame {frame!r}")
-        return LabelledObject(frame, obj, u, v, shape, _yes_no(row.get("partial")), _yes_no(row.get("stacked")),
-                              line)
+        partial, stacked = _yes_no(row.get("partial")), _yes_no(row.get("stacked"))
+        s = working_factor(w, h)
+        if s == 1:
+            return LabelledObject(frame, obj, u, v, shape, partial, stacked, line)
+        # pixel (j, i) of the frame as read is pixel (s j, s i) of the file: the nearest one, within the frame
+        uw, vw = min(round(u / s), (w - 1) // s), min(round(v / s), (h - 1) // s)
+        return LabelledObject(frame, obj, uw, vw, shape, partial, stacked, line, (u, v))
 
     def _size(self, frame: str) -> tuple[int, int]:
+        """The frame's size in its files (intrinsics.json)."""
         k, _ = read_intrinsics(self.path / "intrinsics.json", frame)
         return k.width, k.height
 
@@ -206,11 +221,23 @@ class FrameFolder:
         return out
 
     def load(self, frame: str) -> RGBD:
+        """The frame as lv3d reads it: at perception's working size (lv3d.rgbd.to_working)."""
         return load_real(self.path, frame)
 
     def label_image(self, frame: str, shape: tuple[int, int]) -> np.ndarray | None:
-        """The frame's ground-truth masks (uint16 ids) or None where it has none."""
-        return read_label_image(self.path / f"{frame}_label.png", shape)
+        """The frame's ground-truth masks (uint16 ids) or None where it has none, on the pixels of the frame as
+        :meth:`load` reads it (``shape``): a label image of a larger frame is taken at every s-th pixel, as
+        its depth is."""
+        w, h = self._size(frame)
+        s = working_factor(w, h)
+        path = self.path / f"{frame}_label.png"
+        lab = read_label_image(path, (h, w))
+        if lab is not None and s > 1:
+            lab = np.ascontiguousarray(lab[::s, ::s])
+        if lab is not None and lab.shape != tuple(shape):
+            raise InputError(path, f"label image is {lab.shape[1]}x{lab.shape[0]} as read, the frame "
+                                   f"{shape[1]}x{shape[0]}")
+        return lab
 
     def signature(self) -> str:
         """A digest of what the folder holds (objects.csv, intrinsics.json, each frame file's name, size and

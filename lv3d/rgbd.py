@@ -1,5 +1,9 @@
 """One registered RGB-D frame and its loaders: this project's data set format and real camera frames
-(PNG or 16-bit TIFF depth with a depth scale, intrinsics from JSON)."""
+(PNG or 16-bit TIFF depth with a depth scale, intrinsics from JSON).
+
+A camera frame larger than perception's working size is read at a whole fraction of its size
+(:func:`working_factor`, :func:`to_working`): perception's settings and the calibration maps are made for frames
+about ``WORK_SIDE_PX`` pixels across."""
 
 from __future__ import annotations
 
@@ -23,6 +27,7 @@ class RGBD:
     intrinsics: Intrinsics
     name: str = "frame"
     meta: dict = field(default_factory=dict, compare=False)
+    scale: int = 1  # pixels of the image files per pixel of this frame (to_working); 1: read as it is
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -126,12 +131,46 @@ def _check_depth_range(path: Path, median_m: float, scale: float, scale_option: 
                            f"the {lo:g}-{hi:g} m an RGB-D sensor reads; {advice}")
 
 
+# The size (pixels along the longer side) perception's settings and the calibration maps are made for: the
+# Kinect and RealSense VGA streams of the real dev frames and the renderer's default, 640x480. Perception's
+# image-side quantities are fractions of the image, but a grid cell's normal is smoothed over 5 cells, the
+# thinnest face it reads is a few cells wide, and the calibration maps read face sizes in pixels: on a frame
+# twice as wide every one of those would mean half as much, and the frame would cost four times as much.
+WORK_SIDE_PX = 640
+
+
+def working_factor(width: int, height: int) -> int:
+    """The whole factor a ``width`` x ``height`` camera frame is read at (1/factor of its size): its longer side
+    over ``WORK_SIDE_PX``, rounded, at least 1 (640x480 and 848x480: 1; 1280x720: 2; 1920x1080: 3). A frame
+    smaller than the working size is read as it is: upsampling adds no reading."""
+    return max(1, round(max(width, height) / WORK_SIDE_PX))
+
+
+def to_working(frame: RGBD) -> RGBD:
+    """``frame`` at its working size (:func:`working_factor`), itself where that is its size. Depth keeps every
+    s-th reading of every s-th row (a reading is never averaged across a depth edge, and no reading is made up
+    where the sensor had none); colour is low-passed (a Gaussian of s/2 pixels, against aliasing) and taken at
+    the same pixels, so the two stay registered; the intrinsics are those of the smaller grid (pixel (u, v) of
+    it is pixel (s u, s v) of the file). ``scale`` records s."""
+    s = working_factor(frame.depth.shape[1], frame.depth.shape[0])
+    if s == 1:
+        return frame
+    color = cv2.GaussianBlur(frame.color, (0, 0), 0.5 * s)[::s, ::s]
+    depth = frame.depth[::s, ::s]
+    k = frame.intrinsics
+    small = Intrinsics(fx=k.fx / s, fy=k.fy / s, cx=k.cx / s, cy=k.cy / s, width=depth.shape[1], height=depth.shape[0])
+    return RGBD(np.ascontiguousarray(color), np.ascontiguousarray(depth), small, frame.name, frame.meta,
+                frame.scale * s)
+
+
 def load_frame(color_path: Path, depth_path: Path | None, intrinsics: Intrinsics | None,
                depth_scale_m: float = 0.001, name: str | None = None, meta: dict | None = None,
-               scale_option: str = "--depth-scale") -> RGBD:
+               scale_option: str = "--depth-scale", working: bool = True) -> RGBD:
     """Load and validate one frame. Without ``depth_path`` the depth is all zeros (rgb-only use) and, without
     ``intrinsics`` too, the intrinsics are nominal (:meth:`Intrinsics.nominal`). ``scale_option`` names where
-    the user sets the depth scale, for the error on depth in the wrong unit."""
+    the user sets the depth scale, for the error on depth in the wrong unit. With ``working`` (a camera frame),
+    a frame larger than the working size is read at it (:func:`to_working`); without (a rendered data set's
+    item, whose ground truth lies on the file's pixel grid), as it is."""
     color = read_color(color_path)
     h, w = color.shape[:2]
     if intrinsics is None:
@@ -151,7 +190,8 @@ def load_frame(color_path: Path, depth_path: Path | None, intrinsics: Intrinsics
         depth = read_depth(depth_path, depth_scale_m, scale_option)
         if depth.shape != (h, w):
             raise InputError(depth_path, f"depth is {depth.shape[1]}x{depth.shape[0]} but colour is {w}x{h}")
-    return RGBD(color, depth, intrinsics, name or Path(color_path).stem, meta or {})
+    frame = RGBD(color, depth, intrinsics, name or Path(color_path).stem, meta or {})
+    return to_working(frame) if working else frame
 
 
 def read_intrinsics(path: Path, frame: str | None = None) -> tuple[Intrinsics, float]:
@@ -192,7 +232,8 @@ def load_item(item_dir: Path) -> RGBD:
         raise InputError(meta_path, "no intrinsics")
     k = Intrinsics.from_dict(meta["intrinsics"], str(meta_path))
     return load_frame(item_dir / "color.png", item_dir / "depth.png", k, _depth_scale(meta, meta_path, "depth_scale_m"),
-                      name=meta.get("id", item_dir.name), meta=meta, scale_option="depth_scale_m in meta.json")
+                      name=meta.get("id", item_dir.name), meta=meta, scale_option="depth_scale_m in meta.json",
+                      working=False)
 
 
 # Real frames in ../shared/data/real/pcl-kinect: name -> (colour file, depth file)
@@ -209,7 +250,8 @@ def real_frame_files(folder: Path) -> dict[str, tuple[Path, Path]]:
 
 
 def load_real(folder: Path, name: str) -> RGBD:
-    """A real frame from a folder laid out like ``../shared/data/real/pcl-kinect``."""
+    """A real frame from a folder laid out like ``../shared/data/real/pcl-kinect``, at its working size
+    (:func:`to_working`)."""
     files = real_frame_files(folder)
     if name not in files:
         raise InputError(folder, f"no frame {name!r}; found: {', '.join(files) or 'none'}")

@@ -71,8 +71,10 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
         facts_obj = describe(scene, frame)
     _write(Path(out_dir), inputs, scene, draw_overlay(frame.color, scene), facts_obj)
     dropped = f" ({scene.dropped_objects} smaller objects left out by --max-objects)" if scene.dropped_objects else ""
+    read_at = (f"; read at 1/{frame.scale} size, {frame.shape[1]}x{frame.shape[0]}: scene.json and overlay.png are in "
+               "its pixels" if frame.scale > 1 else "")
     click.echo(f"{out_dir}: {len(scene.objects)} objects{dropped}, "
-               f"{sum(len(o.faces) for o in scene.objects)} faces, target {scene.target().id}")
+               f"{sum(len(o.faces) for o in scene.objects)} faces, target {scene.target().id}{read_at}")
 
 
 def _write(out_dir: Path, inputs, scene, overlay_rgb, facts_obj) -> None:

@@ -153,7 +153,7 @@ def example_facts_of(rd: RealData, frames: dict) -> tuple[dict[str, SceneFacts],
         if facts[it.id].target is None:
             folder, frame = rd.frames[atom]
             lab = next(o for o in rd.labels[atom] if o.object == obj)
-            errors[it.id] = ff.error or (f"{folder.path / 'objects.csv'}: line {lab.line}: pixel ({lab.u}, {lab.v}) "
+            errors[it.id] = ff.error or (f"{folder.path / 'objects.csv'}: line {lab.line}: pixel {lab.pixel} "
                                          f"of {frame!r} lies on no object {ff.modality} perception found")
     return facts, errors
 
