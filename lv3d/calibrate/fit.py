@@ -53,7 +53,8 @@ the best by scene-grouped CV log loss of none, its group's pooled map and its ow
 
 Weights. Where a key has rows of both kinds, the real rows carry ``REAL_SHARE`` of its total weight (each kind's
 rows equal among themselves, weights averaging 1): a few hundred real candidates against thousands of rendered
-ones would otherwise leave the maps as they were.
+ones would otherwise leave the maps as they were. The log prints, under each such key, every map's CV log loss over
+its real rows and over its rendered rows alone (unweighted): which kind of frame chose the map.
 
 Checks. ``--holdout`` first fits without each real pickle and prints bench_real's figures on the one left out
 (a sensor the fit has not seen), then fits in ``HOLDOUT_FOLDS`` frame-grouped folds over all real frames and prints
@@ -263,12 +264,14 @@ def candidate_maps(pred: str) -> dict:
 
 def fit_one(rows: list[dict], seed: int = 0, w: np.ndarray | None = None):
     """The best map for one (modality, key) by scene-grouped 5-fold CV weighted log loss (:func:`_scene_fold_of`):
-    (None (raw) or a map, {map: CV log loss}, the winner's out-of-fold confidences (n,))."""
+    (None (raw) or a map, {map: CV log loss}, the winner's out-of-fold confidences (n,), and where the key has rows
+    of both kinds {"real"/"rendered": {map: CV log loss over that kind's rows, unweighted}}, else {}: which kind
+    of frame chose the map)."""
     y = np.array([r["y"] for r in rows], float)
     p = np.array([r["p"] for r in rows])
     w = np.ones(len(rows)) if w is None else w
     if len(rows) < MIN_ROWS:
-        return None, {}, np.clip(p, 0, 1)
+        return None, {}, np.clip(p, 0, 1), {}
     fold = _scene_fold_of([scene_of(r) for r in rows], seed)
     folds = np.array([fold[scene_of(r)] for r in rows])
     cands = candidate_maps(rows[0]["pred"])
@@ -284,12 +287,16 @@ def fit_one(rows: list[dict], seed: int = 0, w: np.ndarray | None = None):
             b, c, f = _fit_monotone(trows, feats, w[tr])
             pred[te] = predict_rows(b, c, f, [r for r, t in zip(rows, te) if t])
         losses[name], oof[name] = _wlog_loss(pred, y, w), pred
+    real = np.array([is_real(r) for r in rows])
+    by_kind = {} if real.all() or not real.any() else \
+        {kind: {n: _wlog_loss(v[m], y[m], np.ones(int(m.sum()))) for n, v in oof.items()}
+         for kind, m in (("real", real), ("rendered", ~real))}
     name = min(losses, key=losses.get)
     if cands[name] == "raw":
-        return None, losses, oof[name]
+        return None, losses, oof[name], by_kind
     b, c, f = _fit_monotone(rows, cands[name], w)
     return {"features": f, "bias": round(b, 5), "coef": [round(float(v), 5) for v in c], "n": len(rows),
-            "map": name, "cv_logloss": round(losses[name], 4)}, losses, oof[name]
+            "map": name, "cv_logloss": round(losses[name], 4)}, losses, oof[name], by_kind
 
 
 def _isotonic(conf: np.ndarray, y: np.ndarray, w: np.ndarray | None = None):
@@ -380,15 +387,17 @@ def fit(rows: list[dict], modalities, real_share: float = REAL_SHARE, log=print,
         n_real = sum(is_real(r) for r in rs)
         w = row_weights(rs, real_share)
         if memo is not None and not n_real and (key, len(rs)) in memo:
-            entry, losses, conf = memo[(key, len(rs))]
+            entry, losses, conf, by_kind = memo[(key, len(rs))]
         else:
-            entry, losses, conf = fit_one(rs, w=w)
+            entry, losses, conf, by_kind = fit_one(rs, w=w)
             if memo is not None and not n_real:
-                memo[(key, len(rs))] = entry, losses, conf
+                memo[(key, len(rs))] = entry, losses, conf, by_kind
         oof[key[0]][key[1]] = (conf, np.array([r["y"] for r in rs], float), np.array([scene_of(r) for r in rs]), w)
         log(f"  {key[0]:5s} {key[1]:20s} n={len(rs):5d} ({n_real} real)  cv log loss "
             + "  ".join(f"{k} {v:.4f}" for k, v in losses.items())
             + f"  -> {'raw' if entry is None else entry['map'] + ' ' + ','.join(entry['features'])}")
+        for kind, ls in by_kind.items():  # the same maps' losses over one kind of frame's rows alone
+            log(f"  {'':5s} {'':20s} {kind + ' rows':>13s}  " + "  ".join(f"{k} {v:.4f}" for k, v in ls.items()))
         if entry is not None:
             table.setdefault(key[0], {})[key[1]] = entry
     final = {}

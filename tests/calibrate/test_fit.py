@@ -46,3 +46,26 @@ def test_scene_interval_widens_when_a_scene_s_facts_go_together():
     assert lo_a <= ece(p, own) <= hi_a and lo_t <= ece(p, shared) <= hi_t
     assert hi_t - lo_t > 2 * (hi_a - lo_a)      # 60 independent draws, not 480
     assert scene_interval(p, shared, together) == (lo_t, hi_t)                  # seeded
+
+
+def test_a_key_with_rows_of_both_kinds_reports_each_map_s_loss_on_each_kind():
+    """fit_one's fourth result: every candidate's CV log loss over the real rows and over the rendered rows alone
+    (which kind chose the map); rendered rows where p is right, real rows where a high p is often wrong."""
+    from lv3d.calibrate.fit import _wlog_loss, fit_one
+
+    rng = np.random.default_rng(2)
+    rows = []
+    for i in range(600):
+        real = i % 3 == 0
+        p = float(rng.uniform(0.02, 0.98))
+        y = rng.random() < (0.5 if real and p > 0.5 else p)
+        rows.append({"pred": "perpendicular", "p": p, "y": float(y), "seed": i // 6, "support": 0.9,
+                     "source": "real:x" if real else "render:clean", **({"scene": f"x/f{i // 6}"} if real else {})})
+    entry, losses, conf, by_kind = fit_one(rows)
+    assert set(by_kind) == {"real", "rendered"} and set(by_kind["real"]) == set(losses)
+    real = np.array([r["source"].startswith("real:") for r in rows])
+    y = np.array([r["y"] for r in rows])
+    # the winner's out-of-fold confidences give its per-kind losses
+    assert by_kind["real"][entry["map"]] == _wlog_loss(conf[real], y[real], np.ones(real.sum()))
+    assert by_kind["real"]["raw"] > by_kind["rendered"]["raw"]     # the raw p is right on rendered rows only
+    assert fit_one([r for r, k in zip(rows, real) if not k])[3] == {}  # one kind only: nothing to set apart
