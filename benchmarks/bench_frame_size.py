@@ -20,6 +20,7 @@ Exit status: 0, or 2 with one line naming what is wrong.
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import sys
 import tempfile
@@ -58,16 +59,16 @@ def enlarge(folder: Path, out: Path, factor: int, limit: int | None) -> Path:
         intr["frames"][name] = {"fx": k.fx * factor, "fy": k.fy * factor, "cx": k.cx * factor, "cy": k.cy * factor,
                                 "width": k.width * factor, "height": k.height * factor, "depth_scale_m": scale}
     (out / "intrinsics.json").write_text(json.dumps(intr, indent=1))
-    lines = (folder / "objects.csv").read_text(encoding="utf-8-sig").splitlines()
-    header = [c.strip() for c in lines[0].split(",")]
+    rows = list(csv.reader((folder / "objects.csv").read_text(encoding="utf-8-sig").splitlines()))
+    header = [c.strip() for c in rows[0]]
     iu, iv, iframe = header.index("u"), header.index("v"), header.index("frame")
-    kept = [lines[0]]
-    for line in lines[1:]:
-        cells = line.split(",")
-        if len(cells) > max(iu, iv) and cells[iframe].strip() in frames:
-            cells[iu], cells[iv] = str(int(cells[iu]) * factor), str(int(cells[iv]) * factor)
-            kept.append(",".join(cells))
-    (out / "objects.csv").write_text("\n".join(kept) + "\n")
+    with (out / "objects.csv").open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(rows[0])
+        for cells in rows[1:]:
+            if len(cells) > max(iu, iv, iframe) and cells[iframe].strip() in frames:
+                cells[iu], cells[iv] = str(int(cells[iu]) * factor), str(int(cells[iv]) * factor)
+                w.writerow(cells)
     return out
 
 
