@@ -19,7 +19,9 @@ writes them as ``{"pooled": {MODALITY: {...}}, "folders": {NAME: {MODALITY: {...
 object_recall, merged_frac, split_frac, support_ok_frac, box_perpendicular_frac, box_overfaced_frac,
 cylinder_as_prism_frac, perpendicular_ece, cylinder_read_frac, box_curved_frac, ms_median, ms_p90 and the extra
 labelled_found, cpu_ms_median, bowl_curved_frac, cylinder_elliptical_frac and box_elliptical_frac, and
-stage_ms_median, the median ms of each stage of a frame (perception's stages and grounding); a figure a
+stage_ms_median, the median ms of each stage of a frame (perception's stages and grounding); with several
+``--seed``, also ``"pooled_by_seed": {SEED: {MODALITY: {...}}}``, the pooled figures of each seed alone (printed
+with their spread, how much of a figure is perception's chance); a figure a
 folder or modality cannot measure is null (recall and split without masks; support, every ``perpendicular``
 figure and the curved-face figures under rgb, which has no planes and no curved faces; both elliptical figures
 under depth and rgbd, which do not say ``elliptical``).
@@ -569,6 +571,30 @@ def table(title: str, figures: dict[str, dict], modalities: list[str]) -> str:
     return "\n".join(lines)
 
 
+SEED_KEYS = tuple(k for k in KEYS if not k.startswith("ms_"))  # the figures a perception seed can move
+
+
+def by_seed(rows: dict[str, list[dict]], seeds: tuple[int, ...], modalities: list[str]) -> dict[str, dict]:
+    """{seed: {modality: figures}}: the pooled rows' figures (:func:`summarise`) of each perception seed alone."""
+    return {str(s): {m: summarise([r for r in rows[m] if r["seed"] == s], m) for m in modalities} for s in seeds}
+
+
+def seed_table(figures: dict[str, dict], modalities: list[str]) -> str:
+    """Each figure a perception seed can move (``SEED_KEYS``), per modality, under each seed of ``figures`` (as
+    :func:`by_seed` gives it), with the spread (largest - smallest): how much of a figure is perception's chance."""
+    seeds = list(figures)
+    lines = [f"{'figure':24}{'modality':>9}" + "".join(f"{'seed ' + s:>10}" for s in seeds) + f"{'spread':>10}"]
+    for key in SEED_KEYS:
+        for m in modalities:
+            vals = [figures[s][m][key] for s in seeds]
+            if all(v is None for v in vals):
+                continue
+            got = [v for v in vals if v is not None]
+            lines.append(f"{key:24}{m:>9}" + "".join(f"{'null' if v is None else f'{v:.3f}':>10}" for v in vals)
+                         + f"{max(got) - min(got):>10.3f}")
+    return "\n".join(lines)
+
+
 def stage_lines(figures: dict[str, dict], modalities: list[str]) -> str:
     """One line per modality: the median ms of each stage of a frame (:func:`stage_medians`)."""
     return "\n".join(f"median ms by stage, {m}: " + ", ".join(f"{k} {v:.1f}" for k, v in
@@ -858,6 +884,9 @@ def main(argv=None) -> int:
                 f"{sum(r['labelled'] for r in once)} labelled objects{seeds_text} "
                 f"({time.perf_counter() - t0:.0f} s)", figures, mods))
     print(stage_lines(figures, mods))
+    if len(args.seed) > 1:
+        result["pooled_by_seed"] = by_seed(pooled_rows, args.seed, mods)
+        print(f"\n== pooled, each perception seed on its own\n{seed_table(result['pooled_by_seed'], mods)}")
     print("ok / MISS: the figure meets / misses its target (issues 39, 40); targets hold for the modalities named; "
           "ms: perception + grounding per frame, one core, warm")
     if args.json is not None:

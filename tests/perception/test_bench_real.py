@@ -440,3 +440,19 @@ def test_the_profile_lists_lv3d_functions_per_frame_and_names_a_file_not_a_folde
     assert rows and all(any(p.strip("/") in r for p in bench.PROFILED) for r in rows)
     top = next(r for r in rows if "h_maxima" in r)
     assert top.split()[2] == "1.0" and "lv3d/perception/depth/creases.py" in top  # calls per frame, path from the root
+
+
+def test_several_seeds_also_give_each_seed_s_figures_and_their_spread(monkeypatch):
+    none = {k: None for k in bench.KEYS + bench.EXTRA_KEYS}
+    figures = {"0": {"depth": {**none, "box_perpendicular_frac": 0.9}, "rgbd": {**none, "box_perpendicular_frac": 0.85}},
+               "1": {"depth": {**none, "box_perpendicular_frac": 0.8}, "rgbd": {**none, "box_perpendicular_frac": None}}}
+    text = bench.seed_table(figures, ["depth", "rgbd"])
+    lines = text.splitlines()
+    assert "seed 0" in lines[0] and "seed 1" in lines[0] and "spread" in lines[0]
+    assert [ln.split() for ln in lines[1:]] == [["box_perpendicular_frac", "depth", "0.900", "0.800", "0.100"],
+                                                ["box_perpendicular_frac", "rgbd", "0.850", "null", "0.000"]]
+    assert "ms_median" not in text  # time is not perception's chance
+    rows = {"depth": [{"seed": 0, "x": 1}, {"seed": 1, "x": 2}, {"seed": 1, "x": 3}]}
+    seen = []
+    monkeypatch.setattr(bench, "summarise", lambda rs, m: seen.append([r["x"] for r in rs]) or none)
+    assert set(bench.by_seed(rows, (0, 1), ["depth"])) == {"0", "1"} and seen == [[1], [2, 3]]
