@@ -98,18 +98,22 @@ def main(argv=None) -> int:
             print(f"bench_frame_size.py: error: {e}", file=sys.stderr)
             return 2
         common = ["--limit", str(args.limit), "--modalities", args.modalities]
-        runs = [("as they are", folders, tmp / "a.json"), (f"{args.factor} times as large", large, tmp / "b.json")]
-        if args.full_size:
-            runs.append((f"{args.factor} times as large, perceived at full size", large, tmp / "c.json"))
-        for name, fs, out in runs:
+        # (what the run is, its folders, its JSON, the working size it reads them at)
+        runs = [("as they are", folders, tmp / "a.json", rgbd.WORK_SIDE_PX),
+                (f"{args.factor} times as large", large, tmp / "b.json", rgbd.WORK_SIDE_PX)]
+        if args.full_size:  # a working size no frame exceeds: every frame read at its own size
+            runs.append((f"{args.factor} times as large, perceived at full size", large, tmp / "c.json", 10 ** 9))
+        for name, fs, out, side in runs:
             print(f"#### the frames {name}")
-            if out.name == "c.json":
-                rgbd.WORK_SIDE_PX = 10 ** 9  # every frame is read at its own size
-            rc = bench_real.main([str(f) for f in fs] + common + ["--json", str(out)])
+            kept, rgbd.WORK_SIDE_PX = rgbd.WORK_SIDE_PX, side
+            try:
+                rc = bench_real.main([str(f) for f in fs] + common + ["--json", str(out)])
+            finally:
+                rgbd.WORK_SIDE_PX = kept
             if rc:
                 return rc
         rc = 0
-        for (name, _, out) in runs[1:]:
+        for name, _, out, _ in runs[1:]:
             print(f"#### A: the frames as they are, B: {name}")
             rc = rc or compare_real.main([str(tmp / "a.json"), str(out), "--folders"])
         return rc

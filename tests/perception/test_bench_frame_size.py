@@ -51,3 +51,14 @@ def test_bad_arguments_exit_2(folder, capsys):
         main([str(folder), "--factor", "1"])
     assert e.value.code == 2
     assert "--factor must be at least 2" in capsys.readouterr().err
+
+
+def test_the_full_size_run_leaves_the_working_size_as_it_was(folder, monkeypatch):
+    import benchmarks.bench_frame_size as bench
+    from lv3d import rgbd
+
+    sides = []
+    monkeypatch.setattr(bench.bench_real, "main", lambda argv: sides.append(rgbd.WORK_SIDE_PX) or 0)
+    monkeypatch.setattr(bench.compare_real, "main", lambda argv: 0)
+    assert bench.main([str(folder), "--limit", "1", "--full-size"]) == 0
+    assert sides == [640, 640, 10 ** 9] and rgbd.WORK_SIDE_PX == 640
