@@ -52,9 +52,11 @@ learn_noisy(Ctx, Settings, Pos, Neg, Best, Score) :-
 %   first size (First) gives any hypothesis (each drawn sample held a positive whose facts no small
 %   program shares with the others', or a negative that shares them), samples half the size,
 %   positives rounded up and negatives down, down to one positive and no negative (each positive
-%   alone: the minimal samples of sample consensus, all of them), until one gives a hypothesis that
-%   is kept (kept/4).  Only when every sample of the first size runs out of time is it the
-%   time-limit error; a smaller size that runs out gives nothing.
+%   alone: the minimal samples of sample consensus, all of them), and the hypotheses every smaller
+%   size gives that are kept (kept/4) compete together: an unlucky draw of a middle size must not
+%   end the search with one positive's idiosyncrasy before the minimal samples are seen.  Only when
+%   every sample of the first size runs out of time is it the time-limit error; a smaller size that
+%   runs out gives nothing.
 scored_hypotheses(Search, First, SP-SN, Round, Scored, Which) :-
     Search = search(Ctx, Settings, SCtx, LT, K, Deadline, T, Pos, Neg),
     samples(K, SP, SN, Pos, Neg, Drawn),
@@ -70,22 +72,32 @@ scored_hypotheses(Search, First, SP-SN, Round, Scored, Which) :-
                            literal_cost(Ctx, Prog, Cost), NCost is -Cost, NOrder is -Order,
                            Key = k(J, Soft, W, NCost, NOrder)), Scored0),
     kept(Round, First, Scored0, Scored1),
-    (   Scored1 == [], option(shrink_samples(true), Settings),
+    (   Round == first, Scored1 \== []
+    ->  Scored-Which = Scored1-first
+    ;   option(shrink_samples(true), Settings),
         smaller(SP-SN, Smaller), get_time(Then), Then < Deadline
-    ->  scored_hypotheses(Search, First, Smaller, smaller, Scored, Which)
+    ->  scored_hypotheses(Search, First, Smaller, smaller, Scored2, _),
+        foldl(add_new_program, Scored2, Scored1, Scored), Which = smaller
     ;   Scored-Which = Scored1-Round
     ).
 
+%   Hs with the scored hypothesis H added after them unless its program is already there.
+add_new_program(H, Hs0, Hs) :-
+    H = _-(Prog-_),
+    (   memberchk(_-(Prog-_), Hs0) -> Hs = Hs0 ; append(Hs0, [H], Hs) ).
+
 smaller(SP-SN, SP1-SN1) :- ( SP > 1 ; SN > 0 ), SP1 is max(1, (SP + 1) // 2), SN1 is SN // 2.
 
-%   A hypothesis of a smaller sample is kept only where a sample of the first size (SP positives, SN
-%   negatives) is consistent with it on the scores: it proves SP positives and leaves SN negatives
-%   unproved.  It is then one a luckier draw of the first size would have found: the smaller samples
-%   widen the draws, not what a hypothesis may get wrong.  Those of the first size are kept.
+%   A hypothesis of a smaller sample is kept only where it leaves a first-size sample's negatives (SN)
+%   unproved: samples shrink because every first-size sample held a positive whose facts no small
+%   program shares with the others' (one perception spoiled: a can cut into planes), so a smaller
+%   sample's hypothesis may miss positives, and J on all examples weighs what it misses; but one that
+%   proves more negatives than a first-size sample may leave out is over-general, whatever its J.
+%   Those of the first size are kept.
 kept(first, _, Hs, Hs) :- !.
-kept(smaller, Size, Hs0, Hs) :- include(first_size_consistent(Size), Hs0, Hs).
+kept(smaller, Size, Hs0, Hs) :- include(leaves_sample_negatives(Size), Hs0, Hs).
 
-first_size_consistent(SP-SN, _-(_-score(_, _, TP/_, FP/NN, _))) :- TP >= SP, NN - FP >= SN.
+leaves_sample_negatives(_-SN, _-(_-score(_, _, _, FP/NN, _))) :- NN - FP >= SN.
 
 %   Among the hypotheses of the best J, the most probable under the size principle (Tenenbaum
 %   1999; docs/learner.md): the positives are taken as drawn from the objects a hypothesis covers,

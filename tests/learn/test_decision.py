@@ -181,8 +181,8 @@ def test_samples_shrink_when_no_sample_gives_a_hypothesis(seed):
     """Two cans read as cylindrical, two cut into planes: a sample of two cans and four of the six negatives
     gives `cylindrical` only when it draws both cylindrical cans and leaves the bowl out (one draw in 18), so
     one sample seldom does. The smaller samples end with each can alone, which finds it whatever the draw,
-    and it is kept, since a sample of the first size is consistent with it (it proves two cans and leaves
-    five negatives unproved): J = 2/4 - 1/6, less the clause penalty of 0.02."""
+    and it is kept, since it leaves a first-size sample's four negatives unproved (it proves one of six):
+    J = 2/4 - 1/6, less the clause penalty of 0.02."""
     scenes, labels = _cans_task(planar=2)
     prog = fit(scenes, labels, "can", settings={"samples": 1, "disjunctions": 0, "shrink_samples": True}, seed=seed)
     assert any("cylindrical(B)" in c for c in prog.clauses)
@@ -190,11 +190,35 @@ def test_samples_shrink_when_no_sample_gives_a_hypothesis(seed):
     assert prog.score["j"] == pytest.approx(2 / 4 - 1 / 6 - 0.02)
 
 
-def test_a_hypothesis_no_sample_of_the_first_size_fits_is_not_kept():
-    """Three of the four cans cut into planes: `cylindrical` proves one can, and no sample of two cans is
-    consistent with any hypothesis, so the smaller samples' hypotheses (one can each) are not kept, though
-    their J is above 0."""
-    scenes, labels = _cans_task(planar=3)
+def _two_cans_task(n_bowls: int) -> tuple[list[SceneFacts], list[str]]:
+    """Cans, all read as cylindrical but one cut into planes (a quadrilateral face, as every box has), against
+    six negatives: ``n_bowls`` bowls read as cylindrical and boxes. Three cans where ``n_bowls`` > 1, else two."""
+    n_cans = 3 if n_bowls > 1 else 2
+    cans = [_one_object(f"can{i}", [[("cylindrical", 0.95)]]) for i in range(n_cans - 1)]
+    cans.append(_one_object("flat_can", [[("quadrilateral", 0.9)]]))
+    negs = [_one_object(f"bowl{i}", [[("cylindrical", 0.8)]]) for i in range(n_bowls)]
+    negs += [_one_object(f"box{i}", [[("quadrilateral", 0.95)], [("rectangle", 0.9)]]) for i in range(6 - n_bowls)]
+    return cans + negs, ["can"] * n_cans + ["not_can"] * 6
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_a_smaller_sample_hypothesis_may_miss_positives(seed):
+    """Two cans, one cut into planes: no hypothesis proves both, so no sample of the first size (both cans)
+    gives one, and each can alone does. The cylindrical can's `cylindrical` proves one can and the bowl, and
+    leaves a first-size sample's four negatives unproved: it is kept, its J = 1/2 - 1/6 - 0.02. The flat can's
+    `quadrilateral` proves all five boxes and is not."""
+    scenes, labels = _two_cans_task(n_bowls=1)
+    prog = fit(scenes, labels, "can", settings={"samples": 1, "disjunctions": 0, "shrink_samples": True}, seed=seed)
+    assert any("cylindrical(B)" in c for c in prog.clauses)
+    assert (prog.score["tp"], prog.score["fp"]) == (1, 1)
+    assert prog.score["j"] == pytest.approx(1 / 2 - 1 / 6 - 0.02)
+
+
+def test_a_smaller_sample_hypothesis_that_proves_too_many_negatives_is_not_kept():
+    """Three bowls of six negatives read as cylindrical: every sample of four negatives holds one, so the
+    first size gives nothing, and `cylindrical`, which the smaller samples give, proves three negatives, more
+    than a sample of four may leave out (two): it is not kept, though its J (3/4 - 3/6 - 0.02) is above 0."""
+    scenes, labels = _two_cans_task(n_bowls=3)
     with pytest.raises(LearnError, match="no program"):
         fit(scenes, labels, "can", settings={"disjunctions": 0, "shrink_samples": True}, seed=0)
 
