@@ -2,7 +2,8 @@
 # Rerun every study in experiments/ after a change to lv3d's code, retraining only the lv3d systems, with the
 # systems and conditions of the committed reports in experiments/results/, and the seed protocol's four
 # replicates (its lv3d systems on data seeds 1-4; scripts/pooled_replicates.py pools them) and the real-objects
-# study's lv3d systems on perception seeds 1 and 2 (real_objects_pseed1, _pseed2). Each study's
+# study's lv3d systems on perception seeds 1 and 2 (real_objects_pseed1, _pseed2), and the ten-class study's
+# depth systems without arbiters (ten_classes_no_arbiters). Each study's
 # baseline fold files are restored from its committed results.csv first (scripts/restore_baselines.py), then
 # `lv3d experiment run` computes the lv3d folds and rewrites the report.
 #
@@ -45,6 +46,13 @@ replicate() {  # replicate SEED: the seed protocol's lv3d systems on images of a
     log "seed_protocol_seed$1: $(grep -a 'fold results computed' "$RUNS/seed_protocol_seed$1.log" | tail -1)"
 }
 
+no_arbiters() {  # the ten-class study's depth systems without arbiters (docs/learner.md, "Arbiters"; no baselines)
+    OMP_NUM_THREADS=1 $LV3D experiment run experiments/ten_classes.yaml --out "$RUNS/ten_classes_no_arbiters" \
+        --set "$CACHE" --set "systems=[lv3d-depth,lv3d-rgbd]" --set lv3d.settings.arbiters=false \
+        > "$RUNS/ten_classes_no_arbiters.log" 2>&1
+    log "ten_classes_no_arbiters: $(grep -a 'fold results computed' "$RUNS/ten_classes_no_arbiters.log" | tail -1)"
+}
+
 perception_seed() {  # perception_seed S: the real-objects study's lv3d systems with perception's seed S (no baselines)
     OMP_NUM_THREADS=1 $LV3D experiment run experiments/real_objects.yaml --out "$RUNS/real_objects_pseed$1" \
         --set "$REAL_CACHE" --set "$LV3D_ONLY" --set lv3d.perception_seed="$1" > "$RUNS/real_objects_pseed$1.log" 2>&1
@@ -74,7 +82,7 @@ pids=()
   real_objects; perception_seed 1; perception_seed 2 ) & pids+=($!)
 ( study ten_classes --set "$CACHE"
   until [ -e "$RUNS/.seed_protocol_done" ]; do sleep 10; done
-  study ablations --set "$CACHE"; replicate 3; replicate 4 ) & pids+=($!)
+  study ablations --set "$CACHE"; replicate 3; replicate 4; no_arbiters ) & pids+=($!)
 failed=0
 for p in "${pids[@]}"; do wait "$p" || failed=1; done
 [ "$failed" = 0 ] || { echo "a lane stopped: see $RUNS/progress and the last log it names" >&2; exit 1; }
