@@ -190,10 +190,9 @@ def test_samples_shrink_when_no_sample_gives_a_hypothesis(seed):
     assert prog.score["j"] == pytest.approx(2 / 4 - 1 / 6 - 0.02)
 
 
-def _two_cans_task(n_bowls: int) -> tuple[list[SceneFacts], list[str]]:
-    """Cans, all read as cylindrical but one cut into planes (a quadrilateral face, as every box has), against
-    six negatives: ``n_bowls`` bowls read as cylindrical and boxes. Three cans where ``n_bowls`` > 1, else two."""
-    n_cans = 3 if n_bowls > 1 else 2
+def _cans_one_flat(n_cans: int, n_bowls: int) -> tuple[list[SceneFacts], list[str]]:
+    """``n_cans`` cans, all read as cylindrical but one cut into planes (a quadrilateral face, as every box
+    has), against six negatives: ``n_bowls`` bowls read as cylindrical and boxes."""
     cans = [_one_object(f"can{i}", [[("cylindrical", 0.95)]]) for i in range(n_cans - 1)]
     cans.append(_one_object("flat_can", [[("quadrilateral", 0.9)]]))
     negs = [_one_object(f"bowl{i}", [[("cylindrical", 0.8)]]) for i in range(n_bowls)]
@@ -207,7 +206,7 @@ def test_a_smaller_sample_hypothesis_may_miss_positives(seed):
     gives one, and each can alone does. The cylindrical can's `cylindrical` proves one can and the bowl, and
     leaves a first-size sample's four negatives unproved: it is kept, its J = 1/2 - 1/6 - 0.02. The flat can's
     `quadrilateral` proves all five boxes and is not."""
-    scenes, labels = _two_cans_task(n_bowls=1)
+    scenes, labels = _cans_one_flat(n_cans=2, n_bowls=1)
     prog = fit(scenes, labels, "can", settings={"samples": 1, "disjunctions": 0, "shrink_samples": True}, seed=seed)
     assert any("cylindrical(B)" in c for c in prog.clauses)
     assert (prog.score["tp"], prog.score["fp"]) == (1, 1)
@@ -215,10 +214,10 @@ def test_a_smaller_sample_hypothesis_may_miss_positives(seed):
 
 
 def test_a_smaller_sample_hypothesis_that_proves_too_many_negatives_is_not_kept():
-    """Three bowls of six negatives read as cylindrical: every sample of four negatives holds one, so the
+    """Three cans, one cut into planes; three bowls of six negatives read as cylindrical: every sample of four negatives holds one, so the
     first size gives nothing, and `cylindrical`, which the smaller samples give, proves three negatives, more
     than a sample of four may leave out (two): it is not kept, though its J (3/4 - 3/6 - 0.02) is above 0."""
-    scenes, labels = _two_cans_task(n_bowls=3)
+    scenes, labels = _cans_one_flat(n_cans=3, n_bowls=3)
     with pytest.raises(LearnError, match="no program"):
         fit(scenes, labels, "can", settings={"disjunctions": 0, "shrink_samples": True}, seed=0)
 
