@@ -27,6 +27,11 @@ CAP_PX = 30.0  # edge fields are clipped to +-this many pixels
 COLOUR_FIRST_PX = 6.0  # rgbd fields near a depth-found face: colour's edge stands where it is within this (px)
 SIDE_NAMES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
 _SIDE_PREDS = frozenset(SIDE_NAMES.values())
+# facts about the angle between two faces' planes. An rgbd scene reads them as depth does: its faces are grounded a
+# second time against depth's edge field (:func:`ground`), and these facts take that grounding's probabilities and
+# measurements. Colour adds nothing to an angle between two depth planes, and colour's edges (print on a box,
+# a shadow) change the outline measurements the calibration of an angle reads: colour helps or stays out.
+ANGLE_PREDS = frozenset({"perpendicular", "parallel", "acute", "obtuse"})
 # facts that describe a face as a polygon: its side count, its shape as a polygon, the kinds of its corners
 POLYGON_PREDS = _SIDE_PREDS | {"parallelogram", "square", "rectangle", "regular",
                               "has_right_angle", "has_acute_angle", "has_obtuse_angle"}
@@ -58,6 +63,9 @@ class FaceResult:
     features: dict = dc_field(default_factory=dict)
     plane_tilt_std_rad: np.ndarray | None = None  # (2,) spread of the plane normal's two tilts, radians
     cylinder_reading: CylinderReading | None = None  # a cylindrical face's refined cylinder (read_cylinder)
+    # the same measurements as ``features`` from the depth reading of an rgbd scene's angles (ANGLE_PREDS), which
+    # those facts' calibration reads; None where the face has no such reading (every face outside rgbd)
+    angle_features: dict | None = None
 
 
 @dataclass
@@ -150,12 +158,14 @@ def _boxes(scene: Scene, margin_px: float, provenance: str | None = None) -> lis
     return [tuple(b) for b in boxes]
 
 
-def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px: float = 24.0) -> np.ndarray:
+def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px: float = 24.0, *,
+               depth_field: np.ndarray | None = None) -> np.ndarray:
     """The edge-distance field (H, W) float32 pixels a system that sees ``modality`` may use: colour edges
     for rgb, edges of the depth image's surface normals and depth steps for depth, and for rgbd colour edges with,
     around each face depth found and colour did not (provenance "depth"), depth's edges where colour has none
     within ``COLOUR_FIRST_PX``. With ``scene``, only the boxes around its objects' polygons (plus ``margin_px``)
-    are computed; the rest is the cap."""
+    are computed; the rest is the cap. ``depth_field``: the depth field of the same frame and scene, where it is
+    already at hand (rgbd reads depth's edges from it rather than computing them again)."""
     import grounding
 
     boxes = _boxes(scene, margin_px) if scene is not None else []
@@ -174,7 +184,8 @@ def edge_field(frame: RGBD, modality: str, scene: Scene | None = None, margin_px
     fill = _boxes(scene, margin_px, provenance="depth")
     if not fill:
         return colour
-    depth = grounding.normal_edge_field(frame.depth, intr, roi=fill, cap_px=CAP_PX)
+    depth = depth_field if depth_field is not None else \
+        grounding.normal_edge_field(frame.depth, intr, roi=fill, cap_px=CAP_PX)
     near = np.abs(colour)
     return np.where((near <= COLOUR_FIRST_PX) | (near <= np.abs(depth)), colour, depth)
 
@@ -216,14 +227,18 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
 
     k = scene.intrinsics
     intr = (k.fx, k.fy, k.cx, k.cy)
+    # rgbd: depth's field, for the angle facts' second grounding (ANGLE_PREDS) and the rgbd field's depth edges
+    angle_depth = scene.modality == "rgbd" and any(
+        sum(f.plane is not None for f in o.faces) >= 2 for o in scene.objects)
+    depth_field = edge_field(frame, "depth", scene) if angle_depth else None
     if field is None:
-        field = edge_field(frame, scene.modality, scene)
+        field = edge_field(frame, scene.modality, scene, depth_field=depth_field)
     support = None if scene.support_plane is None else _plane_row(scene.support_plane)
     cands: list[tuple[str, tuple[str, ...], float, float | None]] = []
     curved: list[tuple[str, tuple[str, ...], float, float | None]] = []  # measured, no calibration map (yet)
     results: list[ObjectResult] = []
     # pack every object (in chunks of MAX_FACES faces), ground them all in batched calls, then read facts
-    jobs = []
+    jobs, pts_of = [], []  # pts_of: per job, the depth points and adjacency it was packed with
     target = scene.target()
     for oi, obj in enumerate(scene.objects):
         usable = [f for f in obj.faces if len(f.polygon) >= 3]
@@ -244,40 +259,49 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 adjacency=[(pos[a], pos[b]) for a, b in obj.adjacency if a in pos and b in pos],
                 support_plane=support)
             jobs.append((oi, chunk, polys, has_plane, index, prob, refined))
+            pts_of.append((pts, [(pos[a], pos[b]) for a, b in obj.adjacency if a in pos and b in pos]))
     field = jnp.asarray(field, jnp.float32)  # moved to the device once for every object
+    # rgbd: every problem with two planes is grounded a second time against depth's field (ANGLE_PREDS)
     # every program is dispatched before any result is read, then each result is read once
     grounded = [_to_numpy(g) for g in [grounding.ground_object(j[5], field, j[6]) for j in jobs]]
+    angle_grounded = _angle_readings(jobs, grounded, depth_field, pts_of, intr, support) if angle_depth else {}
     for oi, obj in enumerate(scene.objects):
         face_conf: dict[str, float] = {}
         face_results: list[FaceResult] = []
         dihedrals: dict[tuple[str, str], float] = {}
         raw: list[tuple[list[str], dict]] = []
         status = 0
-        for (oj, chunk, polys, has_plane, index, _, _), g in zip(jobs, grounded):
+        for ji, ((oj, chunk, polys, has_plane, index, _, _), g) in enumerate(zip(jobs, grounded)):
             if oj != oi:
                 continue
+            ga, index_a = angle_grounded.get(ji, (g, index))  # what the angle facts read
             raw.append(([f.id for f in chunk], g))
             status = max(status, int(g["status"]))
             # every number a candidate carries, as Python floats in one call per array (indexing numpy
             # scalars one at a time cost more than the rest of this loop)
             c = {k: v.tolist() for k, v in g["conf"].items()}
             tilt_l = g["quantities"]["tilt_deg"].tolist()
-            dih_l = g["quantities"]["dihedral_deg"].tolist()
-            par_l = g["quantities"]["parallel_deg"].tolist()
+            ca = c if ga is g else {k: ga["conf"][k].tolist() for k in ("p_perpendicular", "p_parallel", "p_acute",
+                                                                       "p_obtuse")}
+            dih_l = ga["quantities"]["dihedral_deg"].tolist()
+            par_l = ga["quantities"]["parallel_deg"].tolist()
             corner_l, corner_sd = g["quantities"]["corner_deg"].tolist(), g["std"]["corner_deg"].tolist()
             side_l, side_sd = g["quantities"]["side_px"].tolist(), g["std"]["side_px"].tolist()
             # float32 arithmetic, as on the scalars before
             support_l = np.clip(g["conf"]["edge_support"] / grounding.SUPPORT_FULL, 0.0, 1.0).tolist()
             vstd_all = _largest_std(g["vertex_cov"])
             ns = [len(p) for p in polys]
-            feats = _face_features(g, index, ns, [f.points if hp else None for f, hp in zip(chunk, has_plane)])
+            face_points = [f.points if hp else None for f, hp in zip(chunk, has_plane)]
+            feats = _face_features(g, index, ns, face_points)
+            angle_feats = None if ga is g else _face_features(ga, index_a, ns, face_points)
             for i, f in enumerate(chunk):
                 n = ns[i]
                 ids_i = index[i, :n]
                 reading = read_cylinder(f, intr)
                 face_results.append(FaceResult(f, g["vertices"][ids_i], g["planes"][i] if has_plane[i] else None,
                                                vstd_all[ids_i], feats[i],
-                                               g["plane_std"][i][:2] if has_plane[i] else None, reading))
+                                               g["plane_std"][i][:2] if has_plane[i] else None, reading,
+                                               None if angle_feats is None else angle_feats[i]))
                 support_term = support_l[i]
                 face_conf[f.id] = support_term
                 cands.append(("face_of", (obj.id, f.id), support_term, None))
@@ -309,11 +333,11 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                     dih = dih_l[i][j]
                     dihedrals[(fi.id, fj.id)] = dih
                     args = (fi.id, fj.id)
-                    cands.append(("perpendicular", args, c["p_perpendicular"][i][j], dih))
-                    cands.append(("parallel", args, c["p_parallel"][i][j], par_l[i][j]))
+                    cands.append(("perpendicular", args, ca["p_perpendicular"][i][j], dih))
+                    cands.append(("parallel", args, ca["p_parallel"][i][j], par_l[i][j]))
                     if args in adjacent:
-                        cands.append(("acute", args, c["p_acute"][i][j], dih))
-                        cands.append(("obtuse", args, c["p_obtuse"][i][j], dih))
+                        cands.append(("acute", args, ca["p_acute"][i][j], dih))
+                        cands.append(("obtuse", args, ca["p_obtuse"][i][j], dih))
         for a, b in obj.adjacency:
             if a in face_conf and b in face_conf:
                 p = min(face_conf[a], face_conf[b])  # the shared edge is as real as the weaker face
@@ -336,6 +360,30 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         cands = [(pred, args, calibrate_one(modality, key, p, next(it) if pick else None), value)
                  for (pred, args, p, value), key, pick in zip(cands, keys, picked)]
     return cands + curved, results
+
+
+def _angle_readings(jobs: list, grounded: list[dict], depth_field: np.ndarray, pts_of: list,
+                    intr: tuple[float, float, float, float], support: np.ndarray | None) -> dict[int, tuple[dict, np.ndarray]]:
+    """Depth's reading of an rgbd scene's angles (ANGLE_PREDS): per job of :func:`ground` with two planes or more,
+    (its grounding against ``depth_field``, the problem's map from polygon slots to union vertices). The faces keep
+    the geometry the first grounding gave them (refined polygons and planes, where refined); only their
+    uncertainty and their outlines' measurements are read against depth's edges, so no solver runs again."""
+    import grounding
+    import jax.numpy as jnp
+
+    field = jnp.asarray(depth_field, jnp.float32)
+    todo = {}
+    for ji, ((_, chunk, polys, has_plane, index, prob, refined), g) in enumerate(zip(jobs, grounded)):
+        if sum(has_plane) < 2:
+            continue
+        if refined:  # the refined geometry, packed again (its union vertices as the first grounding merged them)
+            pts, adjacency = pts_of[ji]
+            prob, index = grounding.pack_object(
+                [g["vertices"][index[i, :len(p)]] for i, p in enumerate(polys)], intrinsics=intr,
+                planes=[g["planes"][i] if hp else None for i, hp in enumerate(has_plane)],
+                points=pts, adjacency=adjacency, support_plane=support)
+        todo[ji] = (grounding.ground_object(prob, field, False), index)
+    return {ji: (_to_numpy(g), index) for ji, (g, index) in todo.items()}
 
 
 def curved_evidence(points: np.ndarray, cylinder) -> float | None:
@@ -604,32 +652,39 @@ def _weaker(name: str, values: list[float]) -> float:
 
 def calibration_features(cands: list, results: list[ObjectResult], *, fewer: list[bool] | None = None,
                          shared: dict | None = None) -> list[dict]:
-    """Per candidate the face measurements its calibration may read (:func:`_face_features`); for a fact
-    about two faces, the weaker of each (the smaller value; the larger of ``plane_rms_mm`` and ``edge_scale2``), the length of the side they share
-    (``shared_side_px``, :func:`shared_side_px`) and, where both have planes, how far they are from one plane
+    """Per candidate the face measurements its calibration may read (:func:`_face_features`; for an angle
+    fact of an rgbd scene, those of depth's reading, ``FaceResult.angle_features``); for a fact about two faces,
+    the weaker of each (the smaller value; the larger of ``plane_rms_mm`` and ``edge_scale2``), the length of the
+    side they share (``shared_side_px``, :func:`shared_side_px`) and, where both have planes, how far they are
+    from one plane
     (``plane_gap_mm``, :func:`plane_gap_mm`); for ``object`` the object's best face; and, for a candidate with a
     measured value, that value as ``value``. An (n - 1) side count reads the face's measurements without its weakest
     corner, marked ``is_fewer`` (its calibration key is its own: grounding.calibration_key). ``fewer`` and ``shared``
     as :func:`calibration_keys` takes them."""
     by_face = {fr.face.id: fr.features for res in results for fr in res.faces}
+    # an angle fact reads the measurements of the reading it came from (ANGLE_PREDS: depth's, in an rgbd scene)
+    by_face_angle = {fr.face.id: fr.features if fr.angle_features is None else fr.angle_features
+                     for res in results for fr in res.faces}
     by_result = {fr.face.id: fr for res in results for fr in res.faces}
     by_obj = {res.obj.id: [fr.features for fr in res.faces] for res in results}
     fewer = one_side_fewer(cands, results) if fewer is None else fewer
     shared = {} if shared is None else shared
-    weaker: dict[tuple[str, ...], dict] = {}  # by faces: a pair has up to six facts, each in both orders
+    weaker: dict[tuple, dict] = {}  # by faces: a pair has up to six facts, each in both orders
 
-    def combined(args):
+    def combined(args, angle: bool):
         key = args if len(args) < 2 or args[0] <= args[1] else args[::-1]  # (a, b) and (b, a) share one
-        if key not in weaker:
-            fs = [by_face[a] for a in key if a in by_face]
-            weaker[key] = {k: _weaker(k, [f[k] for f in fs if k in f]) for k in fs[0] if k != "fewer"} if fs else {}
+        if (key, angle) not in weaker:
+            source = by_face_angle if angle else by_face
+            fs = [source[a] for a in key if a in source]
+            f = {k: _weaker(k, [f[k] for f in fs if k in f]) for k in fs[0] if k != "fewer"} if fs else {}
             side = _shared_side(shared, by_result, key)
             if side is not None:
-                weaker[key]["shared_side_px"] = side
+                f["shared_side_px"] = side
                 gap = plane_gap_mm(by_result[key[0]], by_result[key[1]])
                 if gap is not None:
-                    weaker[key]["plane_gap_mm"] = gap
-        return weaker[key]
+                    f["plane_gap_mm"] = gap
+            weaker[(key, angle)] = f
+        return weaker[(key, angle)]
 
     out = []
     for (pred, args, _, value), few in zip(cands, fewer):
@@ -637,7 +692,7 @@ def calibration_features(cands: list, results: list[ObjectResult], *, fewer: lis
             fs = by_obj.get(args[0], [])
             out.append(max(fs, key=lambda f: f["support"]) if fs else {})
         else:
-            f = combined(args)
+            f = combined(args, pred in ANGLE_PREDS)
             if few:  # the (sides - 1) fact reads the polygon without its weakest corner
                 f = {**by_face[args[0]]["fewer"], "is_fewer": 1.0}
             out.append(f if value is None else {**f, "value": value})
