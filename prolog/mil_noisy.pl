@@ -23,7 +23,7 @@
 %   Pos and Neg are l/3 atoms.  Hypotheses from seeded random samples of the examples, each scored
 %   on all of them (score/6, then support/4, literal_cost/3); the best is kept if it is better than
 %   chance on them (J > 0).  Fails when no sample gives a hypothesis that is kept (with
-%   shrink_samples(true), down to the smallest samples: scored_hypotheses/6), or the best is no
+%   shrink_samples(true), down to the smallest samples: scored_hypotheses/4), or the best is no
 %   better than chance.  Each sample's search has an equal share of the time left; a sample that
 %   runs out gives no hypothesis (a mislabelled example can make a sample's search exhaustive), and
 %   only when every sample of the first size runs out is it an error.
@@ -36,7 +36,7 @@ learn_noisy(Ctx, Settings, Pos, Neg, Best, Score) :-
     scoring(Settings, Ctx, SCtx, Ts),
     length(Pos, NP), length(Neg, NN), SP1 is min(SP, NP), SN1 is min(SN, NN),
     Search = search(Ctx, SSettings, SCtx, Lambda-Ts, K, Deadline, T, Pos, Neg),
-    scored_hypotheses(Search, SP1-SN1, SP1-SN1, first, Scored, Round),
+    scored_hypotheses(Search, SP1-SN1, Scored, Round),
     Scored \== [],
     option(disjunctions(KD), Settings),
     disjunctions(SCtx, Lambda-Ts, KD, Pos, Neg, Scored, Pairs0),
@@ -45,46 +45,61 @@ learn_noisy(Ctx, Settings, Pos, Neg, Best, Score) :-
     best_specific(SCtx, Settings, Pos, All, Best, Score),
     Score = score(JBest, _, _, _, _), JBest > 0.
 
-%   The distinct hypotheses of samples of SP positives and SN negatives, each scored on all examples
-%   as Key-(Prog-Score) (keys: J, Soft, support, then literal cost and the order found, which break
-%   ties), and the round that found them (first, or smaller).  Each sample's search has an equal
-%   share of the time left before the deadline.  With shrink_samples(true), where no sample of the
-%   first size (First) gives any hypothesis (each drawn sample held a positive whose facts no small
-%   program shares with the others', or a negative that shares them), samples half the size,
-%   positives rounded up and negatives down, down to one positive and no negative (each positive
-%   alone: the minimal samples of sample consensus, all of them), and the hypotheses every smaller
-%   size gives that are kept (kept/4) compete together: an unlucky draw of a middle size must not
-%   end the search with one positive's idiosyncrasy before the minimal samples are seen.  Only when
-%   every sample of the first size runs out of time is it the time-limit error; a smaller size that
-%   runs out gives nothing.
-scored_hypotheses(Search, First, SP-SN, Round, Scored, Which) :-
-    Search = search(Ctx, Settings, SCtx, LT, K, Deadline, T, Pos, Neg),
+%   The distinct hypotheses of samples of the first size (First = SP-SN: SP positives and SN
+%   negatives), each scored on all examples as Key-(Prog-Score) (keys: J, Soft, support, then
+%   literal cost and the order found, which break ties), and the round that found them (first, or
+%   smaller).  Each sample's search has an equal share of the time left before the deadline.  With
+%   shrink_samples(true), where no sample of the first size gives any hypothesis (each drawn sample
+%   held a positive whose facts no small program shares with the others', or a negative that
+%   shares them), samples half the size, positives rounded up and negatives down, down to one
+%   positive and no negative (each positive alone: the minimal samples of sample consensus, all of
+%   them): the programs of every smaller size, each once in the order found, are scored together and
+%   those kept (kept/4) compete, so an unlucky draw of a middle size cannot end the search with one
+%   positive's idiosyncrasy before the minimal samples are seen.  Only when every sample of the
+%   first size runs out of time is it the time-limit error; a smaller size that runs out gives
+%   nothing.
+scored_hypotheses(Search, First, Scored, Which) :-
+    Search = search(_, Settings, _, _, _, _, _, _, _),
+    sample_programs(Search, First, first, Progs1),
+    scored(Search, Progs1, Scored1a), kept(first, First, Scored1a, Scored1),
+    (   Scored1 \== []
+    ->  Scored-Which = Scored1-first
+    ;   option(shrink_samples(true), Settings)
+    ->  smaller_programs(Search, First, Progs2),
+        scored(Search, Progs2, Scored2), kept(smaller, First, Scored2, Scored), Which = smaller
+    ;   Scored-Which = []-first
+    ).
+
+%   The distinct programs the samples of SP positives and SN negatives give, in the order found.
+sample_programs(Search, SP-SN, Round, Progs) :-
+    Search = search(Ctx, Settings, _, _, K, Deadline, T, Pos, Neg),
     samples(K, SP, SN, Pos, Neg, Drawn),
     length(Drawn, ND), list_to_set(Drawn, Samples), length(Samples, NS),
     get_time(Now), TS is (Deadline - Now) / ND,
     foldl(sample_hypotheses(Ctx, Settings, TS), Samples, r([], 0), r(Found0, TimedOut)),
     (   TimedOut =:= NS, Round == first -> throw(mil_error(time_limit(T))) ; true ),
     append(Found0, Found),
-    list_to_set(Found, Unique),                     % in the order found: it breaks ties
-    findall(Key-(Prog-S), (nth1(Order, Unique, Prog),
+    list_to_set(Found, Progs).
+
+%   The distinct programs of every size smaller than Size (smaller/2) while time is left, in the
+%   order found.
+smaller_programs(Search, Size, Progs) :-
+    Search = search(_, _, _, _, _, Deadline, _, _, _),
+    (   smaller(Size, Smaller), get_time(Now), Now < Deadline
+    ->  sample_programs(Search, Smaller, smaller, Progs1),
+        smaller_programs(Search, Smaller, Progs2),
+        append(Progs1, Progs2, Progs12), list_to_set(Progs12, Progs)
+    ;   Progs = []
+    ).
+
+%   Each program scored on all examples, keyed for selection (the order found breaks ties).
+scored(Search, Progs, Scored) :-
+    Search = search(Ctx, _, SCtx, LT, _, _, _, Pos, Neg),
+    findall(Key-(Prog-S), (nth1(Order, Progs, Prog),
                            score(SCtx, LT, Prog, Pos, Neg, S),
                            S = score(J, Soft, _, _, _), support(Ctx, Prog, Pos, W),
                            literal_cost(Ctx, Prog, Cost), NCost is -Cost, NOrder is -Order,
-                           Key = k(J, Soft, W, NCost, NOrder)), Scored0),
-    kept(Round, First, Scored0, Scored1),
-    (   Round == first, Scored1 \== []
-    ->  Scored-Which = Scored1-first
-    ;   option(shrink_samples(true), Settings),
-        smaller(SP-SN, Smaller), get_time(Then), Then < Deadline
-    ->  scored_hypotheses(Search, First, Smaller, smaller, Scored2, _),
-        foldl(add_new_program, Scored2, Scored1, Scored), Which = smaller
-    ;   Scored-Which = Scored1-Round
-    ).
-
-%   Hs with the scored hypothesis H added after them unless its program is already there.
-add_new_program(H, Hs0, Hs) :-
-    H = _-(Prog-_),
-    (   memberchk(_-(Prog-_), Hs0) -> Hs = Hs0 ; append(Hs0, [H], Hs) ).
+                           Key = k(J, Soft, W, NCost, NOrder)), Scored).
 
 smaller(SP-SN, SP1-SN1) :- ( SP > 1 ; SN > 0 ), SP1 is max(1, (SP + 1) // 2), SN1 is SN // 2.
 
