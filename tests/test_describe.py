@@ -1,5 +1,7 @@
 """describe(): a hand-built Scene and frame -> facts with confidences, per modality."""
 
+import dataclasses
+
 import cv2
 import numpy as np
 import pytest
@@ -304,3 +306,54 @@ def test_a_round_face_keeps_its_polygon_facts_only_as_far_as_it_may_be_a_polygon
     assert POLYGON_PREDS <= set(PREDICATES) and ROUND_PREDS <= set(PREDICATES)
     assert not POLYGON_PREDS & ROUND_PREDS
     assert all(PREDICATES[p][0] == 1 for p in POLYGON_PREDS | ROUND_PREDS)
+
+
+ANGLES = ("perpendicular", "parallel", "acute", "obtuse")
+
+
+def _angle_readings(scene, frame, refine):
+    from lv3d.describe import calibration_features, ground
+
+    cands, results = ground(scene, frame, refine=refine, calibrate=False)
+    angle = [c for c in cands if c[0] in ANGLES]
+    return angle, calibration_features(angle, results), cands, results
+
+
+@pytest.mark.parametrize("refine", [False, True])
+def test_rgbd_reads_the_angle_between_two_planes_as_depth_does_whatever_the_print(refine):
+    # print on the faces (stripes of another colour) moves colour's edges and every outline measurement read
+    # against them; the angle facts of an rgbd scene, and the measurements their calibration reads, are depth's
+    scene, frame = _scene("rgbd", np.random.default_rng(7))
+    plain = _angle_readings(scene, frame, refine)
+    printed = dataclasses.replace(frame, color=frame.color.copy())
+    printed.color[::9] = (250, 250, 250)
+    printed.color[:, ::13] = (0, 0, 0)
+    striped = _angle_readings(scene, printed, refine)
+    assert plain[0] and [c[0] for c in plain[0]] == [c[0] for c in striped[0]]
+    for (_, args, p, value), (_, args2, p2, value2) in zip(plain[0], striped[0]):
+        assert args == args2
+        assert p == pytest.approx(p2, abs=0.02 if refine else 1e-6)
+        assert value == pytest.approx(value2, abs=0.5 if refine else 1e-6)
+    if not refine:  # the geometry is perception's in both: the angle's measurements are the same numbers
+        for f, g in zip(plain[1], striped[1]):
+            assert f.keys() == g.keys() and all(f[k] == pytest.approx(g[k], abs=1e-6) for k in f)
+    # the faces' own facts still read colour: the print moves their outline measurements
+    own = [[fr.features for res in r[3] for fr in res.faces] for r in (plain, striped)]
+    assert any(f[k] != pytest.approx(g[k], rel=1e-3) for f, g in zip(*own) for k in ("edge_scale2", "min_turn_z"))
+    faces = [fr for res in plain[3] for fr in res.faces]
+    assert all(fr.angle_features is not None and fr.angle_features["sides"] == fr.features["sides"] for fr in faces)
+
+
+def test_outside_rgbd_the_angle_facts_read_the_faces_own_measurements():
+    from lv3d.describe import calibration_features, ground
+
+    scene, frame = _scene("depth", np.random.default_rng(8))
+    cands, results = ground(scene, frame, calibrate=False)
+    faces = [fr for res in results for fr in res.faces]
+    assert faces and all(fr.angle_features is None for fr in faces)
+    perp = [c for c in cands if c[0] == "perpendicular"]
+    side = [c for c in cands if c[0] == "face_of"]
+    f_perp, f_side = calibration_features(perp, results), calibration_features(side, results)
+    weakest = min(fr.features["support"] for fr in faces)
+    assert f_perp[0]["support"] == pytest.approx(weakest)
+    assert {f["support"] for f in f_side} == {fr.features["support"] for fr in faces}
