@@ -79,7 +79,7 @@ import numpy as np
 from grounding._calibration import (SHARED_SIDE_PREDS, TOL_FRAC_PREDS, calibrate_with, calibration_key, factors,
                                     inputs, is_slope, logit)
 
-from ..describe import SIDE_NAMES
+from ..describe import ANGLE_PREDS, SIDE_NAMES
 from ..errors import InputError
 from ..facts import PREDICATES
 from ..output import write_atomic
@@ -108,6 +108,11 @@ FINAL_REPEATS = 5    # fold draws the final maps are chosen over (_choose_final)
 # the share of a key's total fit weight its real rows carry where it has rows of both kinds: the two kinds count
 # alike (the maps must hold on both; neither is the other's special case)
 REAL_SHARE = 0.5
+# modalities whose facts about the angle between two planes (lv3d.describe.ANGLE_PREDS; their keys are the
+# predicate or the predicate with a suffix, e.g. perpendicular_touch) are read as another modality reads them:
+# rgbd's are depth's reading (the faces' uncertainty and measurements against depth's edge field), so they take
+# depth's maps and fit none of their own
+READ_AS = {"rgbd": "depth"}
 HOLDOUT_FOLDS = 5    # --holdout: frame-grouped folds over the real frames (each fold ~12 of 59 dev frames)
 SUPPORT_PREDS = ("face_of", "adjacent", "object")  # p is edge support, not a geometric probability: may be ignored
 # facts about two faces whose map may also read the side the faces share (0: none, e.g. pyramid laterals
@@ -378,7 +383,7 @@ def fit(rows: list[dict], modalities, real_share: float = REAL_SHARE, log=print,
     differ in their real rows only)."""
     by = defaultdict(list)
     for r in rows:
-        if r["modality"] in modalities and r["p"] > 0:
+        if r["modality"] in modalities and r["p"] > 0 and not reads_as_other(r):
             by[(r["modality"], row_key(r))].append(r)
     table: dict = {}
     oof = defaultdict(dict)  # per modality, per key: out-of-fold confidences, truth, scenes, weights
@@ -406,7 +411,28 @@ def fit(rows: list[dict], modalities, real_share: float = REAL_SHARE, log=print,
         final[mod], losses = fit_final(oof[mod])
         for pred, ls in losses.items():
             log(f"  {mod:5s} {pred:20s} " + "  ".join(f"{k} {v:.4f}" for k, v in ls.items()) + f"  -> {min(ls, key=ls.get)}")
+    for mod, other in READ_AS.items():  # the keys a modality reads as another does take that one's maps
+        if mod in final and other in final:
+            for key in sorted(k for k in {*table.get(other, {}), *final[other]["by_pred"]} if k.split("_")[0] in ANGLE_PREDS):
+                if key in table.get(other, {}):
+                    table[mod][key] = table[other][key]
+                final[mod]["by_pred"][key] = final_knots(final[other], key)
+                log(f"  {mod:5s} {key:20s} takes {other}'s maps")
     return table, final
+
+
+def reads_as_other(r: dict) -> bool:
+    """Whether the row's fact is read as another modality reads it (``READ_AS``), so that it takes that
+    modality's maps and fits none of its own."""
+    return r["modality"] in READ_AS and r["pred"] in ANGLE_PREDS
+
+
+def final_knots(final: dict, key: str) -> dict | None:
+    """The final map one modality's ``final`` (:func:`fit_final`'s layout) gives ``key``: its own knots, None (no
+    final stage), the per-face pooled knots or the every-key pooled ones."""
+    by_pred = final.get("by_pred", {})
+    knots = by_pred[key] if key in by_pred else {"x": final["x"], "y": final["y"]}
+    return final["faces"] if knots == "faces" else knots
 
 
 # ---------------------------------------------------------------------------------------------- checks
