@@ -413,9 +413,11 @@ def fit(rows: list[dict], modalities, real_share: float = REAL_SHARE, log=print,
             log(f"  {mod:5s} {pred:20s} " + "  ".join(f"{k} {v:.4f}" for k, v in ls.items()) + f"  -> {min(ls, key=ls.get)}")
     for mod, other in READ_AS.items():  # the keys a modality reads as another does take that one's maps
         if mod in final and other in final:
-            for key in sorted(k for k in {*table.get(other, {}), *final[other]["by_pred"]} if k.split("_")[0] in ANGLE_PREDS):
+            for key in sorted(k for k in oof[other] if k.split("_")[0] in ANGLE_PREDS):
                 if key in table.get(other, {}):
-                    table[mod][key] = table[other][key]
+                    table.setdefault(mod, {})[key] = table[other][key]
+                else:  # the other modality keeps the raw probability (then its final map)
+                    table.get(mod, {}).pop(key, None)
                 final[mod]["by_pred"][key] = final_knots(final[other], key)
                 log(f"  {mod:5s} {key:20s} takes {other}'s maps")
     return table, final
