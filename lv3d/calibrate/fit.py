@@ -76,8 +76,8 @@ from pathlib import Path
 
 import numpy as np
 
-from grounding._calibration import (SHARED_SIDE_PREDS, TOL_FRAC_PREDS, calibrate_with, calibration_key, factors,
-                                    inputs, is_slope, logit)
+from grounding._calibration import (SHARED_SIDE_PREDS, TOL_FRAC_PREDS, _final_knots, calibrate_with, calibration_key,
+                                    factors, inputs, is_slope, logit)
 
 from ..describe import ANGLE_PREDS, SIDE_NAMES
 from ..errors import InputError
@@ -413,7 +413,8 @@ def fit(rows: list[dict], modalities, real_share: float = REAL_SHARE, log=print,
             log(f"  {mod:5s} {pred:20s} " + "  ".join(f"{k} {v:.4f}" for k, v in ls.items()) + f"  -> {min(ls, key=ls.get)}")
     for mod, other in READ_AS.items():  # the keys a modality reads as another does take that one's maps
         if mod in final and other in final:
-            for key in sorted(k for k in oof[other] if k.split("_")[0] in ANGLE_PREDS):
+            angle_keys = {k for (m, k), rs in by.items() if m == other and rs[0]["pred"] in ANGLE_PREDS}
+            for key in sorted(angle_keys):
                 if key in table.get(other, {}):
                     table.setdefault(mod, {})[key] = table[other][key]
                 else:  # the other modality keeps the raw probability (then its final map)
@@ -430,11 +431,11 @@ def reads_as_other(r: dict) -> bool:
 
 
 def final_knots(final: dict, key: str) -> dict | None:
-    """The final map one modality's ``final`` (:func:`fit_final`'s layout) gives ``key``: its own knots, None (no
-    final stage), the per-face pooled knots or the every-key pooled ones."""
-    by_pred = final.get("by_pred", {})
-    knots = by_pred[key] if key in by_pred else {"x": final["x"], "y": final["y"]}
-    return final["faces"] if knots == "faces" else knots
+    """The final map one modality's ``final`` (:func:`fit_final`'s layout) gives ``key``, as grounding reads it
+    (its own knots, None for no final stage, or the per-face pooled knots), the every-key pooled map as its knots
+    alone."""
+    knots = _final_knots(key, final)
+    return {"x": final["x"], "y": final["y"]} if knots is final else knots
 
 
 # ---------------------------------------------------------------------------------------------- checks
