@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, field as dc_field
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -76,6 +77,20 @@ class ObjectResult:
     status: int
     # per padded problem: (face ids in slot order, grounding result as nested dicts of numpy arrays)
     raw: list[tuple[list[str], dict]]
+
+
+class _Job(NamedTuple):
+    """One padded grounding problem of :func:`ground`: up to MAX_FACES faces of one object."""
+
+    oi: int                                    # the object's index in the scene
+    chunk: list[Face]                          # its faces, in slot order
+    polys: list[np.ndarray]                    # their polygons as packed (at most MAX_SIDES vertices)
+    has_plane: list[bool]                      # which faces carry a plane with 3 points or more
+    index: np.ndarray                          # polygon slot -> union vertex (grounding.pack_object)
+    prob: object                               # the packed problem
+    refined: bool                              # whether the solver refines its geometry
+    points: list[np.ndarray | None]            # each face's depth points, as packed
+    adjacency: list[tuple[int, int]]           # touching faces, as slot pairs
 
 
 def _simplify(poly: np.ndarray, max_sides: int) -> np.ndarray:
@@ -227,18 +242,12 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
 
     k = scene.intrinsics
     intr = (k.fx, k.fy, k.cx, k.cy)
-    # rgbd: depth's field, for the angle facts' second grounding (ANGLE_PREDS) and the rgbd field's depth edges
-    angle_depth = scene.modality == "rgbd" and any(
-        sum(f.plane is not None for f in o.faces) >= 2 for o in scene.objects)
-    depth_field = edge_field(frame, "depth", scene) if angle_depth else None
-    if field is None:
-        field = edge_field(frame, scene.modality, scene, depth_field=depth_field)
     support = None if scene.support_plane is None else _plane_row(scene.support_plane)
     cands: list[tuple[str, tuple[str, ...], float, float | None]] = []
     curved: list[tuple[str, tuple[str, ...], float, float | None]] = []  # measured, no calibration map (yet)
     results: list[ObjectResult] = []
     # pack every object (in chunks of MAX_FACES faces), ground them all in batched calls, then read facts
-    jobs, pts_of = [], []  # pts_of: per job, the depth points and adjacency it was packed with
+    jobs: list[_Job] = []
     target = scene.target()
     for oi, obj in enumerate(scene.objects):
         usable = [f for f in obj.faces if len(f.polygon) >= 3]
@@ -252,28 +261,33 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
             pts = [f.points if hp else None for f, hp in zip(chunk, has_plane)]
             if refined and dense_points:  # only a refined plane moves, so only it needs the full-resolution points
                 pts = [p if p is None else _first(dense_face_points(f, frame), p) for f, p in zip(chunk, pts)]
+            adjacency = [(pos[a], pos[b]) for a, b in obj.adjacency if a in pos and b in pos]
             prob, index = grounding.pack_object(
                 polys, intrinsics=intr,
                 planes=[_plane_row(f.plane) if hp else None for f, hp in zip(chunk, has_plane)],
-                points=pts,
-                adjacency=[(pos[a], pos[b]) for a, b in obj.adjacency if a in pos and b in pos],
-                support_plane=support)
-            jobs.append((oi, chunk, polys, has_plane, index, prob, refined))
-            pts_of.append((pts, [(pos[a], pos[b]) for a, b in obj.adjacency if a in pos and b in pos]))
+                points=pts, adjacency=adjacency, support_plane=support)
+            jobs.append(_Job(oi, chunk, polys, has_plane, index, prob, refined, pts, adjacency))
+    # rgbd: depth's field, for the angle facts' second grounding of every problem with two planes or more
+    # (ANGLE_PREDS, _angle_readings) and for the depth edges of the rgbd field
+    angle_depth = scene.modality == "rgbd" and any(sum(j.has_plane) >= 2 for j in jobs)
+    depth_field = edge_field(frame, "depth", scene) if angle_depth else None
+    if field is None:
+        field = edge_field(frame, scene.modality, scene, depth_field=depth_field)
     field = jnp.asarray(field, jnp.float32)  # moved to the device once for every object
-    # rgbd: every problem with two planes is grounded a second time against depth's field (ANGLE_PREDS)
-    # every program is dispatched before any result is read, then each result is read once
-    grounded = [_to_numpy(g) for g in [grounding.ground_object(j[5], field, j[6]) for j in jobs]]
-    angle_grounded = _angle_readings(jobs, grounded, depth_field, pts_of, intr, support) if angle_depth else {}
+    # every problem is dispatched before any result is read, then each result is read once; the angle readings
+    # go after, as they start from the first grounding's refined geometry
+    grounded = [_to_numpy(g) for g in [grounding.ground_object(j.prob, field, j.refined) for j in jobs]]
+    angle_grounded = _angle_readings(jobs, grounded, depth_field, intr, support) if angle_depth else {}
     for oi, obj in enumerate(scene.objects):
         face_conf: dict[str, float] = {}
         face_results: list[FaceResult] = []
         dihedrals: dict[tuple[str, str], float] = {}
         raw: list[tuple[list[str], dict]] = []
         status = 0
-        for ji, ((oj, chunk, polys, has_plane, index, _, _), g) in enumerate(zip(jobs, grounded)):
-            if oj != oi:
+        for ji, (job, g) in enumerate(zip(jobs, grounded)):
+            if job.oi != oi:
                 continue
+            chunk, polys, has_plane, index = job.chunk, job.polys, job.has_plane, job.index
             ga, index_a = angle_grounded.get(ji, (g, index))  # what the angle facts read
             raw.append(([f.id for f in chunk], g))
             status = max(status, int(g["status"]))
@@ -362,7 +376,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     return cands + curved, results
 
 
-def _angle_readings(jobs: list, grounded: list[dict], depth_field: np.ndarray, pts_of: list,
+def _angle_readings(jobs: list[_Job], grounded: list[dict], depth_field: np.ndarray,
                     intr: tuple[float, float, float, float], support: np.ndarray | None) -> dict[int, tuple[dict, np.ndarray]]:
     """Depth's reading of an rgbd scene's angles (ANGLE_PREDS): per job of :func:`ground` with two planes or more,
     (its grounding against ``depth_field``, the problem's map from polygon slots to union vertices). The faces keep
@@ -373,15 +387,15 @@ def _angle_readings(jobs: list, grounded: list[dict], depth_field: np.ndarray, p
 
     field = jnp.asarray(depth_field, jnp.float32)
     todo = {}
-    for ji, ((_, chunk, polys, has_plane, index, prob, refined), g) in enumerate(zip(jobs, grounded)):
-        if sum(has_plane) < 2:
+    for ji, (job, g) in enumerate(zip(jobs, grounded)):
+        if sum(job.has_plane) < 2:
             continue
-        if refined:  # the refined geometry, packed again (its union vertices as the first grounding merged them)
-            pts, adjacency = pts_of[ji]
+        prob, index = job.prob, job.index
+        if job.refined:  # the refined geometry, packed again (its union vertices as the first grounding merged them)
             prob, index = grounding.pack_object(
-                [g["vertices"][index[i, :len(p)]] for i, p in enumerate(polys)], intrinsics=intr,
-                planes=[g["planes"][i] if hp else None for i, hp in enumerate(has_plane)],
-                points=pts, adjacency=adjacency, support_plane=support)
+                [g["vertices"][index[i, :len(p)]] for i, p in enumerate(job.polys)], intrinsics=intr,
+                planes=[g["planes"][i] if hp else None for i, hp in enumerate(job.has_plane)],
+                points=job.points, adjacency=job.adjacency, support_plane=support)
         todo[ji] = (grounding.ground_object(prob, field, False), index)
     return {ji: (_to_numpy(g), index) for ji, (g, index) in todo.items()}
 
@@ -656,11 +670,10 @@ def calibration_features(cands: list, results: list[ObjectResult], *, fewer: lis
     fact of an rgbd scene, those of depth's reading, ``FaceResult.angle_features``); for a fact about two faces,
     the weaker of each (the smaller value; the larger of ``plane_rms_mm`` and ``edge_scale2``), the length of the
     side they share (``shared_side_px``, :func:`shared_side_px`) and, where both have planes, how far they are
-    from one plane
-    (``plane_gap_mm``, :func:`plane_gap_mm`); for ``object`` the object's best face; and, for a candidate with a
-    measured value, that value as ``value``. An (n - 1) side count reads the face's measurements without its weakest
-    corner, marked ``is_fewer`` (its calibration key is its own: grounding.calibration_key). ``fewer`` and ``shared``
-    as :func:`calibration_keys` takes them."""
+    from one plane (``plane_gap_mm``, :func:`plane_gap_mm`); for ``object`` the object's best face; and, for a
+    candidate with a measured value, that value as ``value``. An (n - 1) side count reads the face's measurements
+    without its weakest corner, marked ``is_fewer`` (its calibration key is its own: grounding.calibration_key).
+    ``fewer`` and ``shared`` as :func:`calibration_keys` takes them."""
     by_face = {fr.face.id: fr.features for res in results for fr in res.faces}
     # an angle fact reads the measurements of the reading it came from (ANGLE_PREDS: depth's, in an rgbd scene)
     by_face_angle = {fr.face.id: fr.features if fr.angle_features is None else fr.angle_features

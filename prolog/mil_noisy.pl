@@ -61,7 +61,7 @@ learn_noisy(Ctx, Settings, Pos, Neg, Best, Score) :-
 scored_hypotheses(Search, First, Scored, Which) :-
     Search = search(_, Settings, _, _, _, _, _, _, _),
     sample_programs(Search, First, first, Progs1),
-    scored(Search, Progs1, Scored1a), kept(first, First, Scored1a, Scored1),
+    scored(Search, Progs1, Scored1),
     (   Scored1 \== []
     ->  Scored-Which = Scored1-first
     ;   option(shrink_samples(true), Settings)
