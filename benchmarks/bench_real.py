@@ -6,6 +6,7 @@
     .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --seed 0,1,2     # pooled over perception seeds
     .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --set stride=2   # depth settings other than the defaults
     .venv/bin/python -m benchmarks.bench_real --objects out/objects.csv               # and a row per labelled object
+    .venv/bin/python -m benchmarks.bench_real --frames out/frames.csv                 # and a row per frame: its ms by stage
     .venv/bin/python -m benchmarks.bench_real --modalities rgbd --profile out/real.prof  # where the time goes
 
 A folder is in the real layout of ../shared/data/real/README.md: ``<frame>_rgb.*`` and ``<frame>_depth*`` images,
@@ -120,6 +121,11 @@ empty where the figure does not count it, e.g. ``box_perpendicular`` for a parti
 verdicts' yes over yes + no, summed over rows; the objects a figure misses on are its rows with the verdict its
 target does not want (no for ``box_perpendicular`` and ``cylinder_read``, yes for ``box_overfaced``, ``as_prism``
 and ``box_curved``).
+
+``--frames FILE`` writes where the time goes, frame by frame: one CSV row per frame, folder, modality and seed,
+with the objects perceived and labelled, the frame's ms and CPU ms (as the figures time them), the compilation
+taken off, and the ms of each stage (``stages_ms`` of the rows the stage medians come from): which frames are slow,
+and in which stage.
 
 ``--profile FILE`` runs the timed frames under cProfile, prints the lv3d and grounding functions that take the
 most time per frame (cumulative and own ms, calls) and writes the statistics to FILE (``python -m pstats FILE``,
@@ -517,6 +523,25 @@ OBJECT_COLUMNS = ("folder", "frame", "object", "shape", "partial", "stacked", "m
                   "cylinder_elliptical", "box_elliptical")
 
 
+# --frames: one row per frame, folder, modality and seed (then a column per stage, in STAGE_ORDER)
+FRAME_COLUMNS = ("folder", "frame", "modality", "seed", "perceived", "labelled", "ms", "cpu_ms", "compile_ms")
+STAGE_ORDER = ("cloud", "support", "objects", "planes", "boundary", "edges", "fuse", "grounding")
+
+
+def write_frames(path: Path, records: list[dict]) -> None:
+    """The per-frame timings as CSV: ``FRAME_COLUMNS``, then the ms of each stage (``STAGE_ORDER`` first, any
+    other stage a frame reports after them, by name; empty where a modality has no such stage), to 0.1 ms."""
+    seen = {k for r in records for k in r["stages_ms"]}
+    stages = [k for k in STAGE_ORDER if k in seen] + sorted(seen - set(STAGE_ORDER))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow([*FRAME_COLUMNS, *(f"{k}_ms" for k in stages)])
+        for r in records:
+            w.writerow([*(f"{r[k]:.1f}" if isinstance(r[k], float) else r[k] for k in FRAME_COLUMNS),
+                        *("" if k not in r["stages_ms"] else f"{r['stages_ms'][k]:.1f}" for k in stages)])
+
+
 def write_objects(path: Path, records: list[dict]) -> None:
     """The per-object records as CSV (``OBJECT_COLUMNS``): booleans as yes/no, confidences and IoU to 3 decimals,
     empty where a record has no value (the figure does not count the object, or nothing was found)."""
@@ -751,7 +776,8 @@ def run_folder(folder: Path, modalities: list[str], limit: int | None, rows: dic
                 cpu_ms = 1e3 * (time.process_time() - c) - jit_ms
                 stages = {**scene.timings_ms, "grounding": 1e3 * (time.perf_counter() - t_ground) - jit_ms}
                 row = dict(evaluate_frame(scene, facts, frame, labels.get(name, []), label_img), ms=ms,
-                           cpu_ms=cpu_ms, compile_ms=jit_ms, stages_ms=stages, frame=name, seed=seed)
+                           cpu_ms=cpu_ms, compile_ms=jit_ms, stages_ms=stages, frame=name, seed=seed,
+                           perceived=len(scene.objects))
                 mine[m].append(row)
                 rows[m].append(row)
                 if overlays is not None and seed == seeds[0]:
@@ -816,6 +842,9 @@ def main(argv=None) -> int:
     ap.add_argument("--objects", type=Path, metavar="FILE",
                     help="also write one CSV row per labelled object, folder, modality and seed: what perception "
                          "made of it and the verdict of every figure that counts it (OBJECT_COLUMNS)")
+    ap.add_argument("--frames", type=Path, metavar="FILE",
+                    help="also write one CSV row per frame, folder, modality and seed: objects perceived and "
+                         "labelled, ms, CPU ms and the ms of each stage (FRAME_COLUMNS, then STAGE_ORDER)")
     ap.add_argument("--profile", type=Path, metavar="FILE",
                     help="also run every timed frame under cProfile: print the lv3d and grounding functions with the "
                          "most time per frame and write the statistics to FILE (python -m pstats FILE); the ms "
@@ -839,7 +868,8 @@ def main(argv=None) -> int:
     if args.overlays is not None and args.overlays.exists() and not args.overlays.is_dir():
         print(f"bench_real.py: error: {args.overlays}: is a file; --overlays names a folder", file=sys.stderr)
         return 2
-    for opt, path in (("--json", args.json), ("--objects", args.objects), ("--profile", args.profile)):
+    for opt, path in (("--json", args.json), ("--objects", args.objects), ("--frames", args.frames),
+                      ("--profile", args.profile)):
         if path is not None and path.is_dir():
             print(f"bench_real.py: error: {path}: is a folder; {opt} names a file", file=sys.stderr)
             return 2
@@ -852,6 +882,7 @@ def main(argv=None) -> int:
     pooled_rows: dict[str, list[dict]] = {m: [] for m in mods}
     result: dict = {"pooled": {}, "folders": {}}
     records: list[dict] = []
+    frame_records: list[dict] = []
     pixels = "a perceived object's pixels: its segment (depth, rgbd), else the union of its faces' polygons (rgb)"
     seeds_text = "" if len(args.seed) == 1 else \
         f", each frame perceived once per seed {','.join(map(str, args.seed))} (counts pooled)"
@@ -868,6 +899,7 @@ def main(argv=None) -> int:
         if args.objects is not None:
             records += [{"folder": name, "modality": m, "seed": r["seed"], **rec}
                         for m in mods for r in mine[m] for rec in r["objects"]]
+        frame_records += [{"folder": name, "modality": m, **r} for m in mods for r in mine[m]]
         figures = {m: summarise(mine[m], m) for m in mods}
         result["folders"][name] = {m: {**{k: figures[m][k] for k in KEYS + EXTRA_KEYS},
                                        STAGES: figures[m].get(STAGES)} for m in mods}
@@ -894,6 +926,8 @@ def main(argv=None) -> int:
         args.json.write_text(json.dumps(result, indent=1) + "\n")
     if args.objects is not None:
         write_objects(args.objects, records)
+    if args.frames is not None:
+        write_frames(args.frames, frame_records)
     if profiler is not None:
         args.profile.parent.mkdir(parents=True, exist_ok=True)
         profiler.dump_stats(args.profile)

@@ -280,13 +280,21 @@ def test_the_seed_reaches_perception_and_a_negative_one_stops_at_the_command_lin
         assert e.value.code == 2 and "--seed" in capsys.readouterr().err
 
 
-def test_objects_names_a_file_not_a_folder(tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize("opt", ["--objects", "--frames"])
+def test_a_csv_option_names_a_file_not_a_folder(tmp_path, capsys, monkeypatch, opt):
     _stub_folders(monkeypatch)
-    assert bench.main([str(tmp_path), "--modalities", "depth", "--objects", str(tmp_path)]) == 2
-    assert "--objects names a file" in capsys.readouterr().err
+    assert bench.main([str(tmp_path), "--modalities", "depth", opt, str(tmp_path)]) == 2
+    assert f"{opt} names a file" in capsys.readouterr().err
+
+
+def test_a_run_of_no_frame_writes_the_headers_alone(tmp_path, monkeypatch):
+    _stub_folders(monkeypatch)
     out = tmp_path / "o.csv"
     assert bench.main([str(tmp_path), "--modalities", "depth", "--objects", str(out)]) == 0
     assert out.read_text().splitlines() == [",".join(bench.OBJECT_COLUMNS)]  # no frame, no object
+    frames = tmp_path / "f.csv"
+    assert bench.main([str(tmp_path), "--modalities", "depth", "--frames", str(frames)]) == 0
+    assert frames.read_text().splitlines() == [",".join(bench.FRAME_COLUMNS)]
 
 
 def test_depth_settings_reach_perception_and_a_wrong_one_is_named(tmp_path, capsys, monkeypatch):
@@ -313,9 +321,9 @@ def test_one_osd_frame_end_to_end_writes_every_figure(tmp_path, capsys):
     osd = OSD
     if not (osd / "objects.csv").is_file():
         pytest.skip(f"real OSD frames not found at {osd} (../shared/data/real/osd-learn)")
-    out, objects = tmp_path / "bench.json", tmp_path / "objects.csv"
+    out, objects, frames = tmp_path / "bench.json", tmp_path / "objects.csv", tmp_path / "frames.csv"
     assert bench.main([str(osd), "--limit", "1", "--modalities", "depth", "--json", str(out),
-                       "--objects", str(objects)]) == 0
+                       "--objects", str(objects), "--frames", str(frames)]) == 0
     d = json.loads(out.read_text())
     keys = set(bench.KEYS) | set(bench.EXTRA_KEYS) | {bench.STAGES}
     assert set(d) == {"pooled", "folders"} and set(d["folders"]) == {"osd-learn"}
@@ -335,6 +343,13 @@ def test_one_osd_frame_end_to_end_writes_every_figure(tmp_path, capsys):
     perp = [r["box_perpendicular"] for r in rows if r["box_perpendicular"]]
     assert fig["box_perpendicular_frac"] == pytest.approx(perp.count("yes") / len(perp))
     assert fig["labelled_found"] == pytest.approx([r["found"] for r in rows].count("yes") / len(rows))
+    # one row per frame: its ms, whose median is the figure's, and each stage's
+    (row,) = list(csv.DictReader(frames.open()))
+    assert (row["folder"], row["frame"], row["modality"], row["seed"]) == ("osd-learn", first, "depth", "0")
+    assert int(row["labelled"]) == len(labelled) and int(row["perceived"]) >= 1
+    assert float(row["ms"]) == pytest.approx(fig["ms_median"], abs=0.05)
+    assert float(row["objects_ms"]) == pytest.approx(fig[bench.STAGES]["objects"], abs=0.05)
+    assert "fuse_ms" not in row  # a stage no frame of the run has (depth: no colour fusion) has no column
 
 
 def test_objects_csv_naming_a_missing_frame_stops_before_any_work(tmp_path, capsys):
