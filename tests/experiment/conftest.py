@@ -1,5 +1,6 @@
 """Tiny studies on a synthetic data set and a fake learner, so that the runner is tested on its own."""
 
+import csv
 import importlib.util
 import json
 import sys
@@ -159,3 +160,19 @@ def load_script():
         return mod
 
     return load
+
+
+@pytest.fixture(scope="session")
+def write_results():
+    """Writes a study's results.csv at a path from (condition, system, fold, task, accuracy) rows: the columns the
+    scripts reading reports need."""
+
+    def write(path: Path, rows) -> Path:
+        with path.open("w", newline="") as f:
+            w = csv.DictWriter(f, ["condition", "system", "fold", "task", "accuracy"])
+            w.writeheader()
+            for cond, system, fold, task, acc in rows:
+                w.writerow({"condition": cond, "system": system, "fold": fold, "task": task, "accuracy": acc})
+        return path
+
+    return write

@@ -1,7 +1,5 @@
 """scripts/pooled_replicates.py: paired differences pooled over replicate runs of one study."""
 
-import csv
-
 import pytest
 
 
@@ -10,17 +8,12 @@ def pooled(load_script):
     return load_script("pooled_replicates")
 
 
-def _results(folder, rows):
-    folder.mkdir()
-    with (folder / "results.csv").open("w", newline="") as f:
-        w = csv.DictWriter(f, ["condition", "system", "fold", "task", "accuracy"])
-        w.writeheader()
-        for cond, system, fold, task, acc in rows:
-            w.writerow({"condition": cond, "system": system, "fold": fold, "task": task, "accuracy": acc})
-    return folder
+def test_cells_of_every_run_are_pooled_per_condition(tmp_path, pooled, capsys, write_results):
+    def _results(folder, rows):
+        folder.mkdir()
+        write_results(folder / "results.csv", rows)
+        return folder
 
-
-def test_cells_of_every_run_are_pooled_per_condition(tmp_path, pooled, capsys):
     one = _results(tmp_path / "one", [("c", "lv3d-rgbd", 0, "cube", 1.0), ("c", "lv3d-depth", 0, "cube", 0.975),
                                       ("c", "lv3d-rgbd", 0, "multiclass", 0.1), ("c", "lv3d-depth", 0, "multiclass", 0.9)])
     two = _results(tmp_path / "two", [("c", "lv3d-rgbd", 0, "cube", 0.95), ("c", "lv3d-depth", 0, "cube", 0.925),
