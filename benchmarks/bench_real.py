@@ -899,7 +899,8 @@ def main(argv=None) -> int:
         if args.objects is not None:
             records += [{"folder": name, "modality": m, "seed": r["seed"], **rec}
                         for m in mods for r in mine[m] for rec in r["objects"]]
-        frame_records += [{"folder": name, "modality": m, **r} for m in mods for r in mine[m]]
+        if args.frames is not None:
+            frame_records += [{"folder": name, "modality": m, **r} for m in mods for r in mine[m]]
         figures = {m: summarise(mine[m], m) for m in mods}
         result["folders"][name] = {m: {**{k: figures[m][k] for k in KEYS + EXTRA_KEYS},
                                        STAGES: figures[m].get(STAGES)} for m in mods}

@@ -5,12 +5,12 @@ class without it (or with no perceived object under its pixel), or an object of 
 resting on that evidence answers all of those wrong, whatever the learner does; the rest are the learner's own
 (a program that rests on other facts, or none).
 
-    .venv/bin/python scripts/real_errors.py runs/real_objects runs/real_cache \\
-        --evidence cylinder=cylindrical,box=perpendicular
+    .venv/bin/python scripts/real_errors.py runs/real_objects --evidence cylinder=cylindrical,box=perpendicular
 
-RUN_DIR is the study's --out (its folds/<condition>/<system>/fold<k>.json); CACHE its data.cache, where the facts
-of every frame are (facts/real-*/<facts version>/<modality>-refine1/<frame>.json, one folder per version of the
-code that made them: --facts-version picks one where there are several).
+RUN_DIR is the study's --out: its config.yaml (the frames' folders and classes, data.cache, lv3d.refine and
+lv3d.perception_seed) and its fold files (folds/<condition>/<system>/fold<k>.json). Each example's facts are read
+as the study reads them (lv3d.experiment.real_data: ensure_frame_facts, example_facts_of), from the cache of this
+checkout's facts version; facts the cache lacks are computed.
 """
 
 from __future__ import annotations
@@ -34,50 +34,31 @@ def _evidence(arg: str) -> dict[str, str]:
     return out
 
 
-def facts_folder(cache: Path, modality: str, version: str | None) -> Path:
-    """The folder of one modality's cached facts (refined) in ``cache``, of ``version`` where given."""
-    found = sorted(p for p in cache.glob(f"facts/real-*/*/{modality}-refine1") if version in (None, p.parent.name))
-    if not found:
-        raise SystemExit(f"{cache}: no cached {modality} facts of real frames"
-                         + (f" made by version {version}" if version else ""))
-    if len(found) > 1:
-        raise SystemExit(f"{cache}: cached {modality} facts of several versions ("
-                         + ", ".join(p.parent.name for p in found) + "): name one with --facts-version")
-    return found[0]
+def example_evidence(run: Path, modality: str, preds: set[str]) -> dict[str, set[str]]:
+    """Per example id of the study in ``run``, which of ``preds`` hold on a face of the perceived object under its
+    labelled pixel at confidence >= EVIDENCE_CONF (none where no object lies there), in ``modality``'s facts."""
+    from lv3d.experiment.code_version import facts_version
+    from lv3d.experiment.config import load_study
+    from lv3d.experiment.real_data import ensure_frame_facts, example_facts_of, real_data
 
-
-def object_evidence(folder: Path, preds: set[str]) -> dict[str, dict[str, bool] | None]:
-    """Per example id (``<frame>_x<object>``), which of ``preds`` hold on a face of the perceived object under its
-    labelled pixel at confidence >= EVIDENCE_CONF; None where no object lies there."""
-    out: dict[str, dict[str, bool] | None] = {}
-    for path in sorted(folder.glob("*.json")):
-        d = json.loads(path.read_text())
-        facts = (d.get("facts") or {}).get("facts", [])
-        faces = defaultdict(set)
-        best: dict[tuple[str, str], float] = {}
-        for f in facts:
-            if f["pred"] == "face_of":
-                faces[f["args"][0]].add(f["args"][1])
-            elif f["pred"] in preds:
-                key = (f["pred"], f["args"][0])
-                best[key] = max(best.get(key, 0.0), f["conf"])
-        for label, obj in (d.get("under") or {}).items():
-            out[f"{d['frame']}_x{label}"] = None if obj is None else {
-                p: any(best.get((p, face), 0.0) >= EVIDENCE_CONF for face in faces[obj]) for p in preds}
-    return out
+    cfg = load_study(run / "config.yaml").base
+    rd = real_data(cfg.data.folders, cfg.data.classes)
+    root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else run / "facts"  # as the study's
+    frames = ensure_frame_facts(rd, root, facts_version(), modality, cfg.lv3d.refine, seed=cfg.lv3d.perception_seed)
+    facts, _ = example_facts_of(rd, frames)
+    return {i: {f.pred for f in sf.facts if f.pred in preds and f.conf >= EVIDENCE_CONF} for i, sf in facts.items()}
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("run", type=Path, help="the study's --out folder")
-    ap.add_argument("cache", type=Path, help="the study's data.cache folder")
     ap.add_argument("--evidence", type=_evidence, required=True, metavar="CLASS=PRED,...",
                     help="the predicate each class task's evidence is, e.g. cylinder=cylindrical,box=perpendicular")
-    ap.add_argument("--facts-version", help="the version folder of the cached facts, where there are several")
     args = ap.parse_args(argv)
     folds = sorted(args.run.glob("folds/*/lv3d-*/fold*.json"))
-    if not folds:
-        raise SystemExit(f"{args.run}: no lv3d fold files (folds/<condition>/lv3d-*/fold<k>.json)")
+    if not folds or not (args.run / "config.yaml").is_file():
+        raise SystemExit(f"{args.run}: not a study's --out folder with lv3d fold files "
+                         "(config.yaml, folds/<condition>/lv3d-*/fold<k>.json)")
     evidence_of: dict[str, dict] = {}
     counts: dict[tuple[str, str, str], Counter] = defaultdict(Counter)
     for path in folds:
@@ -85,15 +66,13 @@ def main(argv: list[str] | None = None) -> int:
         system = fold["system"]
         modality = system.split("-", 1)[1]
         if modality not in evidence_of:
-            evidence_of[modality] = object_evidence(facts_folder(args.cache, modality, args.facts_version),
-                                                    set(args.evidence.values()))
+            evidence_of[modality] = example_evidence(args.run, modality, set(args.evidence.values()))
         ev = evidence_of[modality]
         truth = dict(zip(fold["test_ids"], fold["test_classes"]))
         for cls, pred in args.evidence.items():
             for draw in fold["predictions"].get(cls, []):
                 for example, answer, _ in draw:
-                    has = ev.get(example)
-                    holds = bool(has and has[pred])
+                    holds = pred in ev.get(example, ())
                     positive = truth[example] == cls
                     contradicts = not holds if positive else holds
                     wrong = (answer == cls) != positive
