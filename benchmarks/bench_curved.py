@@ -59,6 +59,7 @@ from lv3d.describe import curved_evidence, describe, read_cylinder
 from lv3d.perception import perceive
 from lv3d.perception.depth.quadrics import cone_evidence, sphere_evidence
 from lv3d.render import render_scene
+from benchmarks.targets import mark, meets
 
 CURVED = ["cylinder", "cone", "sphere"]
 BOXES = ["cube", "cuboid"]
@@ -202,8 +203,7 @@ def _target(preset: str, key: str, value: float) -> str:
     if preset not in TARGETS or key not in TARGETS[preset]:
         return "-"
     op, t = TARGETS[preset][key]
-    ok = value >= t if op == ">=" else value <= t
-    return f"{op} {t} {'ok' if ok else 'MISS'}"
+    return f"{op} {t} {mark(meets(op, t, value))}"
 
 
 def main(argv=None) -> int:
@@ -263,12 +263,12 @@ def main(argv=None) -> int:
             print(f"{'missed (class:seed)':22} {' '.join(missed) or '-'}")
             print(f"{'boxes with curved':22} {' '.join(curved_boxes) or '-'}")
             print(f"{'unconverged fits':22} {a['unconverged']:7d}   -")
-            print(f"{'nan parameters':22} {a['nan']:7d}   = 0 {'ok' if a['nan'] == 0 else 'MISS'}")
+            print(f"{'nan parameters':22} {a['nan']:7d}   = 0 {mark(a['nan'] == 0)}")
             print(f"{'ms per frame, median':22} {np.median(ms[m]):7.0f}   -")
             if m == "rgb":
                 print(f"{'elliptical (target / any object), confidence >= 0.5':52}   target")
                 for c in classes:
-                    goal = "-" if c in CURVED else "0 " + ("ok" if s[c]["elliptical"] == 0 else "MISS")
+                    goal = "-" if c in CURVED else "0 " + mark(s[c]["elliptical"] == 0)
                     print(f"  {c:20} {s[c]['elliptical']:7.3f} {s[c]['elliptical_any']:7.3f}   {goal}")
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)

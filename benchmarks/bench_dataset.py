@@ -20,6 +20,7 @@ from pathlib import Path
 from lv3d.render import CLASSES, make_dataset, render_scene
 from lv3d.render import dataset as ds_mod
 from lv3d.render import frame as frame_mod
+from benchmarks.targets import mark
 
 TARGET_IMAGES_PER_S = 20.0
 TARGET_CPU_MS = 100.0  # 2 cores * 1000 ms / 20 images
@@ -98,11 +99,11 @@ def main() -> None:
     total = (cpu + acc["write files"]) / m
     print(f"  {'render_scene total':<24} {1000 * cpu / m:7.1f}   (wall {1000 * wall1 / m:.0f} ms)")
     print(f"  {'render + files':<24} {1000 * total:7.1f}   (target <= {TARGET_CPU_MS:.0f} ms CPU per image) "
-          f"{'MET' if 1000 * total <= TARGET_CPU_MS else 'NOT MET'}")
+          f"{mark(1000 * total <= TARGET_CPU_MS)}")
     rate = n / wall
     print(f"make_dataset realsense {args.width}x{args.height}, {n} images, {args.workers} workers: "
           f"{wall:.2f} s wall, {rate:.1f} images/s (target >= {TARGET_IMAGES_PER_S:.0f} images/s on 2 cores) "
-          f"{'MET' if rate >= TARGET_IMAGES_PER_S else 'NOT MET'}; on a shared machine wall time is pessimistic: "
+          f"{mark(rate >= TARGET_IMAGES_PER_S)}; on a shared machine wall time is pessimistic: "
           f"CPU-bound estimate for 2 free cores {2000 / (1000 * total):.1f} images/s")
 
 

@@ -37,6 +37,7 @@ from lv3d.calibrate.truth import match_faces, truth_labels, truth_quantities, tr
 from lv3d.describe import MIN_CONF, ground
 from lv3d.perception import perceive
 from lv3d.render import render_scene
+from benchmarks.targets import beside
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -223,7 +224,7 @@ def main(argv=None) -> int:
         for key, unit in (("vertex", "px"), ("dihedral", "deg")):
             raw, ref = _med(st[key][False]), _med(st[key][True])
             cut = 1 - ref / raw if raw > 0 else float("nan")
-            tgt = f"  (target cut >= {CUT_TARGET:.0%}: {'met' if cut >= CUT_TARGET else 'NOT met'})" if preset == "realsense" else ""
+            tgt = f"  (cut {beside('>=', CUT_TARGET, cut, '.0%')})" if preset == "realsense" else ""
             print(f"  median {key} error: unrefined {raw:.3f} {unit}, refined {ref:.3f} {unit} "
                   f"(n={len(st[key][True])}), cut {cut:.1%}{tgt}")
         allp = [r for rows in st["facts"].values() for r in rows]
@@ -251,11 +252,11 @@ def main(argv=None) -> int:
         first = float(np.median(firsts))
         print(f"== speed (one core; this machine is shared, so figures are pessimistic)")
         print(f"  refinement + facts per 640x480 frame, median after warm-up: {ms:.1f} ms "
-              f"(target <= {FRAME_MS_TARGET:.0f} ms: {'met' if ms <= FRAME_MS_TARGET else 'NOT met'}); "
+              f"({beside('<=', FRAME_MS_TARGET, ms, '.0f', ' ms')}); "
               f"CPU time {cpu_ms:.1f} ms")
         print(f"  first call in a new process, warm cache: median {first:.2f} s of "
               f"{', '.join(f'{x:.2f}' for x in firsts)} "
-              f"(target <= {FIRST_CALL_S_TARGET:.0f} s: {'met' if first <= FIRST_CALL_S_TARGET else 'NOT met'}; "
+              f"({beside('<=', FIRST_CALL_S_TARGET, first, '.0f', ' s')}; "
               f"includes importing JAX)")
     return 0
 

@@ -43,6 +43,7 @@ from lv3d.experiment.folds import Item, class_task, multiclass_task, split, stra
 from lv3d.learn import Model, fit
 from lv3d.learn.engine import LearnError
 from lv3d.truth_facts import truth_facts
+from benchmarks.targets import mark
 
 CLASSES = ("cube", "square_pyramid", "triangular_prism", "pentagonal_prism")
 MODALITIES = ("rgbd", "depth", "rgb")
@@ -173,7 +174,7 @@ def show(name: str, r: dict, ref: dict | None = None, check: bool = False) -> No
         line += f"  drop {-db:+.1f} / {-dm:+.1f} pts"
         if check:
             ok = db >= -10 and (dm != dm or dm >= -10)
-            line += f"  target drop <= 10  {'ok' if ok else 'MISSED'}"
+            line += f"  target drop <= 10  {mark(ok)}"
     print(line, flush=True)
 
 
@@ -191,7 +192,7 @@ def speed(data: Data, facts: dict, seed: int) -> None:
             print(f"  {c}: {e}")
         times.append(time.perf_counter() - t)
     med = statistics.median(times)
-    ok = "ok" if med <= 1.0 else "MISSED"
+    ok = mark(med <= 1.0)
     print(f"fit-{len(big)} (s)          median {med:.3f} (max {max(times):.3f})  target median <= 1 s  {ok}")
     model = Model.fit(x, y, seed=seed)
     times = []
@@ -200,7 +201,7 @@ def speed(data: Data, facts: dict, seed: int) -> None:
         model.predict(facts[i])
         times.append(time.perf_counter() - t)
     med = 1000 * statistics.median(times)
-    print(f"classify (ms)        median {med:.2f}  target median <= 10 ms  {'ok' if med <= 10 else 'MISSED'}")
+    print(f"classify (ms)        median {med:.2f}  target median <= 10 ms  {mark(med <= 10)}")
 
 
 def main(argv=None) -> int:

@@ -43,6 +43,7 @@ from lv3d.render import render_scene
 from lv3d.experiment.code_version import FACT_SOURCES, source_digest
 from lv3d.experiment.config import parse_override
 from lv3d.render.noise import noise_config
+from benchmarks.targets import beside
 
 CLASSES = ["cube", "cuboid", "square_pyramid", "triangular_prism", "pentagonal_prism", "hexagonal_prism",
            "tetrahedron"]
@@ -208,8 +209,7 @@ def _fmt_target(preset: str, key: str, value: float) -> str:
     if preset not in TARGETS or key not in TARGETS[preset]:
         return ""
     op, t = TARGETS[preset][key]
-    ok = value >= t if op == ">=" else value <= t
-    return f" (target {op} {t}: {'met' if ok else 'NOT met'})"
+    return f" ({beside(op, t, value)})"
 
 
 def main(argv=None) -> int:
@@ -303,7 +303,7 @@ def main(argv=None) -> int:
         for k, v in timings.items():
             print(f"{k:10} {np.median(v):8.1f}")
         tot = float(np.median(timings["total"]))
-        print(f"total {tot:.1f} ms (target <= {TIME_TARGET_MS:.0f} ms: {'met' if tot <= TIME_TARGET_MS else 'NOT met'})")
+        print(f"total {tot:.1f} ms ({beside('<=', TIME_TARGET_MS, tot, '.0f', ' ms')})")
     return 0
 
 

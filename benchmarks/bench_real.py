@@ -170,6 +170,7 @@ from lv3d.errors import InputError
 from lv3d.facts import MODALITIES, PREDICATES
 from lv3d.frame_folder import FrameFolder, LabelledObject
 from lv3d.object_facts import HOLD_SHARE, face_cover, held_object, holds, merged_flags, object_under, region_pixels
+from benchmarks.targets import mark, meets
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -568,7 +569,7 @@ def verdict(key: str, modality: str, value: float | None) -> str:
     if t is None or value is None or modality not in t[2]:
         return ""
     op, target, _ = t
-    return "ok" if (value >= target if op == ">=" else value <= target) else "MISS"
+    return mark(meets(op, target, value))
 
 
 def target_text(key: str) -> str:

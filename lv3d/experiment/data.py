@@ -27,7 +27,7 @@ from ..facts import SceneFacts
 from ..output import clean_stale, locked, write_atomic
 from .code_version import facts_version
 from .config import StudyConfig, digest
-from .executor import LocalExecutor
+from .executor import cache_missing
 from .folds import Item
 
 
@@ -135,18 +135,10 @@ def ensure_facts(cfg: StudyConfig, out: Path, data: Path, items: list[Item], mod
     clean_stale(dest)
     have = {it.id: _read_facts(dest / f"{it.id}.json") for it in items}
     todo = [it for it in items if have[it.id] is None]
-    if todo:
-        jobs = [(str(Path(data) / it.dir), it.id, modality, refine, cfg.lv3d.perception_seed) for it in todo]
-        own = executor is None
-        executor = LocalExecutor(workers) if own else executor
-        try:
-            for i, record in tqdm(executor.map(facts_job, jobs, workers=None if own else workers), total=len(jobs),
-                                  desc=f"facts {modality} refine={refine}"):
-                write_atomic(dest / f"{todo[i].id}.json", json.dumps(record))
-                have[todo[i].id] = (SceneFacts.from_json(record["facts"], todo[i].id), record["error"])
-        finally:
-            if own:
-                executor.close()
+    jobs = [(str(Path(data) / it.dir), it.id, modality, refine, cfg.lv3d.perception_seed) for it in todo]
+    for name, record in cache_missing(dest, [it.id for it in todo], facts_job, jobs, f"facts {modality} refine={refine}",
+                                      workers, executor):
+        have[name] = (SceneFacts.from_json(record["facts"], name), record["error"])
     facts, errors = {}, {}
     for it in items:
         sf, error = have[it.id]

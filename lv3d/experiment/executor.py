@@ -15,12 +15,17 @@ so the results are the same, bit for bit, wherever and in whatever order the job
 
 from __future__ import annotations
 
+import json
 import os
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
+
+from tqdm import tqdm
 
 from .. import compile_cache
 from ..errors import InputError
+from ..output import write_atomic
 
 EXECUTORS = ("local", "dask")
 
@@ -165,6 +170,25 @@ class _Shared:
 
 def _call(fn: Callable, job, shared: _Shared):
     return fn(job, shared.value)
+
+
+def cache_missing(dest: Path, names: list[str], fn: Callable, jobs: list, desc: str, workers: int = 1,
+                  executor=None) -> Iterator[tuple[str, dict]]:
+    """Compute the cache records a folder lacks: ``jobs[i]`` gives the JSON record of ``names[i]``, written to
+    ``dest/<name>.json`` as it comes back (so that an interrupted run resumes), then yielded as (name, record).
+    The jobs run on ``executor``, default ``workers`` local processes, with a progress bar labelled ``desc``;
+    nothing runs (and no bar shows) when there is no job."""
+    if not jobs:
+        return
+    own = executor is None
+    executor = LocalExecutor(workers) if own else executor
+    try:
+        for i, record in tqdm(executor.map(fn, jobs, workers=None if own else workers), total=len(jobs), desc=desc):
+            write_atomic(Path(dest) / f"{names[i]}.json", json.dumps(record))
+            yield names[i], record
+    finally:
+        if own:
+            executor.close()
 
 
 def make_executor(kind: str = "local", workers: int = 1, address: str | None = None):

@@ -26,7 +26,7 @@ from tqdm import tqdm
 from ..errors import InputError
 from ..facts import SceneFacts
 from ..frame_folder import FrameFolder, LabelledObject, Problem, scene_atom
-from ..output import clean_stale, write_atomic
+from ..output import clean_stale
 from .folds import Item
 
 # An object perceived nowhere still gets a crop for the baselines: a square this fraction of the frame's
@@ -117,7 +117,7 @@ def ensure_frame_facts(rd: RealData, root: Path, version: str, modality: str, re
     """{frame atom: FrameFacts} for every frame with a labelled object, computed where the cache lacks it;
     ``seed``: perception's."""
     from .data import facts_variant
-    from .executor import LocalExecutor
+    from .executor import cache_missing
     from ..object_facts import FrameFacts
 
     dest = Path(root) / rd.key / version / facts_variant(modality, refine, seed)
@@ -125,19 +125,11 @@ def ensure_frame_facts(rd: RealData, root: Path, version: str, modality: str, re
     clean_stale(dest)
     have = {a: _read_record(dest / f"{a}.json") for a in rd.frames}
     todo = [a for a in rd.frames if have[a] is None]
-    if todo:
-        jobs = [(str(rd.frames[a][0].path), rd.frames[a][1], a, [(o.object, o.u, o.v) for o in rd.labels[a]],
-                 modality, refine, seed) for a in todo]
-        own = executor is None
-        executor = LocalExecutor(workers) if own else executor
-        try:
-            for i, record in tqdm(executor.map(_frame_job, jobs, workers=None if own else workers), total=len(jobs),
-                                  desc=f"facts {modality} refine={refine}"):
-                write_atomic(dest / f"{todo[i]}.json", json.dumps(record))
-                have[todo[i]] = FrameFacts.from_json(record, todo[i])
-        finally:
-            if own:
-                executor.close()
+    jobs = [(str(rd.frames[a][0].path), rd.frames[a][1], a, [(o.object, o.u, o.v) for o in rd.labels[a]],
+             modality, refine, seed) for a in todo]
+    for name, record in cache_missing(dest, todo, _frame_job, jobs, f"facts {modality} refine={refine}", workers,
+                                      executor):
+        have[name] = FrameFacts.from_json(record, name)
     return have
 
 
