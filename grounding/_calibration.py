@@ -181,7 +181,7 @@ def _inputs(key: str, names: list[str]) -> list:
     return out
 
 
-def _final_knots(pred: str, final: dict | None) -> dict | None:
+def final_knots(pred: str, final: dict | None) -> dict | None:
     """The final map of ``pred`` in one modality's ``final`` (:func:`calibrate_with`'s layout): the type's own
     (or None, no final stage) where "by_pred" names it, the per-face pooled one ("faces") where it says
     "faces", else the pooled one of every type."""
@@ -196,7 +196,7 @@ def _compile(pred: str, entry: dict | None, final: dict | None):
     """(bias, [(coefficient, whether it multiplies logit p, key in x or None for 1, scale)], final knots (xs, ys))
     of ``pred``'s table entry (bias and terms None without one) and its final map in its modality's ``final`` (None
     without one); None if neither."""
-    knots = _final_knots(pred, final)
+    knots = final_knots(pred, final)
     if entry is None and knots is None:
         return None
     terms = None if entry is None else [(c, *t) for c, t in zip(entry["coef"], _inputs(pred, entry["features"]))]

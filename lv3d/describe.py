@@ -11,7 +11,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, field as dc_field
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import cv2
 import numpy as np
@@ -22,6 +22,9 @@ from .facts import PREDICATES, Fact, SceneFacts
 from .perception.polygons import area
 from .rgbd import RGBD
 from .scene import Face, Scene, SceneObject
+
+if TYPE_CHECKING:  # grounding (JAX) is imported where it is used, not when lv3d.describe is
+    import grounding
 
 MIN_CONF = 0.05
 CAP_PX = 30.0  # edge fields are clipped to +-this many pixels
@@ -87,7 +90,7 @@ class _Job(NamedTuple):
     polys: list[np.ndarray]                    # their polygons as packed (at most MAX_SIDES vertices)
     has_plane: list[bool]                      # which faces carry a plane with 3 points or more
     index: np.ndarray                          # polygon slot -> union vertex (grounding.pack_object)
-    prob: object                               # the packed problem
+    prob: grounding.ObjectProblem              # the packed problem
     refined: bool                              # whether the solver refines its geometry
     points: list[np.ndarray | None]            # each face's depth points, as packed
     adjacency: list[tuple[int, int]]           # touching faces, as slot pairs

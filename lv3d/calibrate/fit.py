@@ -76,8 +76,9 @@ from pathlib import Path
 
 import numpy as np
 
-from grounding._calibration import (SHARED_SIDE_PREDS, TOL_FRAC_PREDS, _final_knots, calibrate_with, calibration_key,
-                                    factors, inputs, is_slope, logit)
+from grounding import (SHARED_SIDE_PREDS, TOL_FRAC_PREDS, calibrate_with, calibration_key, factors, inputs, is_slope,
+                       logit)
+from grounding import final_knots as grounding_final_knots
 
 from ..describe import ANGLE_PREDS, SIDE_NAMES
 from ..errors import InputError
@@ -434,7 +435,7 @@ def final_knots(final: dict, key: str) -> dict | None:
     """The final map one modality's ``final`` (:func:`fit_final`'s layout) gives ``key``, as grounding reads it
     (its own knots, None for no final stage, or the per-face pooled knots), the every-key pooled map as its knots
     alone."""
-    knots = _final_knots(key, final)
+    knots = grounding_final_knots(key, final)
     return {"x": final["x"], "y": final["y"]} if knots is final else knots
 
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from grounding._confidence import (ACUTE_BELOW_DEG, EQUAL_CORNERS_DEG, EQUAL_SIDES_RATIO, OBTUSE_ABOVE_DEG,
-                                   PARALLEL_SIDES_DEG, PERPENDICULAR_DEG, PLANE_ANGLE_DEG, RIGHT_ANGLE_DEG)
+from grounding import (ACUTE_BELOW_DEG, EQUAL_CORNERS_DEG, EQUAL_SIDES_RATIO, OBTUSE_ABOVE_DEG, PARALLEL_SIDES_DEG,
+                       PERPENDICULAR_DEG, PLANE_ANGLE_DEG, RIGHT_ANGLE_DEG)
 from ..perception.polygons import rasterize
 
 NGONS = {"triangle": 3, "quadrilateral": 4, "pentagon": 5, "hexagon": 6}

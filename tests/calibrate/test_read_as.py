@@ -3,7 +3,7 @@
 
 import numpy as np
 
-from grounding._calibration import calibrate_with
+from grounding import calibrate_with
 from lv3d.calibrate.fit import fit
 
 
