@@ -11,7 +11,7 @@
 #
 # What the committed reports hold, and so what is passed here: the seed protocol and its replicates at the
 # clean and realsense presets; the few-shot study with the lv3d systems, cnn-rgbd, the pretrained networks and
-# the tree; the real-objects study with the tuned CNN at one and two positives only (its two parts are joined by
+# the tree; the real-objects study with the tuned CNN at every size (its two parts are joined by
 # `lv3d experiment report`). Three lanes run at once on two cores; the studies of the seed protocol's images
 # share one data cache, which the seed protocol fills before the ablations start. About 75 min on two cores.
 #
@@ -61,13 +61,11 @@ perception_seed() {  # perception_seed S: the real-objects study's lv3d systems 
     log "real_objects_pseed$1: $(grep -a 'fold results computed' "$RUNS/real_objects_pseed$1.log" | tail -1)"
 }
 
-real_objects() {  # the lv3d systems, the pretrained networks and the tree at every size, the tuned CNN at one and two positives
-    local out=$RUNS/real_objects all="systems=[lv3d-rgb,lv3d-depth,lv3d-rgbd,effnet-rgb,effnet-depth,effnet-rgbd,tree-rgbd]"
+real_objects() {  # the lv3d systems, the pretrained networks, the tree and the tuned CNN at every size
+    local out=$RUNS/real_objects
     local csv=experiments/results/real_objects/results.csv
     {
-        $PY scripts/restore_baselines.py experiments/real_objects.yaml $csv --out "$out" --set "$REAL_CACHE" --set "$all"
-        $PY scripts/restore_baselines.py experiments/real_objects.yaml $csv --out "$out" --set "$REAL_CACHE" \
-            --set "systems=[cnn-rgbd]" --set "sweep={param: train.positives, values: [1, 2]}"
+        $PY scripts/restore_baselines.py experiments/real_objects.yaml $csv --out "$out" --set "$REAL_CACHE"
         OMP_NUM_THREADS=1 $LV3D experiment run experiments/real_objects.yaml --out "$out" --set "$REAL_CACHE" \
             --set "$LV3D_ONLY"
         $LV3D experiment report experiments/real_objects.yaml --out "$out" --set "$REAL_CACHE"

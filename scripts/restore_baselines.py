@@ -8,7 +8,8 @@ on lv3d's code: ``lv3d/experiment/code_version.py``).
 
 Each restored fold file carries the key the runner computes for that system and fold under the
 config as it is now, so the runner skips it; it holds what the report reads (per task: accuracy,
-balanced accuracy, test size, seconds), not the predictions, and says it was restored. Pass the
+balanced accuracy, test size, seconds; the setting a tuned baseline chose), not the predictions, and says it
+was restored. Pass the
 same ``--set`` overrides as the run. A config whose conditions, systems or folds do not match the
 CSV stops with an error naming both files.
 """
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import json
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -27,26 +29,34 @@ from lv3d.experiment.runner import _write_json, fold_path, result_key
 from lv3d.output import claim
 
 
-def read_rows(path: Path) -> dict[tuple[str, str, int], dict[str, dict]]:
-    """(condition, system, fold) -> task -> the task's scores, for the baseline rows of a results.csv."""
+def read_rows(path: Path) -> tuple[dict[tuple[str, str, int], dict[str, dict]], dict[tuple[str, str, int], dict]]:
+    """For the baseline rows of a results.csv: ((condition, system, fold) -> task -> the task's scores,
+    (condition, system, fold) -> the setting a tuned baseline chose there, where the CSV says)."""
     if not path.is_file():
         raise InputError(path, "results file not found")
     cells: dict[tuple[str, str, int], dict[str, dict]] = defaultdict(dict)
+    tuned: dict[tuple[str, str, int], dict] = {}
     with path.open(newline="") as f:
-        for row in csv.DictReader(f):
+        for line, row in enumerate(csv.DictReader(f), start=2):
             if row["system"] in LOGIC_SYSTEMS:
                 continue
             bal = row["balanced_accuracy"]
-            cells[(row["condition"], row["system"], int(row["fold"]))][row["task"]] = {
+            key = (row["condition"], row["system"], int(row["fold"]))
+            cells[key][row["task"]] = {
                 "accuracy": float(row["accuracy"]), "balanced_accuracy": float(bal) if bal else None,
                 "n": int(row["n"]), "seconds": float(row["seconds"])}
-    return cells
+            if row.get("tuned"):
+                try:
+                    tuned[key] = json.loads(row["tuned"])
+                except json.JSONDecodeError as e:
+                    raise InputError(path, f"line {line}: the tuned column is no JSON ({e})") from None
+    return cells, tuned
 
 
 def restore(config: Path, results: Path, out: Path, overrides: list[str] = ()) -> int:
     """Write the baseline fold files of ``config``'s run into ``out`` from ``results``; returns how many."""
     study = load_study(config, list(overrides))
-    cells = read_rows(results)
+    cells, tuned = read_rows(results)
     written = 0
     claim(out, (config, results))  # the study's --out: refused unless new, empty or lv3d's own
     for cname, ccfg in study.conditions.items():
@@ -58,10 +68,12 @@ def restore(config: Path, results: Path, out: Path, overrides: list[str] = ()) -
                 if not tasks:
                     raise InputError(results, f"no rows for condition {cname!r}, system {s!r}, fold {k} of {config}")
                 tasks = {t: {n: v for n, v in sc.items() if v is not None} for t, sc in tasks.items()}
-                _write_json(fold_path(out, cname, s, k), {
-                    "key": result_key(ccfg, s, k), "condition": cname, "system": s, "fold": k, "tasks": tasks,
-                    "seconds": round(sum(sc["seconds"] for sc in tasks.values()), 3), "pipeline_errors": {},
-                    "code": None, "restored_from": str(results)})
+                record = {"key": result_key(ccfg, s, k), "condition": cname, "system": s, "fold": k, "tasks": tasks,
+                          "seconds": round(sum(sc["seconds"] for sc in tasks.values()), 3), "pipeline_errors": {},
+                          "code": None, "restored_from": str(results)}
+                if (cname, s, k) in tuned:
+                    record["tuned"] = tuned[(cname, s, k)]
+                _write_json(fold_path(out, cname, s, k), record)
                 written += 1
     return written
 

@@ -1,5 +1,6 @@
 """The study's report, regenerated from the fold files (never edited by hand):
-``results.csv`` (one row per condition x system x fold x task), ``results.json`` (means, standard
+``results.csv`` (one row per condition x system x fold x task; ``tuned``: the setting a tuned baseline chose on
+that fold, as JSON), ``results.json`` (means, standard
 deviations, paired tests, the calibration of the multi-class answers and, for lv3d systems, how they were
 reached: by a proof, an arbiter, a near proof or none; which classes the answers confuse), ``results.md`` (the
 tables), ``accuracy.png``, ``reliability.png`` (the answers' reliability diagram, last condition),
@@ -62,10 +63,13 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
                     per["learn_failures"] += 1
                     if len(per["learn_failure_examples"]) < 3:
                         per["learn_failure_examples"].append(f"fold {r['fold']} {task} {cls}: {reason}")
+            # a tuned baseline's chosen setting rides on its rows, so that a rerun restoring its folds from the CSV
+            # (scripts/restore_baselines.py) keeps it in the report
+            tuned = json.dumps({k: r["tuned"][k] for k in ("setting", "inner_accuracy")}) if r.get("tuned") else ""
             for task, sc in r["tasks"].items():
                 rows.append({"condition": condition, "system": s, "fold": r["fold"], "task": task,
                              "accuracy": sc["accuracy"], "balanced_accuracy": sc.get("balanced_accuracy", ""),
-                             "n": sc["n"], "seconds": sc["seconds"]})
+                             "n": sc["n"], "seconds": sc["seconds"], "tuned": tuned})
                 if task != "multiclass":
                     cells[s][(r["fold"], task)] = sc["accuracy"]
         for c in classes + ["multiclass"]:
@@ -402,7 +406,8 @@ def write_report(out: Path, cfg: StudyConfig, conds: dict[str, StudyConfig]) -> 
         summaries[cname] = summ
         rows += r
     buf = io.StringIO(newline="")
-    w = csv.DictWriter(buf, ["condition", "system", "fold", "task", "accuracy", "balanced_accuracy", "n", "seconds"])
+    w = csv.DictWriter(buf, ["condition", "system", "fold", "task", "accuracy", "balanced_accuracy", "n", "seconds",
+                             "tuned"])
     w.writeheader()
     w.writerows(rows)
     write_atomic(out / "results.csv", buf.getvalue())
