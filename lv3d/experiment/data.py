@@ -136,8 +136,8 @@ def ensure_facts(cfg: StudyConfig, out: Path, data: Path, items: list[Item], mod
     have = {it.id: _read_facts(dest / f"{it.id}.json") for it in items}
     todo = [it for it in items if have[it.id] is None]
     jobs = [(str(Path(data) / it.dir), it.id, modality, refine, cfg.lv3d.perception_seed) for it in todo]
-    for name, record in cache_missing(dest, [it.id for it in todo], facts_job, jobs, f"facts {modality} refine={refine}",
-                                      workers, executor):
+    for name, record in cache_missing(dest, [it.id for it in todo], facts_job, jobs,
+                                      f"facts {modality} refine={refine}", workers, executor):
         have[name] = (SceneFacts.from_json(record["facts"], name), record["error"])
     facts, errors = {}, {}
     for it in items:
