@@ -1,0 +1,333 @@
+"""Why a labelled object of a real frame has or lacks a cylindrical face: every cylinder the depth stage weighed on
+its object, and the test each one passed or failed, with the measured value beside the limit.
+
+    .venv/bin/python -m benchmarks.why_curved                                 # cylinders and boxes, every dev folder
+    .venv/bin/python -m benchmarks.why_curved ../shared/data/real/ycb-realsense --shapes cylinder
+    .venv/bin/python -m benchmarks.why_curved --seed 1 --set curved.trials=1024 --csv out/why_curved.csv
+
+A diagnostic of the cylinder search (lv3d/perception/depth/curved.py), for work on the ``cylinder_read_frac`` and
+``box_curved_frac`` figures of bench_real: a cylinder missed on a can and a cylinder found on a box are both a
+candidate's tests deciding, and which test decides says what to change.
+
+Every frame of each folder (``--limit N``: the first N) is perceived by the depth stage (lv3d.perception.depth,
+seed ``--seed``, settings with each ``--set KEY=VALUE`` as bench_real takes them); the object of each labelled
+object of ``--shapes`` is the depth object whose grid mask holds its labelled pixel (none: *not found*). For that
+object it prints:
+
+- whether the planes left room for the sample consensus (quadrics.leaves_room; without room only a fan of planes
+  is tried, see curved.object_cylinders);
+- each candidate that reached the acceptance tests (``curved._stands``; a fan of planes is a candidate once
+  fan_cylinder found it; the fan tests inside fan_cylinder are not shown): its radius, cells, side (+1 outside,
+  -1 inside), origin (fan or sample) and, test by test in the order they run, the value and the limit:
+  ``cells`` (>= max(20, the fewest cells of a face)), ``rms`` (mm, <= the inlier distance), ``misfit`` (sampled
+  candidates only: the cylinder's systematic misfit over the cells the planes held, mm, <= ``misfit_ratio``
+  times the planes'), ``track`` (arc deg >= ``min_arc_deg``, gap deg <= ``max_gap_deg``), ``profile`` (normal
+  arc deg >= ``sample_arc_deg``, dip >= ``min_dip``), ``sphere`` (insides only: share of the sphere's residual
+  variance explained >= ``min_share``), ``share`` (curved_share >= ``min_share``); the first that fails is the
+  verdict. The depth stage's own verdict is kept beside it: a row where the two differ says ``DIFFERS``;
+- the object's surfaces as the depth stage left them (planes, cylinders, cones, spheres).
+
+The outcome of each object: ``cylinder`` (a cylindrical face), ``cone`` / ``sphere`` (such a face and no
+cylinder), ``no room`` (no candidate, the consensus did not run), ``no candidate`` (it ran and no candidate
+reached the tests), ``rejected: TEST`` (candidates, none stood: the test that stopped the one with the most
+cells) or ``not found``. The summary counts outcomes per shape; ``--csv FILE`` writes a row per candidate.
+Unoccluded objects only (``partial`` no) unless ``--partial``. Where the real frames are absent it says so and
+exits 0.
+"""
+
+from __future__ import annotations
+
+if __name__ == "__main__":  # one core, as bench_real
+    import os
+
+    for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMEXPR_NUM_THREADS"):
+        os.environ[_var] = "1"
+    os.environ.setdefault("JAX_PLATFORMS", "cpu")
+
+import argparse
+import contextlib
+import csv
+import sys
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.bench_real import _one_core, default_folders, depth_settings, labelled_folder
+from lv3d.errors import InputError
+
+TESTS = ("cells", "rms", "misfit", "track", "profile", "sphere", "share")
+
+
+@dataclass
+class Candidate:
+    """One cylinder that reached the acceptance tests: its radius (mm), cells, side, origin ('fan' or
+    'sample'), each test run as (name, value text, limit text, passed), and the depth stage's verdict."""
+
+    radius_mm: float
+    cells: int
+    side: int
+    origin: str
+    tests: list[tuple[str, str, str, bool]]
+    stood: bool
+
+    @property
+    def verdict(self) -> str:
+        failed = [name for name, _, _, ok in self.tests if not ok]
+        return failed[0] if failed else "stands"
+
+    @property
+    def agrees(self) -> bool:
+        return (self.verdict == "stands") == self.stood
+
+
+@dataclass
+class Weighed:
+    """What the cylinder search did on one depth object: ``room`` (the sample consensus ran) and its
+    candidates."""
+
+    room: bool = False
+    searched: bool = False
+    candidates: list[Candidate] = field(default_factory=list)
+
+
+def gate_tests(cyl, pts: np.ndarray, nrm: np.ndarray, plane_fit, dist_m: float, min_cells: int, settings,
+               side: float) -> list[tuple[str, str, str, bool]]:
+    """The acceptance tests of curved._stands on one candidate, in its order, each as (name, value, limit,
+    passed), up to the first that fails."""
+    from lv3d.perception.depth import curved
+    from lv3d.sphere import algebraic_sphere
+
+    out: list[tuple[str, str, str, bool]] = []
+
+    def test(name: str, value: str, limit: str, ok: bool) -> bool:
+        out.append((name, value, limit, ok))
+        return ok
+
+    need = max(20, min_cells)
+    if not test("cells", str(len(pts)), f">= {need}", len(pts) >= need):
+        return out
+    r, _ = cyl.radial(pts)
+    rms = float(np.sqrt(np.mean((r - cyl.radius) ** 2)))
+    if not test("rms", f"{1e3 * rms:.2f} mm", f"<= {1e3 * dist_m:.2f} mm", rms <= dist_m):
+        return out
+    if plane_fit is not None:
+        on_planes, plane_res = plane_fit
+        bin_deg = settings.max_gap_deg / 2
+        theirs = curved.misfit(cyl, on_planes, plane_res, bin_deg)
+        mine = curved.misfit(cyl, on_planes, side * (cyl.radial(on_planes)[0] - cyl.radius), bin_deg)
+        if not test("misfit", f"{1e3 * mine:.2f} mm", f"<= {settings.misfit_ratio} x {1e3 * theirs:.2f} mm",
+                    mine <= settings.misfit_ratio * theirs):
+            return out
+    _, arc, gap = curved.track(cyl, pts, nrm, settings.max_gap_deg / 2, settings.bin_cells)
+    if not test("track", f"arc {arc:.0f} gap {gap:.0f}", f"arc >= {settings.min_arc_deg:g} gap <= "
+                f"{settings.max_gap_deg:g}", arc >= settings.min_arc_deg and gap <= settings.max_gap_deg):
+        return out
+    arc, dip = curved.normal_profile(cyl, nrm, settings.max_gap_deg / 2)
+    if not test("profile", f"arc {arc:.0f} dip {dip:.2f}", f"arc >= {settings.sample_arc_deg:g} dip >= "
+                f"{settings.min_dip:g}", arc >= settings.sample_arc_deg and dip >= settings.min_dip):
+        return out
+    if side < 0:
+        sphere = algebraic_sphere(pts)
+        if sphere is not None:
+            over = curved.explained_share(rms * rms, float(np.mean(sphere.residual(pts) ** 2)))
+            if not test("sphere", "none" if over is None else f"{over:.2f}", f">= {settings.min_share:g}",
+                        over is not None and over >= settings.min_share):
+                return out
+    share = curved.curved_share(pts, cyl)
+    test("share", f"{share:.2f}", f">= {settings.min_share:g}", share >= settings.min_share)
+    return out
+
+
+@contextlib.contextmanager
+def watching(record: dict[bytes, Weighed]):
+    """Within: the depth stage's cylinder search recorded per object (keyed by its grid mask's bytes) into
+    ``record``. Wraps stage._curved (which object), stage.object_cylinders (whether the consensus ran) and
+    curved._stands (each candidate), and restores them on leaving."""
+    from lv3d.perception.depth import curved, stage
+
+    own_curved, own_search, own_stands = stage._curved, stage.object_cylinders, curved._stands
+    current: list[Weighed] = []
+
+    def curved_of(grid, o, *args, **kw):
+        current.append(record.setdefault(np.packbits(o.mask).tobytes(), Weighed()))
+        try:
+            return own_curved(grid, o, *args, **kw)
+        finally:
+            current.pop()
+
+    def search(*args, sample: bool = True, **kw):
+        if current:
+            current[-1].room, current[-1].searched = sample, True
+        return own_search(*args, sample=sample, **kw)
+
+    def stands(cyl, pts, nrm, plane_fit, dist_m, min_cells, settings, side=1.0):
+        stood = own_stands(cyl, pts, nrm, plane_fit, dist_m, min_cells, settings, side)
+        if current:
+            current[-1].candidates.append(Candidate(
+                1e3 * cyl.radius, len(pts), int(side), "fan" if plane_fit is None else "sample",
+                gate_tests(cyl, pts, nrm, plane_fit, dist_m, min_cells, settings, side), stood))
+        return stood
+
+    stage._curved, stage.object_cylinders, curved._stands = curved_of, search, stands
+    try:
+        yield record
+    finally:
+        stage._curved, stage.object_cylinders, curved._stands = own_curved, own_search, own_stands
+
+
+def surfaces(result) -> Counter:
+    """The surfaces of one depth object as the depth stage left them: planes and curved faces by kind."""
+    kinds = Counter({"plane": len(result.planes)})
+    for c in result.curved:
+        kinds[getattr(c, "surface", "cylinder")] += 1
+    return +kinds
+
+
+def outcome(kinds: Counter, weighed: Weighed | None) -> str:
+    for kind in ("cylinder", "cone", "sphere"):
+        if kinds.get(kind):
+            return kind
+    if weighed is None or not weighed.candidates:
+        return "no candidate" if weighed is not None and weighed.room else "no room"
+    biggest = max(weighed.candidates, key=lambda c: c.cells)
+    return f"rejected: {biggest.verdict}"
+
+
+def weigh_folder(folder: Path, shapes: tuple[str, ...], limit: int | None, seed: int, settings,
+                 partial: bool) -> list[dict]:
+    """One record per labelled object of ``shapes`` in the folder's frames: frame, object, shape, notes,
+    outcome, surfaces and candidates."""
+    from lv3d.perception.depth import depth_scene
+
+    ff = labelled_folder(folder)
+    labels = ff.labels()
+    notes = _notes(folder)
+    frames = ff.frames[:limit] if limit else ff.frames
+    rows = []
+    for name in frames:
+        chosen = [lab for lab in labels.get(name, []) if lab.shape in shapes and (partial or not lab.partial)]
+        if not chosen:
+            continue
+        record: dict[bytes, Weighed] = {}
+        with watching(record):
+            res = depth_scene(ff.load(name), seed=seed, settings=settings)
+        stride = res.settings.stride
+        for lab in chosen:
+            i, j = lab.v // stride, lab.u // stride
+            held = [r for r in res.objects if r.obj.mask[i, j]]
+            row = {"folder": folder.name, "frame": name, "object": lab.object, "shape": lab.shape,
+                   "notes": notes.get((name, str(lab.object)), ""), "candidates": [], "surfaces": Counter()}
+            if not held:
+                row["outcome"] = "not found"
+            else:
+                weighed = record.get(np.packbits(held[0].obj.mask).tobytes())
+                row["surfaces"] = surfaces(held[0])
+                row["candidates"] = weighed.candidates if weighed else []
+                row["room"] = bool(weighed and weighed.room)
+                row["outcome"] = outcome(row["surfaces"], weighed)
+            rows.append(row)
+    return rows
+
+
+def _notes(folder: Path) -> dict[tuple[str, str], str]:
+    with open(folder / "objects.csv", newline="") as f:
+        return {(r.get("frame", ""), r.get("object", "")): r.get("notes") or "" for r in csv.DictReader(f)}
+
+
+def show(row: dict) -> str:
+    kinds = " + ".join(f"{k}*{n}" for k, n in sorted(row["surfaces"].items())) or "-"
+    head = (f"{row['folder']} {row['frame']} object {row['object']} ({row['shape']}"
+            f"{': ' + row['notes'] if row['notes'] else ''}): {row['outcome']}; surfaces {kinds}"
+            f"{'' if row['outcome'] == 'not found' else '; consensus ' + ('ran' if row.get('room') else 'not run')}")
+    lines = [head]
+    for c in row["candidates"]:
+        tests = "; ".join(f"{name} {value} ({limit}){'' if ok else ' FAIL'}" for name, value, limit, ok in c.tests)
+        lines.append(f"    {c.origin} r {c.radius_mm:.0f} mm, {c.cells} cells, side {c.side:+d}: {c.verdict}"
+                     f"{'' if c.agrees else ' DIFFERS from the depth stage'} | {tests}")
+    return "\n".join(lines)
+
+
+def summary(rows: list[dict], shapes: tuple[str, ...]) -> str:
+    lines = ["", "outcomes (objects):"]
+    for shape in shapes:
+        mine = [r for r in rows if r["shape"] == shape]
+        if not mine:
+            continue
+        counts = Counter(r["outcome"] for r in mine)
+        lines.append(f"  {shape} ({len(mine)}): " + ", ".join(f"{k} {n}" for k, n in counts.most_common()))
+    cands = [c for r in rows for c in r["candidates"]]
+    if cands:
+        by = Counter((c.origin, c.verdict) for c in cands)
+        lines.append("candidates by origin and verdict: " + ", ".join(f"{o} {v} {n}" for (o, v), n in
+                                                                      sorted(by.items())))
+    differ = sum(not c.agrees for c in cands)
+    lines.append(f"verdicts that differ from the depth stage's: {differ}")
+    return "\n".join(lines)
+
+
+def write_csv(path: Path, rows: list[dict]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["folder", "frame", "object", "shape", "outcome", "origin", "radius_mm", "cells", "side",
+                    "verdict", "stood", *TESTS])
+        for r in rows:
+            for c in r["candidates"] or [None]:
+                if c is None:
+                    w.writerow([r["folder"], r["frame"], r["object"], r["shape"], r["outcome"], *[""] * 6,
+                                *[""] * len(TESTS)])
+                    continue
+                got = {name: f"{value} ({limit}){'' if ok else ' FAIL'}" for name, value, limit, ok in c.tests}
+                w.writerow([r["folder"], r["frame"], r["object"], r["shape"], r["outcome"], c.origin,
+                            f"{c.radius_mm:.1f}", c.cells, c.side, c.verdict, c.stood,
+                            *[got.get(t, "") for t in TESTS]])
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="why_curved.py", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("folders", nargs="*", type=Path, help="folders in the real layout (default: the dev folders)")
+    ap.add_argument("--shapes", default="cylinder,box", help="labelled shapes to show (default cylinder,box)")
+    ap.add_argument("--limit", type=int, metavar="N", help="only the first N frames of each folder")
+    ap.add_argument("--seed", type=int, default=0, help="perception's seed (default 0)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="overrides",
+                    help="a depth setting other than its default, as bench_real takes it (repeatable)")
+    ap.add_argument("--partial", action="store_true", help="occluded objects (partial yes) too")
+    ap.add_argument("--csv", type=Path, metavar="FILE", help="a row per candidate (a row per object without one)")
+    args = ap.parse_args(argv)
+    if args.limit is not None and args.limit < 1:
+        ap.error("--limit must be at least 1")
+    shapes = tuple(s.strip() for s in args.shapes.split(",") if s.strip())
+    if not shapes:
+        ap.error("--shapes names no shape")
+    try:
+        settings = depth_settings(args.overrides)
+    except InputError as e:
+        print(f"why_curved.py: error: {e}", file=sys.stderr)
+        return 2
+    _one_core()
+    folders = args.folders or default_folders()
+    if not folders:
+        print("why_curved.py: no real frames with objects.csv (../shared/data/real): nothing to weigh")
+        return 0
+    rows: list[dict] = []
+    for folder in folders:
+        try:
+            got = weigh_folder(folder, shapes, args.limit, args.seed, settings, args.partial)
+        except InputError as e:
+            print(f"why_curved.py: error: {e}", file=sys.stderr)
+            return 2
+        for row in got:
+            print(show(row))
+        rows += got
+    print(summary(rows, shapes))
+    if args.csv:
+        write_csv(args.csv, rows)
+        print(f"wrote {args.csv}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
