@@ -16,21 +16,30 @@ object it prints:
 
 - whether the planes left room for the sample consensus (quadrics.leaves_room; without room only a fan of planes
   is tried, see curved.object_cylinders);
-- each candidate that reached the acceptance tests (``curved._stands``; a fan of planes is a candidate once
-  fan_cylinder found it; the fan tests inside fan_cylinder are not shown): its radius, cells, side (+1 outside,
-  -1 inside), origin (fan or sample) and, test by test in the order they run, the value and the limit:
+- each sphere and cone that reached the acceptance tests of that search (``quadrics._stands``, which runs
+  first): its radius (a cone's: its half-angle), cells and, test by test, ``cells``, ``rms`` (mm, <= the inlier
+  distance), ``normals`` (median turn of the cells' normals from the surface's, deg, <= ``normal_fit_deg``),
+  ``planes`` (RMS over the cells on a plane, mm, <= ``plane_ratio`` times theirs from their planes), then for a
+  sphere ``spread`` (deg, >= ``min_spread_deg``), ``over cylinder`` and ``share`` (shares of a least-squares
+  cylinder's and a plane's residual variance explained, >= ``min_share``), for a cone ``profile`` (arc deg >=
+  ``min_arc_deg``, dip >= ``min_dip``), ``over plane`` (>= ``min_share``) and ``share`` (of a cylinder's, >=
+  ``min_cone_share``);
+- each cylinder candidate that reached the acceptance tests (``curved._stands``; a fan of planes is a candidate
+  once fan_cylinder found it; the fan tests inside fan_cylinder are not shown): its radius, cells, side (+1
+  outside, -1 inside), origin (fan or sample) and, test by test in the order they run, the value and the limit:
   ``cells`` (>= max(20, the fewest cells of a face)), ``rms`` (mm, <= the inlier distance), ``misfit`` (sampled
   candidates only: the cylinder's systematic misfit over the cells the planes held, mm, <= ``misfit_ratio``
   times the planes'), ``track`` (arc deg >= ``min_arc_deg``, gap deg <= ``max_gap_deg``), ``profile`` (normal
   arc deg >= ``sample_arc_deg``, dip >= ``min_dip``), ``sphere`` (insides only: share of the sphere's residual
-  variance explained >= ``min_share``), ``share`` (curved_share >= ``min_share``); the first that fails is the
-  verdict. The depth stage's own verdict is kept beside it: a row where the two differ says ``DIFFERS``;
+  variance explained >= ``min_share``), ``share`` (curved_share >= ``min_share``).
+  The first test that fails is a candidate's verdict. The depth stage's own verdict is kept beside it: a row
+  where the two differ says ``DIFFERS``;
 - the object's surfaces as the depth stage left them (planes, cylinders, cones, spheres).
 
 The outcome of each object: ``cylinder`` (a cylindrical face), ``cone`` / ``sphere`` (such a face and no
-cylinder), ``no room`` (no candidate, the consensus did not run), ``no candidate`` (it ran and no candidate
-reached the tests), ``rejected: TEST`` (candidates, none stood: the test that stopped the one with the most
-cells) or ``not found``. The summary counts outcomes per shape; ``--csv FILE`` writes a row per candidate.
+cylinder), ``no room`` (no cylinder candidate, and the planes left no room for the sample consensus),
+``no candidate`` (it ran and no cylinder reached the tests), ``rejected: TEST`` (cylinder candidates, none stood:
+the test that stopped the one with the most cells) or ``not found``. The summary counts outcomes per shape; ``--csv FILE`` writes a row per candidate.
 Unoccluded objects only (``partial`` no) unless ``--partial``. Where the real frames are absent it says so and
 exits 0.
 """
@@ -57,15 +66,17 @@ import numpy as np
 from benchmarks.bench_real import _one_core, default_folders, depth_settings, labelled_folder
 from lv3d.errors import InputError
 
-TESTS = ("cells", "rms", "misfit", "track", "profile", "sphere", "share")
+TESTS = ("cells", "rms", "misfit", "track", "profile", "sphere", "normals", "planes", "spread", "over cylinder",
+         "over plane", "share")
 
 
 @dataclass
 class Candidate:
-    """One cylinder that reached the acceptance tests: its radius (mm), cells, side, origin ('fan' or
-    'sample'), each test run as (name, value text, limit text, passed), and the depth stage's verdict."""
+    """One curved surface that reached the acceptance tests: its ``size`` (radius, mm; a cone's half-angle, deg), cells,
+    side, origin ('fan' or 'sample' for a cylinder, 'sphere', 'cone'), each test run as (name, value text, limit
+    text, passed), and the depth stage's verdict."""
 
-    radius_mm: float
+    size: float
     cells: int
     side: int
     origin: str
@@ -84,11 +95,10 @@ class Candidate:
 
 @dataclass
 class Weighed:
-    """What the cylinder search did on one depth object: ``room`` (the sample consensus ran) and its
-    candidates."""
+    """What the curved-surface searches did on one depth object: ``room`` (the sample consensus of spheres,
+    cones and cylinders ran on it) and the candidates they weighed."""
 
     room: bool = False
-    searched: bool = False
     candidates: list[Candidate] = field(default_factory=list)
 
 
@@ -140,26 +150,101 @@ def gate_tests(cyl, pts: np.ndarray, nrm: np.ndarray, plane_fit, dist_m: float, 
     return out
 
 
+def quadric_tests(model, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarray, dist_m: float, min_cells: int,
+                  settings) -> list[tuple[str, str, str, bool]]:
+    """The acceptance tests of quadrics._stands on one sphere or cone, in its order, each as (name, value,
+    limit, passed), up to the first that fails."""
+    from lv3d.perception.depth import quadrics
+    from lv3d.sphere import Sphere
+
+    out: list[tuple[str, str, str, bool]] = []
+
+    def test(name: str, value: str, limit: str, ok: bool) -> bool:
+        out.append((name, value, limit, ok))
+        return ok
+
+    need = max(20, min_cells)
+    if not test("cells", str(len(pts)), f">= {need}", len(pts) >= need):
+        return out
+    res, normal = quadrics._residual_normal(model, pts)
+    rms = float(np.sqrt(np.mean(res ** 2)))
+    if not test("rms", f"{1e3 * rms:.2f} mm", f"<= {1e3 * dist_m:.2f} mm", bool(np.isfinite(rms)) and rms <= dist_m):
+        return out
+    turn = float(np.median(np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", normal, nrm), -1.0, 1.0)))))
+    if not test("normals", f"{turn:.1f} deg", f"<= {settings.normal_fit_deg:g} deg", turn <= settings.normal_fit_deg):
+        return out
+    on_plane = np.isfinite(plane_res)
+    if np.count_nonzero(on_plane) >= 20:
+        mine = float(np.sqrt(np.mean(res[on_plane] ** 2)))
+        theirs = float(np.sqrt(np.mean(plane_res[on_plane] ** 2)))
+        if not test("planes", f"{1e3 * mine:.2f} mm", f"<= {settings.plane_ratio} x {1e3 * theirs:.2f} mm",
+                    mine <= settings.plane_ratio * theirs):
+            return out
+    if isinstance(model, Sphere):
+        spread = quadrics._spread_deg(nrm)
+        if not test("spread", f"{spread:.1f} deg", f">= {settings.min_spread_deg:g} deg",
+                    spread >= settings.min_spread_deg):
+            return out
+        _, vecs = np.linalg.eigh(nrm.T @ nrm)
+        over = quadrics._share(float(np.mean(res ** 2)), quadrics.cylinder_ms(pts, vecs[:, 0]))
+        if not test("over cylinder", "none" if over is None else f"{over:.2f}", f">= {settings.min_share:g}",
+                    over is None or over >= settings.min_share):
+            return out
+        share, least = quadrics.sphere_evidence(pts, model), settings.min_share
+    else:
+        arc, dip = quadrics._azimuth_profile(model.axis, nrm, settings.bin_deg)
+        if not test("profile", f"arc {arc:.0f} dip {dip:.2f}", f"arc >= {settings.min_arc_deg:g} dip >= "
+                    f"{settings.min_dip:g}", arc >= settings.min_arc_deg and dip >= settings.min_dip):
+            return out
+        plane = quadrics._share(float(np.mean(res ** 2)), quadrics.plane_ms(pts))
+        if not test("over plane", "none" if plane is None else f"{plane:.2f}", f">= {settings.min_share:g}",
+                    plane is not None and plane >= settings.min_share):
+            return out
+        share, least = quadrics.cone_evidence(pts, model), settings.min_cone_share
+    test("share", "none" if share is None else f"{share:.2f}", f">= {least:g}", share is not None and share >= least)
+    return out
+
+
 @contextlib.contextmanager
 def watching(record: dict[bytes, Weighed]):
     """Within: the depth stage's cylinder search recorded per object (keyed by its grid mask's bytes) into
-    ``record``. Wraps stage._curved (which object), stage.object_cylinders (whether the consensus ran) and
-    curved._stands (each candidate), and restores them on leaving."""
-    from lv3d.perception.depth import curved, stage
+    ``record``. Wraps stage.quadric_faces and stage._curved (which object), stage.object_cylinders (whether the
+    consensus ran), quadrics._stands and curved._stands (each candidate), and restores them on leaving."""
+    from lv3d.perception.depth import curved, quadrics, stage
 
-    own_curved, own_search, own_stands = stage._curved, stage.object_cylinders, curved._stands
+    own = (stage.quadric_faces, stage._curved, stage.object_cylinders, quadrics._stands, curved._stands)
+    own_quadrics, own_curved, own_search, own_quadric_stands, own_stands = own
     current: list[Weighed] = []
 
-    def curved_of(grid, o, *args, **kw):
-        current.append(record.setdefault(np.packbits(o.mask).tobytes(), Weighed()))
+    @contextlib.contextmanager
+    def within(mask: np.ndarray):
+        current.append(record.setdefault(np.packbits(mask).tobytes(), Weighed()))
         try:
-            return own_curved(grid, o, *args, **kw)
+            yield
         finally:
             current.pop()
 
+    def quadrics_of(xyz, mask, *args, room=None, **kw):
+        with within(mask):
+            current[-1].room |= room is None or bool(room)
+            return own_quadrics(xyz, mask, *args, room=room, **kw)
+
+    def curved_of(grid, o, *args, **kw):
+        with within(o.mask):
+            return own_curved(grid, o, *args, **kw)
+
+    def quadric_stands(model, pts, nrm, plane_res, dist_m, min_cells, settings):
+        stood = own_quadric_stands(model, pts, nrm, plane_res, dist_m, min_cells, settings)
+        if current:
+            cone = getattr(model, "half_angle_deg", None)
+            current[-1].candidates.append(Candidate(
+                cone if cone is not None else 1e3 * model.radius, len(pts), 0, "sphere" if cone is None else "cone",
+                quadric_tests(model, pts, nrm, plane_res, dist_m, min_cells, settings), stood))
+        return stood
+
     def search(*args, sample: bool = True, **kw):
         if current:
-            current[-1].room, current[-1].searched = sample, True
+            current[-1].room |= bool(sample)
         return own_search(*args, sample=sample, **kw)
 
     def stands(cyl, pts, nrm, plane_fit, dist_m, min_cells, settings, side=1.0):
@@ -170,11 +255,12 @@ def watching(record: dict[bytes, Weighed]):
                 gate_tests(cyl, pts, nrm, plane_fit, dist_m, min_cells, settings, side), stood))
         return stood
 
-    stage._curved, stage.object_cylinders, curved._stands = curved_of, search, stands
+    stage.quadric_faces, stage._curved, stage.object_cylinders, quadrics._stands, curved._stands = \
+        quadrics_of, curved_of, search, quadric_stands, stands
     try:
         yield record
     finally:
-        stage._curved, stage.object_cylinders, curved._stands = own_curved, own_search, own_stands
+        stage.quadric_faces, stage._curved, stage.object_cylinders, quadrics._stands, curved._stands = own
 
 
 def surfaces(result) -> Counter:
@@ -189,10 +275,10 @@ def outcome(kinds: Counter, weighed: Weighed | None) -> str:
     for kind in ("cylinder", "cone", "sphere"):
         if kinds.get(kind):
             return kind
-    if weighed is None or not weighed.candidates:
+    cylinders = [c for c in weighed.candidates if c.origin in ("fan", "sample")] if weighed is not None else []
+    if not cylinders:
         return "no candidate" if weighed is not None and weighed.room else "no room"
-    biggest = max(weighed.candidates, key=lambda c: c.cells)
-    return f"rejected: {biggest.verdict}"
+    return f"rejected: {max(cylinders, key=lambda c: c.cells).verdict}"
 
 
 def weigh_folder(folder: Path, shapes: tuple[str, ...], limit: int | None, seed: int, settings,
@@ -244,7 +330,9 @@ def show(row: dict) -> str:
     lines = [head]
     for c in row["candidates"]:
         tests = "; ".join(f"{name} {value} ({limit}){'' if ok else ' FAIL'}" for name, value, limit, ok in c.tests)
-        lines.append(f"    {c.origin} r {c.radius_mm:.0f} mm, {c.cells} cells, side {c.side:+d}: {c.verdict}"
+        size = f"half-angle {c.size:.0f} deg" if c.origin == "cone" else f"r {c.size:.0f} mm"
+        side = f", side {c.side:+d}" if c.origin in ("fan", "sample") else ""
+        lines.append(f"    {c.origin} {size}, {c.cells} cells{side}: {c.verdict}"
                      f"{'' if c.agrees else ' DIFFERS from the depth stage'} | {tests}")
     return "\n".join(lines)
 
@@ -271,7 +359,7 @@ def write_csv(path: Path, rows: list[dict]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["folder", "frame", "object", "shape", "outcome", "origin", "radius_mm", "cells", "side",
+        w.writerow(["folder", "frame", "object", "shape", "outcome", "origin", "size", "cells", "side",
                     "verdict", "stood", *TESTS])
         for r in rows:
             for c in r["candidates"] or [None]:
@@ -281,7 +369,7 @@ def write_csv(path: Path, rows: list[dict]) -> None:
                     continue
                 got = {name: f"{value} ({limit}){'' if ok else ' FAIL'}" for name, value, limit, ok in c.tests}
                 w.writerow([r["folder"], r["frame"], r["object"], r["shape"], r["outcome"], c.origin,
-                            f"{c.radius_mm:.1f}", c.cells, c.side, c.verdict, c.stood,
+                            f"{c.size:.1f}", c.cells, c.side, c.verdict, c.stood,
                             *[got.get(t, "") for t in TESTS]])
 
 
