@@ -1,11 +1,12 @@
-"""Why a labelled object of a real frame has or lacks a cylindrical face: every cylinder the depth stage weighed on
-its object, and the test each one passed or failed, with the measured value beside the limit.
+"""Why a labelled object of a real frame has or lacks a cylindrical face: every curved surface (sphere, cone,
+cylinder) the depth stage weighed on its object, and the test each one passed or failed, with the measured value
+beside the limit.
 
     .venv/bin/python -m benchmarks.why_curved                                 # cylinders and boxes, every dev folder
     .venv/bin/python -m benchmarks.why_curved ../shared/data/real/ycb-realsense --shapes cylinder
     .venv/bin/python -m benchmarks.why_curved --seed 1 --set curved.trials=1024 --csv out/why_curved.csv
 
-A diagnostic of the cylinder search (lv3d/perception/depth/curved.py), for work on the ``cylinder_read_frac`` and
+A diagnostic of the curved-surface searches (lv3d/perception/depth/quadrics.py and curved.py), for work on the ``cylinder_read_frac`` and
 ``box_curved_frac`` figures of bench_real: a cylinder missed on a can and a cylinder found on a box are both a
 candidate's tests deciding, and which test decides says what to change.
 
@@ -39,8 +40,8 @@ object it prints:
 The outcome of each object: ``cylinder`` (a cylindrical face), ``cone`` / ``sphere`` (such a face and no
 cylinder), ``no room`` (no cylinder candidate, and the planes left no room for the sample consensus),
 ``no candidate`` (it ran and no cylinder reached the tests), ``rejected: TEST`` (cylinder candidates, none stood:
-the test that stopped the one with the most cells) or ``not found``. The summary counts outcomes per shape; ``--csv FILE`` writes a row per candidate.
-Unoccluded objects only (``partial`` no) unless ``--partial``. Where the real frames are absent it says so and
+the test that stopped the one with the most cells) or ``not found``. The summary counts outcomes per shape;
+``--csv FILE`` writes a row per candidate. Unoccluded objects only (``partial`` no) unless ``--partial``. Where the real frames are absent it says so and
 exits 0.
 """
 
