@@ -6,9 +6,9 @@ beside the limit.
     .venv/bin/python -m benchmarks.why_curved ../shared/data/real/ycb-realsense --shapes cylinder
     .venv/bin/python -m benchmarks.why_curved --seed 1 --set curved.trials=1024 --csv out/why_curved.csv
 
-A diagnostic of the curved-surface searches (lv3d/perception/depth/quadrics.py and curved.py), for work on the ``cylinder_read_frac`` and
-``box_curved_frac`` figures of bench_real: a cylinder missed on a can and a cylinder found on a box are both a
-candidate's tests deciding, and which test decides says what to change.
+A diagnostic of the curved-surface searches (lv3d/perception/depth/quadrics.py and curved.py), for work on the
+``cylinder_read_frac`` and ``box_curved_frac`` figures of bench_real: a cylinder missed on a can and a cylinder
+found on a box are both a candidate's tests deciding, and which test decides says what to change.
 
 Every frame of each folder (``--limit N``: the first N) is perceived by the depth stage (lv3d.perception.depth,
 seed ``--seed``, settings with each ``--set KEY=VALUE`` as bench_real takes them); the object of each labelled
@@ -41,8 +41,8 @@ The outcome of each object: ``cylinder`` (a cylindrical face), ``cone`` / ``sphe
 cylinder), ``no room`` (no cylinder candidate, and the planes left no room for the sample consensus),
 ``no candidate`` (it ran and no cylinder reached the tests), ``rejected: TEST`` (cylinder candidates, none stood:
 the test that stopped the one with the most cells) or ``not found``. The summary counts outcomes per shape;
-``--csv FILE`` writes a row per candidate. Unoccluded objects only (``partial`` no) unless ``--partial``. Where the real frames are absent it says so and
-exits 0.
+``--csv FILE`` writes a row per candidate. Unoccluded objects only (``partial`` no) unless ``--partial``. Where
+the real frames are absent it says so and exits 0.
 """
 
 from __future__ import annotations
