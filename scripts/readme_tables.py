@@ -46,6 +46,7 @@ SECTIONS = {
     "### Ablations": ("ablations", "condition"),
     "### Real objects": ("real_objects", "positives"),
     "### Ten classes": ("ten_classes", "noise"),
+    "### Ten classes: learning curve": ("ten_classes_curve", "positives"),
 }
 REPLICATES = "### Seed protocol: replicates"
 NOISE = {"k": "noise_depth", "p": "noise_occlusion", "colour sigma": "noise_color",

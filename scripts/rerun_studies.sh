@@ -3,7 +3,8 @@
 # systems and conditions of the committed reports in experiments/results/, and the seed protocol's four
 # replicates (its lv3d systems on data seeds 1-4; scripts/pooled_replicates.py pools them) and the real-objects
 # study's lv3d systems on perception seeds 1 and 2 (real_objects_pseed1, _pseed2), and the ten-class study's
-# depth systems without arbiters (ten_classes_no_arbiters). Each study's
+# depth systems without arbiters (ten_classes_no_arbiters). The ten-class learning curve shares the ten-class
+# study's images and facts. Each study's
 # baseline fold files are restored from its committed results.csv first (scripts/restore_baselines.py), then
 # `lv3d experiment run` computes the lv3d folds and rewrites the report.
 #
@@ -13,7 +14,8 @@
 # clean and realsense presets; the few-shot study with the lv3d systems, cnn-rgbd, the pretrained networks and
 # the tree; the real-objects study with the tuned CNN at every size (its two parts are joined by
 # `lv3d experiment report`). Three lanes run at once on two cores; the studies of the seed protocol's images
-# share one data cache, which the seed protocol fills before the ablations start. About 75 min on two cores.
+# share one data cache, which the seed protocol fills before the ablations start. About 75 min on two cores, and
+# up to 18 more for the ten-class learning curve (its time alone on two free cores) in the third lane.
 #
 # Then copy each run's results.{csv,md} and plots into experiments/results/<study>/ (the script prints the
 # commands), rewrite the tables of experiments/README.md (scripts/readme_tables.py --write) and its text.
@@ -26,7 +28,7 @@ RUNS=${1:-runs/rerun}
 PY=.venv/bin/python
 LV3D=.venv/bin/lv3d
 mkdir -p "$RUNS"
-CACHE="data.cache=$RUNS/cache"           # the seed protocol's images (and the ten-class ones)
+CACHE="data.cache=$RUNS/cache"           # the seed protocol's images (and the ten-class ones, which two studies share)
 NOISE_CACHE="data.cache=$RUNS/noise_cache"
 REAL_CACHE="data.cache=$RUNS/real_cache"
 TWO_PRESETS="sweep={param: data.noise, values: [clean, realsense]}"
@@ -80,7 +82,7 @@ pids=()
   study learning_curve --set "$CACHE"; study few_shot --set "$CACHE" --set "$FEW_SHOT"; replicate 1; replicate 2 ) & pids+=($!)
 ( for n in noise_depth noise_color noise_occlusion noise_clutter noise_lighting; do study $n --set "$NOISE_CACHE"; done
   real_objects; perception_seed 1; perception_seed 2 ) & pids+=($!)
-( study ten_classes --set "$CACHE"
+( study ten_classes --set "$CACHE"; study ten_classes_curve --set "$CACHE"
   until [ -e "$RUNS/.seed_protocol_done" ]; do sleep 10; done
   study ablations --set "$CACHE"; replicate 3; replicate 4; no_arbiters ) & pids+=($!)
 failed=0
