@@ -103,6 +103,26 @@ class Weighed:
     candidates: list[Candidate] = field(default_factory=list)
 
 
+class _Tests(list):
+    """The tests run on one candidate, each (name, value, limit, passed); called as ``test(name, value, limit,
+    ok)``, it records one and returns whether it passed."""
+
+    def __call__(self, name: str, value: str, limit: str, ok) -> bool:
+        self.append((name, value, limit, bool(ok)))
+        return bool(ok)
+
+
+def _size_and_fit(tests: _Tests, min_cells: int, res: np.ndarray, dist_m: float) -> float | None:
+    """The two tests both searches run first, on a candidate's residuals ``res`` (m,) metres: enough cells
+    (max(20, ``min_cells``)) and an RMS residual within the inlier distance. The RMS where both pass, else None."""
+    need = max(20, min_cells)
+    if not tests("cells", str(len(res)), f">= {need}", len(res) >= need):
+        return None
+    rms = float(np.sqrt(np.mean(res ** 2)))
+    ok = tests("rms", f"{1e3 * rms:.2f} mm", f"<= {1e3 * dist_m:.2f} mm", np.isfinite(rms) and rms <= dist_m)
+    return rms if ok else None
+
+
 def gate_tests(cyl, pts: np.ndarray, nrm: np.ndarray, plane_fit, dist_m: float, min_cells: int, settings,
                side: float) -> list[tuple[str, str, str, bool]]:
     """The acceptance tests of curved._stands on one candidate, in its order, each as (name, value, limit,
@@ -110,45 +130,36 @@ def gate_tests(cyl, pts: np.ndarray, nrm: np.ndarray, plane_fit, dist_m: float, 
     from lv3d.perception.depth import curved
     from lv3d.sphere import algebraic_sphere
 
-    out: list[tuple[str, str, str, bool]] = []
-
-    def test(name: str, value: str, limit: str, ok: bool) -> bool:
-        out.append((name, value, limit, ok))
-        return ok
-
-    need = max(20, min_cells)
-    if not test("cells", str(len(pts)), f">= {need}", len(pts) >= need):
-        return out
-    r, _ = cyl.radial(pts)
-    rms = float(np.sqrt(np.mean((r - cyl.radius) ** 2)))
-    if not test("rms", f"{1e3 * rms:.2f} mm", f"<= {1e3 * dist_m:.2f} mm", rms <= dist_m):
-        return out
+    tests = _Tests()
+    rms = _size_and_fit(tests, min_cells, cyl.radial(pts)[0] - cyl.radius, dist_m)
+    if rms is None:
+        return tests
     if plane_fit is not None:
         on_planes, plane_res = plane_fit
         bin_deg = settings.max_gap_deg / 2
         theirs = curved.misfit(cyl, on_planes, plane_res, bin_deg)
         mine = curved.misfit(cyl, on_planes, side * (cyl.radial(on_planes)[0] - cyl.radius), bin_deg)
-        if not test("misfit", f"{1e3 * mine:.2f} mm", f"<= {settings.misfit_ratio} x {1e3 * theirs:.2f} mm",
-                    mine <= settings.misfit_ratio * theirs):
-            return out
+        if not tests("misfit", f"{1e3 * mine:.2f} mm", f"<= {settings.misfit_ratio} x {1e3 * theirs:.2f} mm",
+                     mine <= settings.misfit_ratio * theirs):
+            return tests
     _, arc, gap = curved.track(cyl, pts, nrm, settings.max_gap_deg / 2, settings.bin_cells)
-    if not test("track", f"arc {arc:.0f} gap {gap:.0f}", f"arc >= {settings.min_arc_deg:g} gap <= "
-                f"{settings.max_gap_deg:g}", arc >= settings.min_arc_deg and gap <= settings.max_gap_deg):
-        return out
+    if not tests("track", f"arc {arc:.0f} gap {gap:.0f}", f"arc >= {settings.min_arc_deg:g} gap <= "
+                 f"{settings.max_gap_deg:g}", arc >= settings.min_arc_deg and gap <= settings.max_gap_deg):
+        return tests
     arc, dip = curved.normal_profile(cyl, nrm, settings.max_gap_deg / 2)
-    if not test("profile", f"arc {arc:.0f} dip {dip:.2f}", f"arc >= {settings.sample_arc_deg:g} dip >= "
-                f"{settings.min_dip:g}", arc >= settings.sample_arc_deg and dip >= settings.min_dip):
-        return out
+    if not tests("profile", f"arc {arc:.0f} dip {dip:.2f}", f"arc >= {settings.sample_arc_deg:g} dip >= "
+                 f"{settings.min_dip:g}", arc >= settings.sample_arc_deg and dip >= settings.min_dip):
+        return tests
     if side < 0:
         sphere = algebraic_sphere(pts)
         if sphere is not None:
             over = curved.explained_share(rms * rms, float(np.mean(sphere.residual(pts) ** 2)))
-            if not test("sphere", "none" if over is None else f"{over:.2f}", f">= {settings.min_share:g}",
-                        over is not None and over >= settings.min_share):
-                return out
+            if not tests("sphere", "none" if over is None else f"{over:.2f}", f">= {settings.min_share:g}",
+                         over is not None and over >= settings.min_share):
+                return tests
     share = curved.curved_share(pts, cyl)
-    test("share", f"{share:.2f}", f">= {settings.min_share:g}", share >= settings.min_share)
-    return out
+    tests("share", f"{share:.2f}", f">= {settings.min_share:g}", share >= settings.min_share)
+    return tests
 
 
 def quadric_tests(model, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarray, dist_m: float, min_cells: int,
@@ -158,52 +169,43 @@ def quadric_tests(model, pts: np.ndarray, nrm: np.ndarray, plane_res: np.ndarray
     from lv3d.perception.depth import quadrics
     from lv3d.sphere import Sphere
 
-    out: list[tuple[str, str, str, bool]] = []
-
-    def test(name: str, value: str, limit: str, ok: bool) -> bool:
-        out.append((name, value, limit, ok))
-        return ok
-
-    need = max(20, min_cells)
-    if not test("cells", str(len(pts)), f">= {need}", len(pts) >= need):
-        return out
+    tests = _Tests()
     res, normal = quadrics._residual_normal(model, pts)
-    rms = float(np.sqrt(np.mean(res ** 2)))
-    if not test("rms", f"{1e3 * rms:.2f} mm", f"<= {1e3 * dist_m:.2f} mm", bool(np.isfinite(rms)) and rms <= dist_m):
-        return out
+    if _size_and_fit(tests, min_cells, res, dist_m) is None:
+        return tests
     turn = float(np.median(np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", normal, nrm), -1.0, 1.0)))))
-    if not test("normals", f"{turn:.1f} deg", f"<= {settings.normal_fit_deg:g} deg", turn <= settings.normal_fit_deg):
-        return out
+    if not tests("normals", f"{turn:.1f} deg", f"<= {settings.normal_fit_deg:g} deg", turn <= settings.normal_fit_deg):
+        return tests
     on_plane = np.isfinite(plane_res)
     if np.count_nonzero(on_plane) >= 20:
         mine = float(np.sqrt(np.mean(res[on_plane] ** 2)))
         theirs = float(np.sqrt(np.mean(plane_res[on_plane] ** 2)))
-        if not test("planes", f"{1e3 * mine:.2f} mm", f"<= {settings.plane_ratio} x {1e3 * theirs:.2f} mm",
-                    mine <= settings.plane_ratio * theirs):
-            return out
+        if not tests("planes", f"{1e3 * mine:.2f} mm", f"<= {settings.plane_ratio} x {1e3 * theirs:.2f} mm",
+                     mine <= settings.plane_ratio * theirs):
+            return tests
     if isinstance(model, Sphere):
         spread = quadrics._spread_deg(nrm)
-        if not test("spread", f"{spread:.1f} deg", f">= {settings.min_spread_deg:g} deg",
-                    spread >= settings.min_spread_deg):
-            return out
+        if not tests("spread", f"{spread:.1f} deg", f">= {settings.min_spread_deg:g} deg",
+                     spread >= settings.min_spread_deg):
+            return tests
         _, vecs = np.linalg.eigh(nrm.T @ nrm)
         over = quadrics._share(float(np.mean(res ** 2)), quadrics.cylinder_ms(pts, vecs[:, 0]))
-        if not test("over cylinder", "none" if over is None else f"{over:.2f}", f">= {settings.min_share:g}",
-                    over is None or over >= settings.min_share):
-            return out
+        if not tests("over cylinder", "none" if over is None else f"{over:.2f}", f">= {settings.min_share:g}",
+                     over is None or over >= settings.min_share):
+            return tests
         share, least = quadrics.sphere_evidence(pts, model), settings.min_share
     else:
         arc, dip = quadrics._azimuth_profile(model.axis, nrm, settings.bin_deg)
-        if not test("profile", f"arc {arc:.0f} dip {dip:.2f}", f"arc >= {settings.min_arc_deg:g} dip >= "
-                    f"{settings.min_dip:g}", arc >= settings.min_arc_deg and dip >= settings.min_dip):
-            return out
+        if not tests("profile", f"arc {arc:.0f} dip {dip:.2f}", f"arc >= {settings.min_arc_deg:g} dip >= "
+                     f"{settings.min_dip:g}", arc >= settings.min_arc_deg and dip >= settings.min_dip):
+            return tests
         plane = quadrics._share(float(np.mean(res ** 2)), quadrics.plane_ms(pts))
-        if not test("over plane", "none" if plane is None else f"{plane:.2f}", f">= {settings.min_share:g}",
-                    plane is not None and plane >= settings.min_share):
-            return out
+        if not tests("over plane", "none" if plane is None else f"{plane:.2f}", f">= {settings.min_share:g}",
+                     plane is not None and plane >= settings.min_share):
+            return tests
         share, least = quadrics.cone_evidence(pts, model), settings.min_cone_share
-    test("share", "none" if share is None else f"{share:.2f}", f">= {least:g}", share is not None and share >= least)
-    return out
+    tests("share", "none" if share is None else f"{share:.2f}", f">= {least:g}", share is not None and share >= least)
+    return tests
 
 
 @contextlib.contextmanager
