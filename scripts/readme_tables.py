@@ -44,6 +44,7 @@ SECTIONS = {
     "### Learning curve": ("learning_curve", "positives"),
     "### Few-shot": ("few_shot", "positives"),
     "### Ablations": ("ablations", "condition"),
+    "### Ablations on real frames": ("real_ablations", "condition"),
     "### Real objects": ("real_objects", "positives"),
     "### Ten classes": ("ten_classes", "noise"),
     "### Ten classes: learning curve": ("ten_classes_curve", "positives"),

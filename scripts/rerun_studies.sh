@@ -13,7 +13,7 @@
 # What the committed reports hold, and so what is passed here: the seed protocol and its replicates at the
 # clean and realsense presets; the few-shot study with the lv3d systems, cnn-rgbd, the pretrained networks and
 # the tree; the real-objects study with the tuned CNN at every size (its two parts are joined by
-# `lv3d experiment report`). Three lanes run at once on two cores; the studies of the seed protocol's images
+# `lv3d experiment report`); the ablations on real frames, lv3d systems only. Three lanes run at once on two cores; the studies of the seed protocol's images
 # share one data cache, which the seed protocol fills before the ablations start. About 75 min on two cores, and
 # up to 18 more for the ten-class learning curve (its time alone on two free cores) in the third lane.
 #
@@ -81,7 +81,7 @@ pids=()
 ( study seed_protocol --set "$CACHE" --set "$TWO_PRESETS"; touch "$RUNS/.seed_protocol_done"
   study learning_curve --set "$CACHE"; study few_shot --set "$CACHE" --set "$FEW_SHOT"; replicate 1; replicate 2 ) & pids+=($!)
 ( for n in noise_depth noise_color noise_occlusion noise_clutter noise_lighting; do study $n --set "$NOISE_CACHE"; done
-  real_objects; perception_seed 1; perception_seed 2 ) & pids+=($!)
+  real_objects; study real_ablations --set "$REAL_CACHE"; perception_seed 1; perception_seed 2 ) & pids+=($!)
 ( study ten_classes --set "$CACHE"; study ten_classes_curve --set "$CACHE"
   until [ -e "$RUNS/.seed_protocol_done" ]; do sleep 10; done
   study ablations --set "$CACHE"; replicate 3; replicate 4; no_arbiters ) & pids+=($!)

@@ -485,6 +485,11 @@ class Study:
     def name(self) -> str:
         return self.base.name
 
+    @property
+    def named_conditions(self) -> bool:
+        """Whether its conditions are named ones (``conditions:``, as ablations are), not a sweep or one base."""
+        return bool(self.merged.get("conditions"))
+
 
 def _expand(cfg: dict, where: str) -> dict[str, dict]:
     sweep, named = cfg.get("sweep"), cfg.get("conditions")

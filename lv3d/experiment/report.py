@@ -197,7 +197,9 @@ def _pct(x: dict) -> str:
     return "–" if math.isnan(x["mean"]) else f"{100 * x['mean']:.1f} ± {100 * x['std']:.1f}"
 
 
-def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
+def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing: list[str] = ()) -> str:
+    """The report: a section per condition, then the lines ``closing`` (a section on all conditions), then the code
+    version the lv3d results were made with."""
     lines = [f"# {name}", "", "Predictive accuracy (%) on the held-out fold, mean ± std over folds. "
              "Class columns: binary class tasks; *mean*: over the class tasks; *balanced*: the class tasks' "
              "balanced accuracy (the mean of the shares right among positives and among negatives; a class task's "
@@ -286,6 +288,7 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str]) -> str:
                 lines += ["", f"{best['a']} against {what} here ({best['b']}, {100 * best['rival_mean']:.1f}): "
                           f"{100 * best['mean_diff']:+.1f} points, 95% interval {100 * lo:+.1f} to {100 * hi:+.1f}."]
         lines.append("")
+    lines += closing
     versions = sorted({v for summ in summaries.values() for per in summ["systems"].values() for v in per.get("code", [])})
     if versions:
         lines.append("lv3d results made with lv3d code version " + ", ".join(f"`{v}`" for v in versions) +
@@ -397,22 +400,72 @@ def _plot_confusion(path: Path, confused: dict[str, dict], classes: list[str], t
     plt.close(fig)
 
 
-def write_report(out: Path, cfg: StudyConfig, conds: dict[str, StudyConfig]) -> dict:
-    """Write results.{csv,json,md} and the plots into ``out``; returns the summaries per condition."""
+def against_first(rows: list[dict], conditions: list[str], systems: list[str]) -> list[dict]:
+    """Each later condition against the first, per system: the paired tests over the (fold, class) cells of binary
+    accuracy both hold (a: the condition, b: the first), and the difference of their multi-class accuracy (mean
+    over folds, each fold's over its draws, as the tables give it; None where either lacks it). ``rows`` are the
+    report's CSV rows. A system whose every cell is the same in both is left out: a baseline the conditions'
+    switches do not reach, whose fold results are reused."""
+    acc: dict = {}
+    for r in rows:
+        acc.setdefault((r["condition"], r["system"]), {})[(r["fold"], r["task"])] = r["accuracy"]
+    out = []
+    first = conditions[0]
+    for s in systems:
+        base = acc.get((first, s), {})
+        for cond in conditions[1:]:
+            mine = acc.get((cond, s), {})
+            common = sorted(k for k in set(base) & set(mine) if k[1] != "multiclass")
+            if not common or all(mine[k] == base[k] for k in set(base) & set(mine)):
+                continue
+            multi = [(mine[k], base[k]) for k in sorted(set(base) & set(mine)) if k[1] == "multiclass"]
+            out.append({"system": s, "condition": cond, "first": first, "cells": len(common),
+                        **paired([mine[k] for k in common], [base[k] for k in common]),
+                        "multiclass_diff": mean_std([a for a, _ in multi])[0] - mean_std([b for _, b in multi])[0]
+                        if multi else None})
+    return out
+
+
+def against_first_markdown(tests: list[dict]) -> list[str]:
+    """The report's section of :func:`against_first` (no lines when there is no test)."""
+    if not tests:
+        return []
+    first = tests[0]["first"]
+    lines = [f"## Each condition against {first}", "",
+             f"Paired tests over (fold, class) cells of binary accuracy, the condition against {first} (condition − "
+             f"{first}; ties dropped), and the difference of multi-class accuracy:", "",
+             "| system | condition | cells | mean diff (pts) | 95% interval (bootstrap) | condition wins | "
+             f"{first} wins | ties | sign p | Wilcoxon p | multi diff (pts) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for t in tests:
+        sg, (lo, hi) = t["sign"], t["ci95"]
+        multi = "–" if t["multiclass_diff"] is None else f"{100 * t['multiclass_diff']:+.1f}"
+        lines.append(f"| {t['system']} | {t['condition']} | {t['cells']} | {100 * t['mean_diff']:+.1f} | "
+                     f"{100 * lo:+.1f} to {100 * hi:+.1f} | {sg['wins']} | {sg['losses']} | {sg['ties']} | "
+                     f"{sg['p']:.4g} | {t['wilcoxon']['p']:.4g} | {multi} |")
+    return lines + [""]
+
+
+def write_report(out: Path, cfg: StudyConfig, conds: dict[str, StudyConfig], compare: bool = False) -> dict:
+    """Write results.{csv,json,md} and the plots into ``out``; returns the summaries per condition. ``compare``
+    (a study of named conditions, such as ablations): each condition is also tested against the first
+    (:func:`against_first`, in results.json's ``against_first`` and a section of results.md)."""
     out = Path(out)
     summaries, rows = {}, []
     for cname, c in conds.items():
         summ, r = summarise(out, c, cname)
         summaries[cname] = summ
         rows += r
+    tests = against_first(rows, list(conds), list(cfg.systems)) if compare and len(conds) > 1 else []
     buf = io.StringIO(newline="")
     w = csv.DictWriter(buf, ["condition", "system", "fold", "task", "accuracy", "balanced_accuracy", "n", "seconds",
                              "tuned"])
     w.writeheader()
     w.writerows(rows)
     write_atomic(out / "results.csv", buf.getvalue())
-    write_atomic(out / "results.json", json.dumps({"name": cfg.name, "conditions": summaries}, indent=1))
+    extra = {"against_first": tests} if tests else {}
+    write_atomic(out / "results.json", json.dumps({"name": cfg.name, "conditions": summaries, **extra}, indent=1))
     classes = list(cfg.data.classes)
-    write_atomic(out / "results.md", markdown(cfg.name, summaries, classes))
+    write_atomic(out / "results.md", markdown(cfg.name, summaries, classes, against_first_markdown(tests)))
     plot(out, summaries, classes)
     return summaries

@@ -310,7 +310,7 @@ def report_study(config: Path, out: Path, overrides: list[str] = ()) -> dict:
         raise InputError(out, "not the work folder of a study (lv3d experiment run writes config.yaml and folds/)")
     with locked(out):
         _write_config(out, study)
-        return write_report(out, study.base, study.conditions)
+        return write_report(out, study.base, study.conditions, compare=study.named_conditions)
 
 
 def _write_config(out: Path, study: Study) -> None:
@@ -377,7 +377,7 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
                 ran += 1
                 bar.update(1)
     bar.close()
-    summary = write_report(out, study.base, conds)
+    summary = write_report(out, study.base, conds, compare=study.named_conditions)
     return {"ran": ran, "skipped": skipped, "report": summary, "learn_failures": failed}
 
 

@@ -100,6 +100,48 @@ def test_baselines_are_trained_once_across_ablation_conditions(tmp_path, tiny_co
     assert res["ran"] == 3 + 3 + 3  # lv3d twice, the tree once
     rec = json.loads((out / "folds" / "no_confidences" / "tree-rgbd" / "fold0.json").read_text())
     assert rec["condition"] == "no_confidences" and rec["reused_from"].startswith("folds/full/")
+    # the tree's folds are reused, the same in both conditions: no test of it against the first
+    assert all(t["system"] != "tree-rgbd" for t in json.loads((out / "results.json").read_text()).get(
+        "against_first", []))
+
+
+def test_named_conditions_are_each_tested_against_the_first(tmp_path, tiny_config, fake_world):
+    out = tmp_path / "named"
+    run_study(tiny_config, out, ["systems=[lv3d-rgbd, tree-rgbd]",
+                                 "conditions={full: {}, one_positive: {train.positives: 1}}"], progress=False)
+    tests = json.loads((out / "results.json").read_text())["against_first"]
+    assert {(t["condition"], t["first"]) for t in tests} == {("one_positive", "full")}
+    rows = _csv(out / "results.csv")
+    for t in tests:
+        cells = {(r["condition"], r["fold"], r["task"]): float(r["accuracy"]) for r in rows
+                 if r["system"] == t["system"] and r["task"] != "multiclass"}
+        diffs = [cells[("one_positive", f, k)] - cells[("full", f, k)] for c, f, k in cells if c == "full"]
+        assert t["cells"] == len(diffs) and math.isclose(t["mean_diff"], sum(diffs) / len(diffs))
+    assert "## Each condition against full" in (out / "results.md").read_text()
+
+
+def test_against_first_leaves_out_a_system_the_same_in_both():
+    from lv3d.experiment.report import against_first, against_first_markdown
+
+    rows = [{"condition": c, "system": s, "fold": f, "task": t, "accuracy": a}
+            for c, shift in (("full", 0.0), ("off", -0.1)) for s in ("lv3d-rgbd", "tree-rgbd") for f in (0, 1)
+            for t, a in (("box", 0.9), ("can", 0.8), ("multiclass", 0.7))
+            for a in [a + (shift if s == "lv3d-rgbd" else 0.0)]]
+    tests = against_first(rows, ["full", "off"], ["lv3d-rgbd", "tree-rgbd"])
+    assert [t["system"] for t in tests] == ["lv3d-rgbd"]
+    assert tests[0]["cells"] == 4 and math.isclose(tests[0]["mean_diff"], -0.1)
+    assert math.isclose(tests[0]["multiclass_diff"], -0.1) and tests[0]["sign"]["losses"] == 4
+    text = "\n".join(against_first_markdown(tests))
+    assert text.startswith("## Each condition against full") and "| lv3d-rgbd | off | 4 | -10.0 |" in text
+    assert against_first_markdown([]) == []
+
+
+def test_a_sweep_is_not_tested_condition_against_condition(tmp_path, tiny_config, fake_world):
+    out = tmp_path / "curve"
+    run_study(tiny_config, out, ["systems=[tree-rgbd]", "sweep={param: train.positives, values: [1, 4]}"],
+              progress=False)
+    assert "against_first" not in json.loads((out / "results.json").read_text())
+    assert "Each condition against" not in (out / "results.md").read_text()
 
 
 def test_learner_settings_reach_the_learner(tmp_path, tiny_config, fake_world):
