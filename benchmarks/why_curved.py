@@ -64,8 +64,9 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.bench_real import _one_core, default_folders, depth_settings, labelled_folder
+from benchmarks.bench_real import _one_core, default_folders, depth_settings
 from lv3d.errors import InputError
+from lv3d.frame_folder import FrameFolder
 
 TESTS = ("cells", "rms", "misfit", "track", "profile", "sphere", "normals", "planes", "spread", "over cylinder",
          "over plane", "share")
@@ -290,8 +291,8 @@ def weigh_folder(folder: Path, shapes: tuple[str, ...], limit: int | None, seed:
     outcome, surfaces and candidates."""
     from lv3d.perception.depth import depth_scene
 
-    ff = labelled_folder(folder)
-    labels = ff.labels()
+    ff = FrameFolder(folder)
+    labels = ff.labels()  # any class: ``shapes`` picks the ones shown
     notes = _notes(folder)
     frames = ff.frames[:limit] if limit else ff.frames
     rows = []
@@ -380,7 +381,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="why_curved.py", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("folders", nargs="*", type=Path, help="folders in the real layout (default: the dev folders)")
-    ap.add_argument("--shapes", default="cylinder,box", help="labelled shapes to show (default cylinder,box)")
+    ap.add_argument("--shapes", default="cylinder,box",
+                    help="the classes of objects.csv to show, any of its words (default cylinder,box)")
     ap.add_argument("--limit", type=int, metavar="N", help="only the first N frames of each folder")
     ap.add_argument("--seed", type=int, default=0, help="perception's seed (default 0)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="overrides",

@@ -38,3 +38,22 @@ def test_a_soup_can_has_its_cylinder_and_every_verdict_is_the_depth_stages(tmp_p
     failed = [r for r in mine if r["verdict"] != "stands"]
     assert failed and all(r["stood"] == "False" and "FAIL" in r[r["verdict"]] for r in failed)
     assert {r["shape"] for r in rows} <= {"cylinder", "box"}
+
+
+@pytest.mark.real
+def test_any_class_of_objects_csv_can_be_shown(tmp_path, capsys):
+    """A folder of the user's own classes (a "can", not one of bench_real's shapes) is read, and --shapes picks."""
+    import shutil
+
+    if not (YCB / "objects.csv").is_file():
+        pytest.skip(f"real YCB frames not found at {YCB} (../shared/data/real/ycb-realsense)")
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    for name in ("pcnn000001_rgb.png", "pcnn000001_depth_mm.png", "intrinsics.json"):
+        shutil.copy(YCB / name, mine / name)
+    rows = [r for r in (YCB / "objects.csv").read_text().splitlines()[1:] if r.startswith("pcnn000001,1,")]
+    (mine / "objects.csv").write_text("frame,object,u,v,shape,partial,stacked,notes\n" +
+                                      rows[0].replace(",cylinder,", ",can,") + "\n")
+    assert why.main([str(mine), "--shapes", "can"]) == 0
+    out = capsys.readouterr().out
+    assert "pcnn000001 object 1 (can: tomato soup can): cylinder;" in out and "can (1): cylinder 1" in out
