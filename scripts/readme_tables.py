@@ -46,6 +46,8 @@ SECTIONS = {
     "### Ablations": ("ablations", "condition"),
     "### Ablations on real frames": ("real_ablations", "condition"),
     "### Real objects": ("real_objects", "positives"),
+    "### Real objects, Kinect table-tops alone": ("real_objects_osd", "positives"),
+    "### Real objects, RealSense clutter alone": ("real_objects_ycb", "positives"),
     "### Ten classes": ("ten_classes", "noise"),
     "### Ten classes: learning curve": ("ten_classes_curve", "positives"),
 }

@@ -13,7 +13,8 @@
 # What the committed reports hold, and so what is passed here: the seed protocol and its replicates at the
 # clean and realsense presets; the few-shot study with the lv3d systems, cnn-rgbd, the pretrained networks and
 # the tree; the real-objects study with the tuned CNN at every size (its two parts are joined by
-# `lv3d experiment report`); the ablations on real frames, lv3d systems only. Three lanes run at once on two cores; the studies of the seed protocol's images
+# `lv3d experiment report`); the ablations on real frames, lv3d systems only; the real-objects study on each
+# folder alone (real_objects_osd, real_objects_ycb: boxes and cylinders, no tuned CNN). Three lanes run at once on two cores; the studies of the seed protocol's images
 # share one data cache, which the seed protocol fills before the ablations start. About 75 min on two cores, and
 # up to 18 more for the ten-class learning curve (its time alone on two free cores) in the third lane.
 #
@@ -63,6 +64,19 @@ perception_seed() {  # perception_seed S: the real-objects study's lv3d systems 
     log "real_objects_pseed$1: $(grep -a 'fold results computed' "$RUNS/real_objects_pseed$1.log" | tail -1)"
 }
 
+per_folder() {  # per_folder NAME FOLDER: the real-objects study on one folder's boxes and cylinders (its baselines restored)
+    local out=$RUNS/real_objects_$1
+    local sets=(--set "$REAL_CACHE" --set "data.folders=[../shared/data/real/$2]" --set "data.classes=[box, cylinder]"
+                --set "systems=[lv3d-rgb,lv3d-depth,lv3d-rgbd,effnet-rgb,effnet-depth,effnet-rgbd,tree-rgbd]"
+                --set baselines.tune=false)
+    {
+        $PY scripts/restore_baselines.py experiments/real_objects.yaml "experiments/results/real_objects_$1/results.csv" \
+            --out "$out" "${sets[@]}"
+        OMP_NUM_THREADS=1 $LV3D experiment run experiments/real_objects.yaml --out "$out" "${sets[@]}"
+    } > "$RUNS/real_objects_$1.log" 2>&1
+    log "real_objects_$1: $(grep -a 'fold results computed' "$RUNS/real_objects_$1.log" | tail -1)"
+}
+
 real_objects() {  # the lv3d systems, the pretrained networks, the tree and the tuned CNN at every size
     local out=$RUNS/real_objects
     local csv=experiments/results/real_objects/results.csv
@@ -81,7 +95,8 @@ pids=()
 ( study seed_protocol --set "$CACHE" --set "$TWO_PRESETS"; touch "$RUNS/.seed_protocol_done"
   study learning_curve --set "$CACHE"; study few_shot --set "$CACHE" --set "$FEW_SHOT"; replicate 1; replicate 2 ) & pids+=($!)
 ( for n in noise_depth noise_color noise_occlusion noise_clutter noise_lighting; do study $n --set "$NOISE_CACHE"; done
-  real_objects; study real_ablations --set "$REAL_CACHE"; perception_seed 1; perception_seed 2 ) & pids+=($!)
+  real_objects; study real_ablations --set "$REAL_CACHE"; per_folder osd osd-learn; per_folder ycb ycb-realsense
+  perception_seed 1; perception_seed 2 ) & pids+=($!)
 ( study ten_classes --set "$CACHE"; study ten_classes_curve --set "$CACHE"
   until [ -e "$RUNS/.seed_protocol_done" ]; do sleep 10; done
   study ablations --set "$CACHE"; replicate 3; replicate 4; no_arbiters ) & pids+=($!)
