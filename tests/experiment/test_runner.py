@@ -40,6 +40,14 @@ def test_run_writes_folds_report_and_programs(tmp_path, tiny_config, fake_world)
     # the margin: the best-seeing lv3d system against the best CNN (the only one here)
     best = summary["against_best_cnn"]
     assert (best["a"], best["b"]) == ("lv3d-rgbd", "cnn-rgb") and "lv3d-rgbd against the best CNN here (cnn-rgb" in md
+    # and in balanced accuracy, which an answer of "no" to everything does not inflate: the perfect learner's
+    # cells are 1, the CNN's its own; the difference is theirs, over the cells both have
+    bal = summary["against_best_cnn_balanced"]
+    cnn = [float(r["balanced_accuracy"]) for r in _csv(out / "results.csv")
+           if r["system"] == "cnn-rgb" and r["task"] != "multiclass" and r["balanced_accuracy"]]
+    assert bal["b"] == "cnn-rgb" and bal["cells"] == len(cnn)
+    assert math.isclose(bal["mean_diff"], 1.0 - sum(cnn) / len(cnn))
+    assert "In balanced accuracy, lv3d-rgbd against the best CNN by it (cnn-rgb" in md
 
 
 def test_balanced_accuracy_of_a_fold_is_the_mean_over_its_class_tasks_that_have_one():
