@@ -174,18 +174,27 @@ def answer_confusion(recs: list[dict]) -> dict | None:
     return {"answers": dict(sorted(answers.items())), "pairs": [[y, a, n] for (y, a), n in pairs]}
 
 
-def _against_best(summary: dict, prefix: str) -> dict | None:
-    """The paired test of the best-seeing lv3d system against the system named ``prefix``* (``cnn-``: the CNNs
-    trained from scratch; ``effnet-``: the pretrained networks) with the highest mean binary accuracy, or None
-    when the study has no such test."""
+def _best_rival(summary: dict, prefix: str, measure: str) -> tuple[str, str] | None:
+    """(the best-seeing lv3d system, the system named ``prefix``* (``cnn-``: the CNNs trained from scratch;
+    ``effnet-``: the pretrained networks) with the highest mean of ``measure``, "mean" (binary accuracy) or
+    "balanced"), or None when the study has no such pair."""
     lv3d = _best_seeing(summary["systems"])
-    rivals = [s for s, per in summary["systems"].items() if s.startswith(prefix) and not math.isnan(per["mean"]["mean"])]
+    rivals = [s for s, per in summary["systems"].items()
+              if s.startswith(prefix) and not math.isnan(per[measure]["mean"])]
     if lv3d is None or not rivals:
         return None
-    best = max(rivals, key=lambda s: summary["systems"][s]["mean"]["mean"])
-    test = next((t for t in summary["tests"] if (t["a"], t["b"]) == (lv3d, best)), None)
-    return None if test is None else {**test, "rival_mean": summary["systems"][best]["mean"]["mean"],
-                                      "cnn_mean": summary["systems"][best]["mean"]["mean"]}
+    return lv3d, max(rivals, key=lambda s: summary["systems"][s][measure]["mean"])
+
+
+def _against_best(summary: dict, prefix: str) -> dict | None:
+    """The paired test of the best-seeing lv3d system against the system named ``prefix``* with the highest mean
+    binary accuracy (:func:`_best_rival`), or None when the study has no such test."""
+    pair = _best_rival(summary, prefix, "mean")
+    test = None if pair is None else next((t for t in summary["tests"] if (t["a"], t["b"]) == pair), None)
+    if test is None:
+        return None
+    rival = summary["systems"][pair[1]]["mean"]["mean"]
+    return {**test, "rival_mean": rival, "cnn_mean": rival}
 
 
 def _against_best_balanced(summary: dict, balanced: dict[str, dict], prefix: str) -> dict | None:
@@ -193,12 +202,10 @@ def _against_best_balanced(summary: dict, balanced: dict[str, dict], prefix: str
     ``prefix``* with the highest mean balanced accuracy, paired over the (fold, class) cells where both have one.
     A class task's test fold is mostly negatives, so a system that answers "no" to nearly everything scores a
     high binary accuracy and a balanced accuracy near 50 %; this comparison is not fooled by it."""
-    lv3d = _best_seeing(summary["systems"])
-    rivals = [s for s, per in summary["systems"].items()
-              if s.startswith(prefix) and not math.isnan(per["balanced"]["mean"])]
-    if lv3d is None or not rivals:
+    pair = _best_rival(summary, prefix, "balanced")
+    if pair is None:
         return None
-    best = max(rivals, key=lambda s: summary["systems"][s]["balanced"]["mean"])
+    lv3d, best = pair
     common = sorted(set(balanced.get(lv3d, {})) & set(balanced.get(best, {})))
     if not common:
         return None
