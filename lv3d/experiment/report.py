@@ -106,6 +106,9 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
         if tuned:
             per["tuned"] = tuned
         summary["systems"][s] = per
+    short = short_draws(out, cfg, condition)
+    if short:
+        summary["short"] = short
     for a, b in cfg.stats.pairs or default_pairs(list(cfg.systems)):
         common = sorted(set(cells[a]) & set(cells[b]))
         if common:
@@ -116,6 +119,27 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
     summary["against_best_cnn_balanced"] = _against_best_balanced(summary, balanced, "cnn-")
     summary["against_best_pretrained_balanced"] = _against_best_balanced(summary, balanced, "effnet-")
     return summary, rows
+
+
+def short_draws(out: Path, cfg: StudyConfig, condition: str) -> dict:
+    """The tasks of a condition whose training folds held fewer examples than it asks (``train.positives`` of the
+    class for a class task; that many of every class for the multi-class task), where a small data set (a folder
+    of a few frames) caps the draw: {task: (fewest drawn, most drawn, asked)} over every system's folds, only the
+    short ones. The draws take what there is (folds.class_task), so the condition's figures are those of fewer."""
+    asked = cfg.train.positives
+    drawn: dict[str, list[int]] = {}
+    for s in cfg.systems:
+        for r in _load(out, condition, s, cfg.folds):
+            for task, sc in r["tasks"].items():
+                n = sc.get("n_train") if task == "multiclass" else sc.get("n_pos")
+                if isinstance(n, int):
+                    drawn.setdefault(task, []).append(n)
+    short = {}
+    for task, ns in drawn.items():
+        want = asked * len(cfg.data.classes) if task == "multiclass" else asked
+        if min(ns) < want:
+            short[task] = (min(ns), max(ns), want)
+    return short
 
 
 def _multiclass_draws(r: dict) -> list[list]:
@@ -245,6 +269,16 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing:
             cols = [_pct(per["classes"][c]) for c in classes]
             lines.append(f"| {s} | " + " | ".join(cols) + f" | {_pct(per['mean'])} | {_pct(per['balanced'])} | "
                          f"{_pct(per['classes']['multiclass'])} | {per['folds_done']} | {per['errors']} |")
+        short = summ.get("short")
+        if short:
+            def _drawn(task: str) -> str:
+                lo, hi, want = short[task]
+                n = f"{lo}" if lo == hi else f"{lo}-{hi}"
+                what = "examples in all" if task == "multiclass" else "positives"
+                return f"{task} {n} {what} of the {want} asked"
+            lines += ["", "Fewer training examples than this condition asks (the training folds hold fewer; a "
+                      "draw takes what there is, so these figures are those of fewer): " +
+                      "; ".join(_drawn(t) for t in sorted(short)) + "."]
         if summ["tests"]:
             lines += ["", "Paired tests over (fold, class) cells of binary accuracy (a − b; ties dropped):", "",
                       "| a | b | cells | mean diff (pts) | 95% interval (bootstrap) | a wins | b wins | ties | sign p "

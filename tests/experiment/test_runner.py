@@ -50,6 +50,22 @@ def test_run_writes_folds_report_and_programs(tmp_path, tiny_config, fake_world)
     assert "In balanced accuracy, lv3d-rgbd against the best CNN by it (cnn-rgb" in md
 
 
+def test_a_condition_asking_more_examples_than_the_training_folds_hold_says_so(tmp_path, tiny_config, fake_world):
+    # 6 images a class in 3 folds: the training folds hold 4 of each, so 6 positives draw 4 (a folder of a few
+    # frames caps a learning curve the same way); the report names the tasks and what was drawn
+    out = tmp_path / "short"
+    run_study(tiny_config, out, ["systems=[lv3d-rgbd, tree-rgbd]", "sweep={param: train.positives, values: [4, 6]}"],
+              progress=False)
+    conds = json.loads((out / "results.json").read_text())["conditions"]
+    assert "short" not in conds["positives=4"]
+    assert conds["positives=6"]["short"] == {"cube": [4, 4, 6], "square_pyramid": [4, 4, 6],
+                                             "triangular_prism": [4, 4, 6], "multiclass": [12, 12, 18]}
+    md = (out / "results.md").read_text()
+    section = md[md.index("## positives=6"):]
+    assert md.count("Fewer training examples") == 1 and "Fewer training examples" in section
+    assert "cube 4 positives of the 6 asked" in section and "multiclass 12 examples in all of the 18 asked" in section
+
+
 def test_balanced_accuracy_of_a_fold_is_the_mean_over_its_class_tasks_that_have_one():
     from lv3d.experiment.report import _mean_balanced
 
