@@ -113,8 +113,16 @@ def test_learn_fit_predict_and_explain_on_a_folder_of_frames(frames, tmp_path, c
     assert list(cache.rglob("*.json"))  # the frames' facts are cached: a second command reads them
     assert main(["learn", "predict", *args, "--model", str(model)]) == 0
     out = capsys.readouterr().out
-    rows = [line.split("\t") for line in out.splitlines()[:-1]]
+    rows = [line.split("\t") for line in out.splitlines() if "\t" in line]
     assert len(rows) == 6 and out.splitlines()[-1].startswith("accuracy ")
+    assert out.splitlines()[-2].startswith("per class: box ")
+    # a model of some of the folder's classes: the others' examples are answered, and left out of its accuracy
+    assert main(["learn", "fit", *args, "--classes", "box", "--out", str(tmp_path / "box_only")]) == 0
+    capsys.readouterr()
+    assert main(["learn", "predict", *args, "--model", str(tmp_path / "box_only")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert "left out of the accuracy, of classes the model holds no program for: prism 3 (its classes: box)" in lines
+    assert lines[-1].startswith("accuracy ") and lines[-1].split()[1].endswith("/3")
     assert all(r[2] == "box" for r in rows if r[1] == "box")  # every box is proved a box
     ex = f"{scene_atom('frame-002')}_x1"
     assert main(["learn", "explain", *args, "--model", str(model), "--example", ex]) == 0

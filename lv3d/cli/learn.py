@@ -4,6 +4,8 @@ docs/real_frames.md)."""
 
 from __future__ import annotations
 
+from collections import Counter
+
 import json
 from pathlib import Path
 
@@ -247,11 +249,15 @@ def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path 
 @click.option("--model", "model_dir", type=click.Path(path_type=Path), required=True)
 @click.option("--explain/--no-explain", default=False, help="print each answer's proof")
 def predict(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path, explain: bool):
-    """Classify every example of a data set or folder with saved programs; print accuracy. An example where
-    perception found no object is answered "unknown" (and counts as wrong)."""
+    """Classify every example of a data set or folder with saved programs; print accuracy, over the examples of
+    the classes the model holds a program for, and each class's. An example where perception found no object
+    is answered "unknown" (and counts as wrong); examples of other classes are answered but left out of the
+    accuracy (the model cannot name them), and counted."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir)
-    correct = 0
+    held = set(model.programs)
+    right: Counter = Counter()
+    seen: Counter = Counter()
     for s, y in zip(scenes, labels):
         if s.target is None:
             label, conf = "unknown", 0.0
@@ -263,8 +269,17 @@ def predict(data: Path, modality: str, facts: str | None, cache: Path | None, mo
         else:
             label, conf = model.predict(s)
             click.echo(f"{s.scene}\t{y}\t{label}\t{conf:.3f}")
-        correct += label == y
-    click.echo(f"accuracy {correct}/{len(scenes)} = {correct / len(scenes):.3f}")
+        seen[y] += 1
+        right[y] += label == y
+    others = {y: n for y, n in sorted(seen.items()) if y not in held}
+    n = sum(seen[y] for y in held)
+    if others:
+        click.echo("left out of the accuracy, of classes the model holds no program for: " +
+                   ", ".join(f"{y} {k}" for y, k in others.items()) + f" (its classes: {', '.join(sorted(held))})")
+    click.echo("per class: " + ", ".join(f"{y} {right[y]}/{seen[y]}" for y in sorted(held) if seen[y]))
+    correct = sum(right[y] for y in held)
+    click.echo(f"accuracy {correct}/{n} = {correct / n:.3f}" if n else
+               "accuracy: none of the examples is of a class the model holds a program for")
 
 
 @learn.command()
