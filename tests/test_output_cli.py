@@ -108,3 +108,15 @@ def test_demo_refuses_a_folder_of_the_users(tmp_path, capsys):
     before = _snapshot(tmp_path)
     _refused(main(["demo", "--out", str(tmp_path)]), capsys, "--out", MARKER)
     assert _snapshot(tmp_path) == before
+
+
+def test_the_demo_runs_end_to_end_on_data_it_makes(tmp_path, capsys):
+    # `make demo`'s command at its smallest: it renders, learns, compares, explains and writes what it says
+    out = tmp_path / "demo"
+    assert main(["demo", "--out", str(out), "--per-class", "2", "--train", "1",
+                 "--systems", "lv3d-depth,tree-rgbd", "--no-real"]) == 0
+    said = capsys.readouterr().out
+    assert "lv3d-depth:" in said and "tree-rgbd:" in said and "Why lv3d-depth says" in said
+    results = json.loads((out / "results.json").read_text())
+    assert set(results["accuracy"]) == {"lv3d-depth", "tree-rgbd"} and len(results["test"]) == 4
+    assert (out / "accuracy.png").is_file() and list((out / "programs" / "lv3d-depth").glob("*.pl"))
