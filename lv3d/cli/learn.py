@@ -4,9 +4,8 @@ docs/real_frames.md)."""
 
 from __future__ import annotations
 
-from collections import Counter
-
 import json
+from collections import Counter
 from pathlib import Path
 
 import click

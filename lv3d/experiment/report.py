@@ -53,8 +53,10 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
     rows, summary = [], {"systems": {}, "tests": []}
     cells: dict[str, dict[tuple[int, str], float]] = {}
     balanced: dict[str, dict[tuple[int, str], float]] = {}  # the same cells' balanced accuracy, where they have one
+    loaded = []  # every system's fold records
     for s in cfg.systems:
         recs = _load(out, condition, s, cfg.folds)
+        loaded += recs
         cells[s], balanced[s] = {}, {}
         per = {"folds_done": len(recs), "classes": {}, "errors": 0, "learn_failures": 0, "learn_failure_examples": []}
         for r in recs:
@@ -106,7 +108,7 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
         if tuned:
             per["tuned"] = tuned
         summary["systems"][s] = per
-    short = short_draws(out, cfg, condition)
+    short = short_draws(loaded, cfg.train.positives, len(classes))
     if short:
         summary["short"] = short
     for a, b in cfg.stats.pairs or default_pairs(list(cfg.systems)):
@@ -121,25 +123,35 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
     return summary, rows
 
 
-def short_draws(out: Path, cfg: StudyConfig, condition: str) -> dict:
-    """The tasks of a condition whose training folds held fewer examples than it asks (``train.positives`` of the
-    class for a class task; that many of every class for the multi-class task), where a small data set (a folder
-    of a few frames) caps the draw: {task: (fewest drawn, most drawn, asked)} over every system's folds, only the
-    short ones. The draws take what there is (folds.class_task), so the condition's figures are those of fewer."""
-    asked = cfg.train.positives
+def short_draws(records: list[dict], asked: int, n_classes: int) -> dict:
+    """The tasks of a condition's fold ``records`` whose training folds held fewer examples than it asks
+    (``asked`` positives of the class for a class task; that many of each of the ``n_classes`` classes for the
+    multi-class task), where a small data set (a folder of a few frames) caps the draw: {task: (fewest drawn,
+    most drawn, asked)} over the records, the short tasks only. The draws take what there is
+    (folds.class_task), so the condition's figures are those of fewer."""
     drawn: dict[str, list[int]] = {}
-    for s in cfg.systems:
-        for r in _load(out, condition, s, cfg.folds):
-            for task, sc in r["tasks"].items():
-                n = sc.get("n_train") if task == "multiclass" else sc.get("n_pos")
-                if isinstance(n, int):
-                    drawn.setdefault(task, []).append(n)
+    for r in records:
+        for task, sc in r["tasks"].items():
+            n = sc.get("n_train") if task == "multiclass" else sc.get("n_pos")
+            if isinstance(n, int):
+                drawn.setdefault(task, []).append(n)
     short = {}
     for task, ns in drawn.items():
-        want = asked * len(cfg.data.classes) if task == "multiclass" else asked
+        want = asked * n_classes if task == "multiclass" else asked
         if min(ns) < want:
             short[task] = (min(ns), max(ns), want)
     return short
+
+
+def _short_text(short: dict) -> str:
+    """The line a report gives a condition with :func:`short_draws`."""
+    parts = []
+    for task in sorted(short):
+        lo, hi, want = short[task]
+        what = "examples in all" if task == "multiclass" else "positives"
+        parts.append(f"{task} {lo if lo == hi else f'{lo}-{hi}'} {what} of the {want} asked")
+    return ("Fewer training examples than this condition asks (the training folds hold fewer; a draw takes what "
+            "there is, so these figures are those of fewer): " + "; ".join(parts) + ".")
 
 
 def _multiclass_draws(r: dict) -> list[list]:
@@ -269,16 +281,8 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing:
             cols = [_pct(per["classes"][c]) for c in classes]
             lines.append(f"| {s} | " + " | ".join(cols) + f" | {_pct(per['mean'])} | {_pct(per['balanced'])} | "
                          f"{_pct(per['classes']['multiclass'])} | {per['folds_done']} | {per['errors']} |")
-        short = summ.get("short")
-        if short:
-            def _drawn(task: str) -> str:
-                lo, hi, want = short[task]
-                n = f"{lo}" if lo == hi else f"{lo}-{hi}"
-                what = "examples in all" if task == "multiclass" else "positives"
-                return f"{task} {n} {what} of the {want} asked"
-            lines += ["", "Fewer training examples than this condition asks (the training folds hold fewer; a "
-                      "draw takes what there is, so these figures are those of fewer): " +
-                      "; ".join(_drawn(t) for t in sorted(short)) + "."]
+        if summ.get("short"):
+            lines += ["", _short_text(summ["short"])]
         if summ["tests"]:
             lines += ["", "Paired tests over (fold, class) cells of binary accuracy (a − b; ties dropped):", "",
                       "| a | b | cells | mean diff (pts) | 95% interval (bootstrap) | a wins | b wins | ties | sign p "
