@@ -9,6 +9,7 @@
 | bench_real | perception + grounding on the real frames of ../shared/data/real (the arbiter) | 3 frames a folder | every frame |
 | bench_creases | the crease cut's h-maxima against scikit-image's on the real frames: ms and same cells | 3 frames a folder | every frame |
 | bench_frame_size | the real frames at twice their size, read at perception's working size, against the frames as they are | 2 frames a folder | 8 |
+| bench_mirror | the real frames mirrored left to right against the frames as they are (frames perception has not seen) | 2 frames a folder | every frame |
 | bench_perception | perception on rendered scenes, every noise preset | 2 scenes a class, 2 presets | 5 a class |
 | bench_curved | cylinders, cones and spheres as faces of their kind; boxes without curved faces (rendered) | 3 scenes a class | 10 a class |
 | bench_grounding | refinement error, fact calibration, ms per frame | 2 scenes a class, 1 speed run | 6 a class |
@@ -22,7 +23,7 @@
 Each runs as ``python -m benchmarks.NAME`` in a process of its own, from the repository root; rendered data
 and DEV sets go under ``--work`` (default out/bench) and are reused by the next run. Exit status: 0 when
 every benchmark ran, else that of the first that failed. Without real frames under ../shared/data/real,
-bench_real, bench_creases and bench_frame_size are skipped with a message.
+bench_real, bench_creases, bench_frame_size and bench_mirror are skipped with a message.
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 REAL = ROOT.parent / "shared" / "data" / "real"
+REAL_FRAMES = ("bench_real", "bench_creases", "bench_frame_size", "bench_mirror")  # these read ../shared/data/real
 LEARNER_SEED = 778  # bench_learner's default DEV seed: bench_pipeline_accuracy reads the sets it made
 
 
@@ -47,6 +49,7 @@ def commands(quick: bool, work: Path, json_dir: Path | None) -> list[tuple[str, 
         ("bench_real", real),
         ("bench_creases", ["--limit", "3"] if quick else []),
         ("bench_frame_size", ["--limit", "2"] if quick else []),
+        ("bench_mirror", ["--limit", "2"] if quick else []),
         ("bench_perception", ["--quick"] if quick else ["--per-class", "5"]),
         ("bench_curved", ["--quick"] if quick else []),
         ("bench_grounding", ["--quick", "--speed-runs", "1", "--speed-frames", "4"] if quick else []),
@@ -82,7 +85,7 @@ def main(argv=None) -> int:
         todo = [(name, argv_) for name, argv_ in todo if name in wanted]
     status = 0
     for name, extra in todo:
-        if name in ("bench_real", "bench_creases", "bench_frame_size") and not has_real_frames():
+        if name in REAL_FRAMES and not has_real_frames():
             print(f"run_all: no real frames with objects.csv under {REAL}: {name} skipped", flush=True)
             continue
         cmd = [sys.executable, "-m", f"benchmarks.{name}", *extra]

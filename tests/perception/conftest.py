@@ -1,4 +1,7 @@
-"""Small scenes made by the test code itself: a box on a table, ray-cast analytically."""
+"""Small scenes made by the test code itself: a box on a table, ray-cast analytically; a folder of rendered frames
+in the real-frame layout."""
+
+import json
 
 import cv2
 import numpy as np
@@ -99,3 +102,28 @@ def sliver_box(with_sliver: bool = True, table: bool = False) -> np.ndarray:
 def mask_iou(a: np.ndarray, b: np.ndarray) -> float:
     """Intersection over union of two (H, W) bool masks."""
     return float(np.count_nonzero(a & b) / np.count_nonzero(a | b))
+
+
+@pytest.fixture(scope="session")
+def real_layout(tmp_path_factory):
+    """A folder in the real-frame layout (docs/real_frames.md) of two rendered RealSense frames, a cube and a
+    cylinder, with masks and one labelled object each."""
+    from lv3d.render.frame import render_scene
+
+    f = tmp_path_factory.mktemp("real") / "frames"
+    f.mkdir()
+    intr = {"width": 640, "height": 480, "frames": {}}
+    rows = ["frame,object,u,v,shape,partial,stacked,notes"]
+    for i, cls in enumerate(["cube", "cylinder"]):
+        frame, faces = render_scene(cls, 30 + i, "realsense")
+        name = f"f{i}"
+        cv2.imwrite(str(f / f"{name}_rgb.png"), cv2.cvtColor(frame.color, cv2.COLOR_RGB2BGR))
+        cv2.imwrite(str(f / f"{name}_depth_mm.png"), np.round(frame.depth * 1000).astype(np.uint16))
+        cv2.imwrite(str(f / f"{name}_label.png"), (faces > 0).astype(np.uint16))
+        k = frame.intrinsics
+        intr["frames"][name] = {"fx": k.fx, "fy": k.fy, "cx": k.cx, "cy": k.cy, "depth_scale_m": 0.001}
+        v, u = np.nonzero(faces)
+        rows.append(f"{name},1,{int(np.median(u))},{int(np.median(v))},{'box' if cls == 'cube' else 'cylinder'},no,no,")
+    (f / "intrinsics.json").write_text(json.dumps(intr))
+    (f / "objects.csv").write_text("\n".join(rows) + "\n")
+    return f

@@ -1,0 +1,101 @@
+"""A real folder and the same frames mirrored left to right, through bench_real, side by side.
+
+    .venv/bin/python -m benchmarks.bench_mirror                                  # osd-learn and ycb-realsense
+    .venv/bin/python -m benchmarks.bench_mirror --modalities rgbd --seed 0,1,2   # pooled over perception seeds
+    .venv/bin/python -m benchmarks.bench_mirror ../shared/data/real/ycb-realsense --limit 5
+
+The figures of bench_real are measured on the dev frames, and the same code is judged on frames it was never
+shown. A mirrored frame is such a frame with nothing else changed: the same scene, sensor, noise and labels,
+seen as in a mirror (an object's left is its right), so every quantity perception measures has its mirror
+twin, and a figure that holds on the frames and not on their mirror images holds by luck of the frames (which
+way a sample consensus or a scan order happens to break a tie), not by what perception reads. The colour,
+depth and label images of each folder's first ``--limit`` frames (all by default) are flipped left to right into
+a temporary folder, the principal point and the labelled pixels with them (u -> W - 1 - u), both folders go
+through bench_real with the same ``--modalities`` and ``--seed``, and benchmarks.compare_real sets the two runs
+side by side, pooled and per folder. Exit status: 0, or 2 with one line naming what is wrong.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import cv2
+
+from benchmarks import bench_real, compare_real
+from lv3d.errors import InputError
+from lv3d.frame_folder import FrameFolder
+from lv3d.rgbd import read_intrinsics
+
+
+def mirror(folder: Path, out: Path, limit: int | None) -> Path:
+    """``folder``'s first ``limit`` frames (natural order; all with None), each flipped left to right, written to
+    ``out`` in the same layout with the intrinsics and labelled pixels to match; returns ``out``."""
+    ff = FrameFolder(folder)
+    frames = ff.frames[:limit] if limit else ff.frames
+    out.mkdir(parents=True)
+    intr: dict = {"frames": {}}
+    widths = {}
+    for name in frames:
+        k, scale = read_intrinsics(folder / "intrinsics.json", name)
+        images = [*ff.files[name], folder / f"{name}_label.png"]
+        for path in images:
+            if path.is_file():
+                cv2.imwrite(str(out / path.name), cv2.flip(cv2.imread(str(path), cv2.IMREAD_UNCHANGED), 1))
+        # pixel u of a row is pixel W - 1 - u of the flipped row; the camera is the original's seen in a mirror
+        intr["frames"][name] = {"fx": k.fx, "fy": k.fy, "cx": k.width - 1 - k.cx, "cy": k.cy, "width": k.width,
+                                "height": k.height, "depth_scale_m": scale}
+        widths[name] = k.width
+    (out / "intrinsics.json").write_text(json.dumps(intr, indent=1))
+    rows = list(csv.reader((folder / "objects.csv").read_text(encoding="utf-8-sig").splitlines()))
+    header = [c.strip() for c in rows[0]]
+    iu, iframe = header.index("u"), header.index("frame")
+    with (out / "objects.csv").open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(rows[0])
+        for cells in rows[1:]:
+            if len(cells) > max(iu, iframe) and cells[iframe].strip() in widths:
+                cells[iu] = str(widths[cells[iframe].strip()] - 1 - int(cells[iu]))
+                w.writerow(cells)
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="bench_mirror.py", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("folders", nargs="*", type=Path, help="folders in the real layout (default: bench_real's)")
+    ap.add_argument("--limit", type=int, metavar="N", help="the first N frames of each folder (default: all)")
+    ap.add_argument("--modalities", default="depth,rgbd", help="bench_real's --modalities (default depth,rgbd)")
+    ap.add_argument("--seed", default="0", metavar="S[,S...]", help="bench_real's perception seeds (default 0)")
+    args = ap.parse_args(argv)
+    if args.limit is not None and args.limit < 1:
+        ap.error("--limit must be at least 1")
+    folders = args.folders or bench_real.default_folders()
+    if not folders:
+        print(f"bench_mirror.py: error: {bench_real.REAL}: no folder with objects.csv (name folders on the "
+              "command line)", file=sys.stderr)
+        return 2
+    with tempfile.TemporaryDirectory(prefix="lv3d-mirror-") as tmp:
+        tmp = Path(tmp)
+        try:
+            mirrored = [mirror(f, tmp / f.name, args.limit) for f in folders]
+        except (InputError, OSError, ValueError) as e:
+            print(f"bench_mirror.py: error: {e}", file=sys.stderr)
+            return 2
+        common = ["--modalities", args.modalities, "--seed", args.seed] + (["--limit", str(args.limit)]
+                                                                           if args.limit else [])
+        for name, fs, out in (("as they are", folders, tmp / "a.json"), ("mirrored", mirrored, tmp / "b.json")):
+            print(f"#### the frames {name}")
+            rc = bench_real.main([str(f) for f in fs] + common + ["--json", str(out)])
+            if rc:
+                return rc
+        print("#### A: the frames as they are, B: mirrored")
+        return compare_real.main([str(tmp / "a.json"), str(tmp / "b.json"), "--folders"])
+
+
+if __name__ == "__main__":
+    sys.exit(main())
