@@ -20,7 +20,6 @@ Exit status: 0, or 2 with one line naming what is wrong.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
 import tempfile
@@ -30,6 +29,7 @@ import cv2
 import numpy as np
 
 from benchmarks import bench_real, compare_real
+from benchmarks.frame_copies import copy_objects
 from lv3d import rgbd
 from lv3d.errors import InputError
 from lv3d.frame_folder import FrameFolder
@@ -59,16 +59,7 @@ def enlarge(folder: Path, out: Path, factor: int, limit: int | None) -> Path:
         intr["frames"][name] = {"fx": k.fx * factor, "fy": k.fy * factor, "cx": k.cx * factor, "cy": k.cy * factor,
                                 "width": k.width * factor, "height": k.height * factor, "depth_scale_m": scale}
     (out / "intrinsics.json").write_text(json.dumps(intr, indent=1))
-    rows = list(csv.reader((folder / "objects.csv").read_text(encoding="utf-8-sig").splitlines()))
-    header = [c.strip() for c in rows[0]]
-    iu, iv, iframe = header.index("u"), header.index("v"), header.index("frame")
-    with (out / "objects.csv").open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(rows[0])
-        for cells in rows[1:]:
-            if len(cells) > max(iu, iv, iframe) and cells[iframe].strip() in frames:
-                cells[iu], cells[iv] = str(int(cells[iu]) * factor), str(int(cells[iv]) * factor)
-                w.writerow(cells)
+    copy_objects(folder, out, frames, lambda _name, u, v: (u * factor, v * factor))
     return out
 
 
@@ -85,14 +76,10 @@ def main(argv=None) -> int:
         ap.error("--factor must be at least 2")
     if args.limit < 1:
         ap.error("--limit must be at least 1")
-    folders = args.folders or bench_real.default_folders()
-    if not folders:
-        print(f"bench_frame_size.py: error: {bench_real.REAL}: no folder with objects.csv (name folders on the "
-              "command line)", file=sys.stderr)
-        return 2
     with tempfile.TemporaryDirectory(prefix="lv3d-frame-size-") as tmp:
         tmp = Path(tmp)
         try:
+            folders = bench_real.folders_to_run(args.folders)
             large = [enlarge(f, tmp / f"{f.name}_x{args.factor}", args.factor, args.limit) for f in folders]
         except (InputError, OSError, ValueError) as e:
             print(f"bench_frame_size.py: error: {e}", file=sys.stderr)

@@ -18,7 +18,6 @@ side by side, pooled and per folder. Exit status: 0, or 2 with one line naming w
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
 import tempfile
@@ -27,6 +26,7 @@ from pathlib import Path
 import cv2
 
 from benchmarks import bench_real, compare_real
+from benchmarks.frame_copies import copy_objects
 from lv3d.errors import InputError
 from lv3d.frame_folder import FrameFolder
 from lv3d.rgbd import read_intrinsics
@@ -51,16 +51,7 @@ def mirror(folder: Path, out: Path, limit: int | None) -> Path:
                                 "height": k.height, "depth_scale_m": scale}
         widths[name] = k.width
     (out / "intrinsics.json").write_text(json.dumps(intr, indent=1))
-    rows = list(csv.reader((folder / "objects.csv").read_text(encoding="utf-8-sig").splitlines()))
-    header = [c.strip() for c in rows[0]]
-    iu, iframe = header.index("u"), header.index("frame")
-    with (out / "objects.csv").open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(rows[0])
-        for cells in rows[1:]:
-            if len(cells) > max(iu, iframe) and cells[iframe].strip() in widths:
-                cells[iu] = str(widths[cells[iframe].strip()] - 1 - int(cells[iu]))
-                w.writerow(cells)
+    copy_objects(folder, out, frames, lambda name, u, v: (widths[name] - 1 - u, v))
     return out
 
 
@@ -74,14 +65,10 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.limit is not None and args.limit < 1:
         ap.error("--limit must be at least 1")
-    folders = args.folders or bench_real.default_folders()
-    if not folders:
-        print(f"bench_mirror.py: error: {bench_real.REAL}: no folder with objects.csv (name folders on the "
-              "command line)", file=sys.stderr)
-        return 2
     with tempfile.TemporaryDirectory(prefix="lv3d-mirror-") as tmp:
         tmp = Path(tmp)
         try:
+            folders = bench_real.folders_to_run(args.folders)
             mirrored = [mirror(f, tmp / f.name, args.limit) for f in folders]
         except (InputError, OSError, ValueError) as e:
             print(f"bench_mirror.py: error: {e}", file=sys.stderr)

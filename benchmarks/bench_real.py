@@ -810,6 +810,14 @@ def default_folders() -> list[Path]:
     return sorted(p for p in REAL.iterdir() if (p / "objects.csv").is_file()) if REAL.is_dir() else []
 
 
+def folders_to_run(folders: list[Path]) -> list[Path]:
+    """``folders``, or else :func:`default_folders`; an InputError naming REAL where that is none."""
+    folders = folders or default_folders()
+    if not folders:
+        raise InputError(REAL, "no folder with objects.csv (name folders on the command line)")
+    return folders
+
+
 def _seeds(s: str) -> tuple[int, ...]:
     try:
         return seed_list(s)
@@ -858,10 +866,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.limit is not None and args.limit < 1:
         ap.error("--limit must be at least 1")
-    folders = args.folders or default_folders()
     try:
-        if not folders:
-            raise InputError(REAL, "no folder with objects.csv (name folders on the command line)")
+        folders = folders_to_run(args.folders)
         for folder in folders:
             labelled_folder(folder)
         settings = depth_settings(args.set) if args.set else None
