@@ -3,6 +3,7 @@
     .venv/bin/python -m benchmarks.bench_mirror                                  # osd-learn and ycb-realsense
     .venv/bin/python -m benchmarks.bench_mirror --modalities rgbd --seed 0,1,2   # pooled over perception seeds
     .venv/bin/python -m benchmarks.bench_mirror ../shared/data/real/ycb-realsense --limit 5
+    .venv/bin/python -m benchmarks.bench_mirror --flip both                      # upside down: a camera turned over
 
 The figures of bench_real are measured on the dev frames, and the same code is judged on frames it was never
 shown. A mirrored frame is such a frame with nothing else changed: the same scene, sensor, noise and labels,
@@ -12,7 +13,10 @@ way a sample consensus or a scan order happens to break a tie), not by what perc
 depth and label images of each folder's first ``--limit`` frames (all by default) are flipped left to right into
 a temporary folder, the principal point and the labelled pixels with them (u -> W - 1 - u), both folders go
 through bench_real with the same ``--modalities`` and ``--seed``, and benchmarks.compare_real sets the two runs
-side by side, pooled and per folder. Exit status: 0, or 2 with one line naming what is wrong.
+side by side, pooled and per folder. ``--flip up-down`` mirrors top to bottom instead, and ``--flip both``
+turns the frames upside down (a camera mounted the other way up; v -> H - 1 - v as well): not the same scenes
+as seen by an upright camera, since perception takes the support plane among the planes facing up in the image.
+Exit status: 0, or 2 with one line naming what is wrong.
 """
 
 from __future__ import annotations
@@ -32,26 +36,35 @@ from lv3d.frame_folder import FrameFolder
 from lv3d.rgbd import read_intrinsics
 
 
-def mirror(folder: Path, out: Path, limit: int | None) -> Path:
-    """``folder``'s first ``limit`` frames (natural order; all with None), each flipped left to right, written to
-    ``out`` in the same layout with the intrinsics and labelled pixels to match; returns ``out``."""
+FLIPS = {"left-right": 1, "up-down": 0, "both": -1}  # cv2.flip's codes
+
+
+def mirror(folder: Path, out: Path, limit: int | None, flip: str = "left-right") -> Path:
+    """``folder``'s first ``limit`` frames (natural order; all with None), each flipped as ``flip`` says (a key of
+    FLIPS), written to ``out`` in the same layout with the intrinsics and labelled pixels to match; returns
+    ``out``."""
+    code = FLIPS[flip]
+    across, down = code != 0, code != 1  # whether u, v run the other way
     ff = FrameFolder(folder)
     frames = ff.frames[:limit] if limit else ff.frames
     out.mkdir(parents=True)
     intr: dict = {"frames": {}}
-    widths = {}
+    sizes = {}
     for name in frames:
         k, scale = read_intrinsics(folder / "intrinsics.json", name)
         images = [*ff.files[name], folder / f"{name}_label.png"]
         for path in images:
             if path.is_file():
-                cv2.imwrite(str(out / path.name), cv2.flip(cv2.imread(str(path), cv2.IMREAD_UNCHANGED), 1))
-        # pixel u of a row is pixel W - 1 - u of the flipped row; the camera is the original's seen in a mirror
-        intr["frames"][name] = {"fx": k.fx, "fy": k.fy, "cx": k.width - 1 - k.cx, "cy": k.cy, "width": k.width,
+                cv2.imwrite(str(out / path.name), cv2.flip(cv2.imread(str(path), cv2.IMREAD_UNCHANGED), code))
+        # pixel u of a row is pixel W - 1 - u of the flipped row (v of a column H - 1 - v): the original camera
+        # seen in a mirror, or turned over
+        intr["frames"][name] = {"fx": k.fx, "fy": k.fy, "cx": k.width - 1 - k.cx if across else k.cx,
+                                "cy": k.height - 1 - k.cy if down else k.cy, "width": k.width,
                                 "height": k.height, "depth_scale_m": scale}
-        widths[name] = k.width
+        sizes[name] = (k.width, k.height)
     (out / "intrinsics.json").write_text(json.dumps(intr, indent=1))
-    copy_objects(folder, out, frames, lambda name, u, v: (widths[name] - 1 - u, v))
+    copy_objects(folder, out, frames, lambda name, u, v: (sizes[name][0] - 1 - u if across else u,
+                                                          sizes[name][1] - 1 - v if down else v))
     return out
 
 
@@ -62,6 +75,8 @@ def main(argv=None) -> int:
     ap.add_argument("--limit", type=int, metavar="N", help="the first N frames of each folder (default: all)")
     ap.add_argument("--modalities", default="depth,rgbd", help="bench_real's --modalities (default depth,rgbd)")
     ap.add_argument("--seed", default="0", metavar="S[,S...]", help="bench_real's perception seeds (default 0)")
+    ap.add_argument("--flip", choices=sorted(FLIPS), default="left-right",
+                    help="left-right (a mirror, the default), up-down, or both (the frames upside down)")
     args = ap.parse_args(argv)
     if args.limit is not None and args.limit < 1:
         ap.error("--limit must be at least 1")
@@ -69,18 +84,19 @@ def main(argv=None) -> int:
         tmp = Path(tmp)
         try:
             folders = bench_real.folders_to_run(args.folders)
-            mirrored = [mirror(f, tmp / f.name, args.limit) for f in folders]
+            mirrored = [mirror(f, tmp / f.name, args.limit, args.flip) for f in folders]
         except (InputError, OSError, ValueError) as e:
             print(f"bench_mirror.py: error: {e}", file=sys.stderr)
             return 2
         common = ["--modalities", args.modalities, "--seed", args.seed] + (["--limit", str(args.limit)]
                                                                            if args.limit else [])
-        for name, fs, out in (("as they are", folders, tmp / "a.json"), ("mirrored", mirrored, tmp / "b.json")):
+        flipped = f"flipped {args.flip}"
+        for name, fs, out in (("as they are", folders, tmp / "a.json"), (flipped, mirrored, tmp / "b.json")):
             print(f"#### the frames {name}")
             rc = bench_real.main([str(f) for f in fs] + common + ["--json", str(out)])
             if rc:
                 return rc
-        print("#### A: the frames as they are, B: mirrored")
+        print(f"#### A: the frames as they are, B: {flipped}")
         return compare_real.main([str(tmp / "a.json"), str(tmp / "b.json"), "--folders"])
 
 

@@ -22,6 +22,13 @@ def test_the_mirrored_copy_is_the_folder_seen_in_a_mirror(real_layout, tmp_path)
         ka, kb = a.intrinsics, b.intrinsics
         assert (lb.u - kb.cx) * z / kb.fx == pytest.approx(-(la.u - ka.cx) * z / ka.fx)
         assert (kb.fy, kb.cy) == (ka.fy, ka.cy)
+    # turned over, the labelled pixel moves down too, and so does the principal point
+    over = FrameFolder(mirror(real_layout, tmp_path / "o", limit=1, flip="both"))
+    a, b = plain.load("f0"), over.load("f0")
+    np.testing.assert_array_equal(b.depth, a.depth[::-1, ::-1])
+    (la,), (lb,) = plain.labels()["f0"], over.labels()["f0"]
+    assert (lb.u, lb.v) == (a.intrinsics.width - 1 - la.u, a.intrinsics.height - 1 - la.v)
+    assert b.intrinsics.cy == a.intrinsics.height - 1 - a.intrinsics.cy
     # the mirror of the mirror is the folder
     twice = FrameFolder(mirror(tmp_path / "m", tmp_path / "mm", limit=1))
     assert twice.frames == ["f0"]
