@@ -13,9 +13,10 @@ way a sample consensus or a scan order happens to break a tie), not by what perc
 depth and label images of each folder's first ``--limit`` frames (all by default) are flipped left to right into
 a temporary folder, the principal point and the labelled pixels with them (u -> W - 1 - u), both folders go
 through bench_real with the same ``--modalities`` and ``--seed``, and benchmarks.compare_real sets the two runs
-side by side, pooled and per folder. ``--flip up-down`` mirrors top to bottom instead, and ``--flip both``
-turns the frames upside down (a camera mounted the other way up; v -> H - 1 - v as well): not the same scenes
-as seen by an upright camera, since perception takes the support plane among the planes facing up in the image.
+side by side, pooled and per folder. ``--flip up-down`` mirrors the frames top to bottom (v -> H - 1 - v)
+instead, and ``--flip both`` both ways, which turns them upside down (a camera mounted the other way up): in
+either the table faces down in the image, which perception does not take for a support plane (it takes the
+camera to be upright), so these measure what a camera turned over costs, not luck.
 Exit status: 0, or 2 with one line naming what is wrong.
 """
 
@@ -55,7 +56,10 @@ def mirror(folder: Path, out: Path, limit: int | None, flip: str = "left-right")
         images = [*ff.files[name], folder / f"{name}_label.png"]
         for path in images:
             if path.is_file():
-                cv2.imwrite(str(out / path.name), cv2.flip(cv2.imread(str(path), cv2.IMREAD_UNCHANGED), code))
+                image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+                if image is None:
+                    raise InputError(path, "cannot read the image")
+                cv2.imwrite(str(out / path.name), cv2.flip(image, code))
         # pixel u of a row is pixel W - 1 - u of the flipped row (v of a column H - 1 - v): the original camera
         # seen in a mirror, or turned over
         intr["frames"][name] = {"fx": k.fx, "fy": k.fy, "cx": k.width - 1 - k.cx if across else k.cx,
