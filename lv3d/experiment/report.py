@@ -489,10 +489,11 @@ def against_first(rows: list[dict], conditions: list[str], systems: list[str]) -
         base = acc.get((first, s), {})
         for cond in conditions[1:]:
             mine = acc.get((cond, s), {})
-            common = sorted(k for k in set(base) & set(mine) if k[1] != "multiclass")
-            if not common or all(mine[k] == base[k] for k in set(base) & set(mine)):
+            shared = sorted(set(base) & set(mine))
+            common = [k for k in shared if k[1] != "multiclass"]
+            if not common or all(mine[k] == base[k] for k in shared):
                 continue
-            multi = [(mine[k], base[k]) for k in sorted(set(base) & set(mine)) if k[1] == "multiclass"]
+            multi = [(mine[k], base[k]) for k in shared if k[1] == "multiclass"]
             out.append({"system": s, "condition": cond, "first": first, "cells": len(common),
                         **paired([mine[k] for k in common], [base[k] for k in common]),
                         "multiclass_diff": mean_std([a for a, _ in multi])[0] - mean_std([b for _, b in multi])[0]
