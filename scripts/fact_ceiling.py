@@ -1,0 +1,194 @@
+"""The best a program could do on a real-objects study's facts, chosen with hindsight: per class task, the most
+accurate program over all of the study's examples at once (every test fold together, the labels known), among
+the programs a shape learner learns there:
+
+- one clause ``c(A) :- face_of(A, B), p1(B), ..., pk(B)``: up to ``--literals`` properties of one face, each a
+  face fact of docs/facts.md (``cylindrical``, ``rectangle``, ...) or a derived predicate of prolog/shape_bk.pl
+  (``perpendicular_neighbour``, ...; ``c(A) :- right_corner(A)`` covers what ``c(A) :- face_of(A, B),
+  perpendicular_neighbour(B)`` covers);
+- or two such clauses of one property each (the learner's ``disjunctions``: pairs of one-clause hypotheses).
+
+An example is covered where its object has a face on which the clause's confidence, the product of the facts'
+confidences as a proof combines them (``face_of`` included), reaches ``--threshold`` (the learner's 0.5); an
+example whose labelled pixel lies on no perceived object is covered by none. The figure is the share of the
+study's examples answered right (the positives covered, the other classes' examples not): a ceiling on what a
+learner of such programs reaches from those facts with any training sample, which a study's class-task accuracy
+(the same share, per test fold, mean over folds and draws) can be set against. Where the ceiling lies below a
+target, it is the facts, that is perception, that must change to reach it, not the learner.
+
+    .venv/bin/python scripts/fact_ceiling.py runs/real_objects
+    .venv/bin/python scripts/fact_ceiling.py runs/real_objects --modalities rgbd --classes cylinder --literals 2
+
+RUN_DIR is the study's --out: its config.yaml (the frames' folders and classes, data.cache, lv3d.refine and
+lv3d.perception_seed); the facts are read as the study reads them (scripts/real_errors.py: from the cache of
+this checkout's facts version; facts the cache lacks are computed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+# prolog/shape_bk.pl's derived predicates of a face F, each the best over the G it names of the product of its
+# body's facts: name -> (relation of F and G, property of G or None). acute_neighbour and obtuse_neighbour rest
+# on acute(F, G) / obtuse(F, G) alone. (right_corner(O) is face_of(O, F) with perpendicular_neighbour(F).)
+DERIVED = {"perpendicular_neighbour": (("adjacent", "perpendicular"), None),
+           "acute_neighbour": (("acute",), None),
+           "obtuse_neighbour": (("obtuse",), None),
+           "triangle_neighbour": (("adjacent",), "triangle"),
+           "quadrilateral_neighbour": (("adjacent",), "quadrilateral"),
+           "square_neighbour": (("adjacent",), "square")}
+
+
+def face_properties(facts, target: str | None) -> dict[str, dict[str, float]]:
+    """{face: {property: confidence}} of the object ``target`` in ``facts`` (lv3d.facts.Fact, each with pred,
+    args, conf): its faces' own facts and the derived predicates, each times the face's ``face_of``."""
+    if target is None:
+        return {}
+    face_conf, own, rel = {}, defaultdict(dict), defaultdict(lambda: defaultdict(dict))
+    for f in facts:
+        if f.pred == "face_of":
+            if f.args[0] == target:
+                face_conf[f.args[1]] = f.conf
+        elif len(f.args) == 1:
+            own[f.args[0]][f.pred] = f.conf
+        elif len(f.args) == 2:
+            rel[f.pred][f.args[0]][f.args[1]] = f.conf
+    out = {}
+    for face, c in face_conf.items():
+        props = dict(own[face])
+        for name, (rels, prop) in DERIVED.items():
+            best = 0.0
+            for other in rel[rels[0]].get(face, {}):
+                v = 1.0
+                for r in rels:
+                    v *= rel[r].get(face, {}).get(other, 0.0)
+                if prop is not None:
+                    v *= own[other].get(prop, 0.0)
+                best = max(best, v)
+            if best > 0:
+                props[name] = best
+        out[face] = {k: c * v for k, v in props.items()}
+    return out
+
+
+def ceilings(examples: list[tuple[str, dict[str, dict[str, float]]]], cls: str, literals: int,
+             threshold: float) -> list[tuple[float, str, int, int]]:
+    """The programs for ``cls`` by accuracy over ``examples`` ((class, face properties) each), best first: (accuracy,
+    program text, positives covered, others covered)."""
+    names = sorted({k for _, faces in examples for p in faces.values() for k in p})
+    if not names:
+        return []
+    index = {n: i for i, n in enumerate(names)}
+    # every example's faces stacked, row by row: the logarithms of their properties' confidences, which a
+    # clause's literals add; an example without a face gets one row that covers nothing
+    rows, starts = [], []
+    for _, faces in examples:
+        starts.append(len(rows))
+        for props in faces.values() or [{}]:
+            r = np.zeros(len(names))
+            for k, v in props.items():
+                r[index[k]] = v
+            rows.append(r)
+    with np.errstate(divide="ignore"):
+        logs = np.log(np.array(rows))
+    starts = np.array(starts)
+    pos = np.array([c == cls for c, _ in examples])
+    log_t = np.log(threshold)
+
+    def covers(combos: np.ndarray) -> np.ndarray:
+        """(combos, examples): whether each clause (a row of property indices) covers each example."""
+        out = []
+        for chunk in np.array_split(combos, max(1, len(combos) // 2000)):
+            on_face = logs[:, chunk].sum(axis=2) >= log_t                 # (faces, clauses)
+            out.append(np.maximum.reduceat(on_face, starts, axis=0).T)   # any face of each example
+        return np.concatenate(out)
+
+    def scored(cov: np.ndarray, text: str):
+        right = np.count_nonzero(cov & pos) + np.count_nonzero(~cov & ~pos)
+        return right / len(pos), text, int(np.count_nonzero(cov & pos)), int(np.count_nonzero(cov & ~pos))
+
+    def body(combo) -> str:
+        return ", ".join(f"{names[i]}(B)" for i in combo)
+
+    singles = covers(np.arange(len(names))[:, None])
+    out = [scored(cov, f"face_of(A, B), {body((i,))}") for i, cov in enumerate(singles)]
+    for k in range(2, literals + 1):
+        combos = np.array(list(itertools.combinations(range(len(names)), k)))
+        if len(combos):
+            out += [scored(cov, f"face_of(A, B), {body(c)}") for c, cov in zip(combos, covers(combos))]
+    out += [scored(singles[i] | singles[j], f"face_of(A, B), {body((i,))} ; face_of(A, B), {body((j,))}")
+            for i, j in itertools.combinations(range(len(names)), 2)]
+    out.sort(key=lambda s: (-s[0], len(s[1]), s[1]))
+    return out
+
+
+def study_examples(run: Path, modality: str) -> list[tuple[str, dict[str, dict[str, float]]]]:
+    """(class, face properties of its perceived object) of every example of the study in ``run``."""
+    from lv3d.experiment.code_version import facts_version
+    from lv3d.experiment.config import load_study
+    from lv3d.experiment.real_data import ensure_frame_facts, example_facts_of, real_data
+
+    cfg = load_study(run / "config.yaml").base
+    rd = real_data(cfg.data.folders, cfg.data.classes)
+    root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else run / "facts"  # as the study's
+    frames = ensure_frame_facts(rd, root, facts_version(), modality, cfg.lv3d.refine, seed=cfg.lv3d.perception_seed)
+    facts, _ = example_facts_of(rd, frames)
+    return [(it.cls, face_properties(facts[it.id].facts, facts[it.id].target)) for it in rd.items]
+
+
+def study_figures(run: Path, system: str, cls: str) -> list[tuple[str, float]]:
+    """(condition, the class task's mean accuracy over folds) of ``system`` in the study's results.json, where
+    it has them."""
+    import json
+
+    path = run / "results.json"
+    if not path.is_file():
+        return []
+    out = []
+    for cond, c in json.loads(path.read_text()).get("conditions", {}).items():
+        mean = c.get("systems", {}).get(system, {}).get("classes", {}).get(cls, {}).get("mean")
+        if mean is not None:
+            out.append((cond, mean))
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("run", type=Path, help="the study's --out folder")
+    ap.add_argument("--modalities", default="rgbd,depth", help="comma-separated, of rgb, depth, rgbd")
+    ap.add_argument("--classes", default=None, help="comma-separated class tasks (default: the study's classes)")
+    ap.add_argument("--literals", type=int, default=3, help="most face properties in one clause (default 3)")
+    ap.add_argument("--threshold", type=float, default=0.5, help="confidence at which a clause covers (0.5)")
+    ap.add_argument("--top", type=int, default=3, help="programs shown per class task")
+    args = ap.parse_args(argv)
+    if not (args.run / "config.yaml").is_file():
+        raise SystemExit(f"{args.run}: not a study's --out folder (no config.yaml)")
+    if not 0 < args.threshold <= 1 or args.literals < 1:
+        raise SystemExit("--threshold must lie in (0, 1] and --literals be 1 or more")
+    modalities = [m.strip() for m in args.modalities.split(",") if m.strip()]
+    if bad := [m for m in modalities if m not in ("rgb", "depth", "rgbd")]:
+        raise SystemExit(f"--modalities: unknown {bad}; choose among rgb, depth, rgbd")
+    for modality in modalities:
+        examples = study_examples(args.run, modality)
+        classes = args.classes.split(",") if args.classes else sorted({c for c, _ in examples})
+        for cls in classes:
+            n_pos = sum(c == cls for c, _ in examples)
+            best = ceilings(examples, cls, args.literals, args.threshold)[:args.top]
+            print(f"{modality} {cls}: {len(examples)} examples ({n_pos} {cls}); ceiling "
+                  f"{100 * best[0][0]:.1f} %" if best else f"{modality} {cls}: no facts")
+            if study := study_figures(args.run, f"lv3d-{modality}", cls):
+                print(f"  the study's lv3d-{modality}: " + ", ".join(f"{c} {100 * m:.1f} %" for c, m in study))
+            for acc, text, tp, fp in best:
+                print(f"  {100 * acc:5.1f} %  {cls}(A) :- {text}.   covers {tp}/{n_pos} {cls}, "
+                      f"{fp}/{len(examples) - n_pos} others")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
