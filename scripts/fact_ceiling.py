@@ -1,27 +1,32 @@
-"""The best a program could do on a real-objects study's facts, chosen with hindsight: per class task, the most
-accurate program over all of the study's examples at once (every test fold together, the labels known), among
-the programs a shape learner learns there:
+"""The best a program could do on a study's facts, chosen with hindsight: per class task, the most accurate
+program over all of the study's examples at once (every test fold together, the labels known), among the
+programs a shape learner learns:
 
 - one clause ``c(A) :- face_of(A, B), p1(B), ..., pk(B)``: up to ``--literals`` properties of one face, each a
   face fact of docs/facts.md (``cylindrical``, ``rectangle``, ...) or a derived predicate of prolog/shape_bk.pl
   (``perpendicular_neighbour``, ...; ``c(A) :- right_corner(A)`` covers what ``c(A) :- face_of(A, B),
   perpendicular_neighbour(B)`` covers);
-- or two such clauses of one property each (the learner's ``disjunctions``: pairs of one-clause hypotheses).
+- or two such clauses of one property each (the learner's ``disjunctions``: pairs of one-clause hypotheses);
+- or none (``c(A) :- false``: every answer "no", right on every other class's example; where it is the best,
+  no program of this shape tells the class from the others better than answering "no" does).
 
 An example is covered where its object has a face on which the clause's confidence, the product of the facts'
 confidences as a proof combines them (``face_of`` included), reaches ``--threshold`` (the learner's 0.5); an
-example whose labelled pixel lies on no perceived object is covered by none. The figure is the share of the
-study's examples answered right (the positives covered, the other classes' examples not): a ceiling on what a
-learner of such programs reaches from those facts with any training sample, which a study's class-task accuracy
-(the same share, per test fold, mean over folds and draws) can be set against. Where the ceiling lies below a
-target, it is the facts, that is perception, that must change to reach it, not the learner.
+example with no perceived object (a labelled pixel on none, a rendered image where perception found none) is
+covered by none. The figure is the share of the study's examples answered right (the positives covered, the other
+classes' examples not): a ceiling on what a learner of such programs reaches from those facts with any training
+sample, which a study's class-task accuracy (the same share, per test fold, mean over folds and draws; printed
+beside it from results.json) can be set against. Where the ceiling lies below a target, it is the facts, that is
+perception, that must change to reach it, not the learner.
 
     .venv/bin/python scripts/fact_ceiling.py runs/real_objects
+    .venv/bin/python scripts/fact_ceiling.py runs/ten_classes --modalities rgbd --classes cube,cuboid
     .venv/bin/python scripts/fact_ceiling.py runs/real_objects --modalities rgbd --classes cylinder --literals 2
 
-RUN_DIR is the study's --out: its config.yaml (the frames' folders and classes, data.cache, lv3d.refine and
-lv3d.perception_seed); the facts are read as the study reads them (scripts/real_errors.py: from the cache of
-this checkout's facts version; facts the cache lacks are computed).
+RUN_DIR is a study's --out: its config.yaml says where its examples are (the folders of real frames, or the
+rendered data set in data.cache), and each group of its conditions that learns from the same examples (a sweep
+of positives does; one of noise presets does not) is measured once. The facts are read as the study reads them,
+from the cache of this checkout's facts version; facts the cache lacks are computed.
 """
 
 from __future__ import annotations
@@ -124,35 +129,62 @@ def ceilings(examples: list[tuple[str, dict[str, dict[str, float]]]], cls: str, 
             out += [scored(cov, f"face_of(A, B), {body(c)}") for c, cov in zip(combos, covers(combos))]
     out += [scored(singles[i] | singles[j], f"face_of(A, B), {body((i,))} ; face_of(A, B), {body((j,))}")
             for i, j in itertools.combinations(range(len(names)), 2)]
+    out = [s for s in out if s[2]]                 # a clause that covers no positive is the empty program's
+    out.append(scored(np.zeros(len(pos), bool), "false"))  # no program: every answer "no"
     out.sort(key=lambda s: (-s[0], len(s[1]), s[1]))
     return out
 
 
-def study_examples(run: Path, modality: str) -> list[tuple[str, dict[str, dict[str, float]]]]:
-    """(class, face properties of its perceived object) of every example of the study in ``run``."""
+def study_examples(cfg, run: Path, modality: str) -> list[tuple[str, dict[str, dict[str, float]]]]:
+    """(class, face properties of its perceived object) of every example of the study condition ``cfg`` (a
+    StudyConfig) whose --out is ``run``: the labelled objects of its real frames, or the images of its rendered
+    data set."""
     from lv3d.experiment.code_version import facts_version
-    from lv3d.experiment.config import load_study
-    from lv3d.experiment.real_data import ensure_frame_facts, example_facts_of, real_data
 
-    cfg = load_study(run / "config.yaml").base
-    rd = real_data(cfg.data.folders, cfg.data.classes)
-    root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else run / "facts"  # as the study's
-    frames = ensure_frame_facts(rd, root, facts_version(), modality, cfg.lv3d.refine, seed=cfg.lv3d.perception_seed)
-    facts, _ = example_facts_of(rd, frames)
-    return [(it.cls, face_properties(facts[it.id].facts, facts[it.id].target)) for it in rd.items]
+    if cfg.data.folders:
+        from lv3d.experiment.real_data import ensure_frame_facts, example_facts_of, real_data
+
+        rd = real_data(cfg.data.folders, cfg.data.classes)
+        root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else run / "facts"  # as the study's
+        frames = ensure_frame_facts(rd, root, facts_version(), modality, cfg.lv3d.refine,
+                                    seed=cfg.lv3d.perception_seed)
+        facts, _ = example_facts_of(rd, frames)
+        items = rd.items
+    else:
+        from lv3d.experiment.data import ensure_dataset, ensure_facts, read_items
+
+        data = ensure_dataset(cfg, run)
+        items = read_items(data)
+        facts, _ = ensure_facts(cfg, run, data, items, modality, cfg.lv3d.refine, cfg.lv3d.confidences)
+    return [(it.cls, face_properties(facts[it.id].facts, facts[it.id].target)) for it in items]
 
 
-def study_figures(run: Path, system: str, cls: str) -> list[tuple[str, float]]:
-    """(condition, the class task's mean accuracy over folds) of ``system`` in the study's results.json, where
-    it has them."""
+def data_groups(study) -> dict[str, list]:
+    """The study's conditions grouped by the examples they learn from (a sweep of positives shares them; one of
+    noise presets does not): {data key: [(condition name, its config), ...]}."""
+    from lv3d.experiment.config import digest
+    from lv3d.experiment.data import data_key
+
+    groups: dict[str, list] = {}
+    for name, cfg in study.conditions.items():
+        key = digest({"data": data_key(cfg), "folders": list(cfg.data.folders or []),
+                      "lv3d": [cfg.lv3d.refine, cfg.lv3d.confidences, cfg.lv3d.perception_seed]})
+        groups.setdefault(key, []).append((name, cfg))
+    return groups
+
+
+def study_figures(run: Path, system: str, cls: str, conditions: list[str]) -> list[tuple[str, float]]:
+    """(condition, the class task's mean accuracy over folds) of ``system`` in the study's results.json, for
+    each of ``conditions`` it has."""
     import json
 
     path = run / "results.json"
     if not path.is_file():
         return []
+    found = json.loads(path.read_text()).get("conditions", {})
     out = []
-    for cond, c in json.loads(path.read_text()).get("conditions", {}).items():
-        mean = c.get("systems", {}).get(system, {}).get("classes", {}).get(cls, {}).get("mean")
+    for cond in conditions:
+        mean = found.get(cond, {}).get("systems", {}).get(system, {}).get("classes", {}).get(cls, {}).get("mean")
         if mean is not None:
             out.append((cond, mean))
     return out
@@ -174,19 +206,25 @@ def main(argv: list[str] | None = None) -> int:
     modalities = [m.strip() for m in args.modalities.split(",") if m.strip()]
     if bad := [m for m in modalities if m not in ("rgb", "depth", "rgbd")]:
         raise SystemExit(f"--modalities: unknown {bad}; choose among rgb, depth, rgbd")
-    for modality in modalities:
-        examples = study_examples(args.run, modality)
-        classes = args.classes.split(",") if args.classes else sorted({c for c, _ in examples})
-        for cls in classes:
-            n_pos = sum(c == cls for c, _ in examples)
-            best = ceilings(examples, cls, args.literals, args.threshold)[:args.top]
-            print(f"{modality} {cls}: {len(examples)} examples ({n_pos} {cls}); ceiling "
-                  f"{100 * best[0][0]:.1f} %" if best else f"{modality} {cls}: no facts")
-            if study := study_figures(args.run, f"lv3d-{modality}", cls):
-                print(f"  the study's lv3d-{modality}: " + ", ".join(f"{c} {100 * m:.1f} %" for c, m in study))
-            for acc, text, tp, fp in best:
-                print(f"  {100 * acc:5.1f} %  {cls}(A) :- {text}.   covers {tp}/{n_pos} {cls}, "
-                      f"{fp}/{len(examples) - n_pos} others")
+    from lv3d.experiment.config import load_study
+
+    groups = data_groups(load_study(args.run / "config.yaml"))
+    for conds in groups.values():
+        names = [name for name, _ in conds]
+        where = f" ({', '.join(names)})" if len(groups) > 1 else ""
+        for modality in modalities:
+            examples = study_examples(conds[0][1], args.run, modality)
+            classes = args.classes.split(",") if args.classes else list(conds[0][1].data.classes)
+            for cls in classes:
+                n_pos = sum(c == cls for c, _ in examples)
+                best = ceilings(examples, cls, args.literals, args.threshold)[:args.top]
+                print(f"{modality} {cls}{where}: {len(examples)} examples ({n_pos} {cls}); ceiling "
+                      f"{100 * best[0][0]:.1f} %" if best else f"{modality} {cls}{where}: no facts")
+                if study := study_figures(args.run, f"lv3d-{modality}", cls, names):
+                    print(f"  the study's lv3d-{modality}: " + ", ".join(f"{c} {100 * m:.1f} %" for c, m in study))
+                for acc, text, tp, fp in best:
+                    print(f"  {100 * acc:5.1f} %  {cls}(A) :- {text}.   covers {tp}/{n_pos} {cls}, "
+                          f"{fp}/{len(examples) - n_pos} others")
     return 0
 
 

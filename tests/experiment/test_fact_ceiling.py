@@ -68,7 +68,8 @@ def test_a_clause_covers_where_the_product_of_its_confidences_reaches_the_thresh
     acc = {text: a for a, text, *_ in fact_ceiling.ceilings(examples, "box", literals=2, threshold=0.5)}
     assert acc["face_of(A, B), quadrilateral(B), vertical(B)"] == 1.0  # 0.56 >= 0.5: the box; not the cylinder
     acc = {text: a for a, text, *_ in fact_ceiling.ceilings(examples, "box", literals=2, threshold=0.6)}
-    assert acc["face_of(A, B), quadrilateral(B), vertical(B)"] == 0.5  # 0.56 < 0.6: neither, the box missed
+    assert "face_of(A, B), quadrilateral(B), vertical(B)" not in acc  # 0.56 < 0.6: it covers nothing, as "false"
+    assert acc["false"] == 0.5
     assert acc["face_of(A, B), quadrilateral(B)"] == 1.0
 
 
@@ -80,3 +81,38 @@ def test_bad_arguments_are_one_line(tmp_path, fact_ceiling):
         fact_ceiling.main([str(tmp_path), "--modalities", "lidar"])
     with pytest.raises(SystemExit, match="--threshold"):
         fact_ceiling.main([str(tmp_path), "--threshold", "0"])
+
+
+def test_answering_no_is_the_ceiling_where_no_clause_tells_the_class_apart(fact_ceiling):
+    # a cuboid's faces are rectangles, and so are a cube's: no clause of these facts covers cuboids alone
+    examples = [("cuboid", _face(rectangle=0.9)), ("cube", _face(rectangle=0.9, square=0.9)),
+                ("cube", _face(rectangle=0.9, square=0.9)), ("prism", _face(triangle=0.9))]
+    best = fact_ceiling.ceilings(examples, "cuboid", literals=2, threshold=0.5)
+    assert best[0][:4] == (0.75, "false", 0, 0)
+    assert all(tp > 0 for _, text, tp, _ in best if text != "false")  # no other program covering no positive
+
+
+def test_each_group_of_conditions_with_its_own_examples_is_measured_once_beside_the_studys_figures(
+        tmp_path, fact_ceiling, capsys, monkeypatch):
+    (tmp_path / "config.yaml").write_text(
+        "name: ten\ndata: {classes: [cube, cylinder], per_class: 5}\n"
+        "sweep: {param: data.noise, values: [clean, realsense]}\nsystems: [lv3d-depth]\n")
+    (tmp_path / "results.json").write_text(
+        '{"conditions": {"noise=clean": {"systems": {"lv3d-depth": {"classes": {"cylinder": {"mean": 0.75}}}}}}}')
+    asked = []
+
+    def examples(cfg, run, modality):
+        asked.append((cfg.data.noise, modality))
+        read = 0.9 if cfg.data.noise == "clean" else 0.3  # the noisy preset's cylinders read weakly
+        return [("cylinder", _face(cylindrical=read)), ("cylinder", _face(cylindrical=0.9)),
+                ("cube", _face(square=0.9))]
+
+    monkeypatch.setattr(fact_ceiling, "study_examples", examples)
+    assert fact_ceiling.main([str(tmp_path), "--modalities", "depth", "--classes", "cylinder", "--top", "1"]) == 0
+    assert asked == [("clean", "depth"), ("realsense", "depth")]
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "depth cylinder (noise=clean): 3 examples (2 cylinder); ceiling 100.0 %"
+    assert out[1] == "  the study's lv3d-depth: noise=clean 75.0 %"
+    assert out[2].split() == ["100.0", "%", "cylinder(A)", ":-", "face_of(A,", "B),", "cylindrical(B).", "covers",
+                              "2/2", "cylinder,", "0/1", "others"]
+    assert out[3] == "depth cylinder (noise=realsense): 3 examples (2 cylinder); ceiling 66.7 %"
