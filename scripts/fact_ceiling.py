@@ -16,8 +16,10 @@ example with no perceived object (a labelled pixel on none, a rendered image whe
 covered by none. The figure is the share of the study's examples answered right (the positives covered, the other
 classes' examples not): a ceiling on what a learner of such programs reaches from those facts with any training
 sample, which a study's class-task accuracy (the same share, per test fold, mean over folds and draws; printed
-beside it from results.json) can be set against. Where the ceiling lies below a target, it is the facts, that is
-perception, that must change to reach it, not the learner.
+beside it from results.json) can be set against. It bounds programs of this shape on all examples at once: a
+study's mean over unequal test folds, or a program of another shape (a chain through a neighbour's neighbour),
+may come out a point or so above it. Where it lies well below a target, it is the facts, that is perception,
+that must change to reach the target, not the learner.
 
     .venv/bin/python scripts/fact_ceiling.py runs/real_objects
     .venv/bin/python scripts/fact_ceiling.py runs/ten_classes --modalities rgbd --classes cube,cuboid
@@ -87,8 +89,6 @@ def ceilings(examples: list[tuple[str, dict[str, dict[str, float]]]], cls: str, 
     """The programs for ``cls`` by accuracy over ``examples`` ((class, face properties) each), best first: (accuracy,
     program text, positives covered, others covered)."""
     names = sorted({k for _, faces in examples for p in faces.values() for k in p})
-    if not names:
-        return []
     index = {n: i for i, n in enumerate(names)}
     # every example's faces stacked, row by row: the logarithms of their properties' confidences, which a
     # clause's literals add; an example without a face gets one row that covers nothing
@@ -121,6 +121,8 @@ def ceilings(examples: list[tuple[str, dict[str, dict[str, float]]]], cls: str, 
     def body(combo) -> str:
         return ", ".join(f"{names[i]}(B)" for i in combo)
 
+    if not names:                                   # no example has a face: no clause covers anything
+        return [scored(np.zeros(len(pos), bool), "false")]
     singles = covers(np.arange(len(names))[:, None])
     out = [scored(cov, f"face_of(A, B), {body((i,))}") for i, cov in enumerate(singles)]
     for k in range(2, literals + 1):
@@ -150,6 +152,10 @@ def study_examples(cfg, run: Path, modality: str) -> list[tuple[str, dict[str, d
                                     seed=cfg.lv3d.perception_seed)
         facts, _ = example_facts_of(rd, frames)
         items = rd.items
+        if not cfg.lv3d.confidences:  # the no-confidences ablation, as the study reads it
+            from lv3d.experiment.data import without_confidences
+
+            facts = {k: without_confidences(v) for k, v in facts.items()}
     else:
         from lv3d.experiment.data import ensure_dataset, ensure_facts, read_items
 
@@ -201,14 +207,17 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if not (args.run / "config.yaml").is_file():
         raise SystemExit(f"{args.run}: not a study's --out folder (no config.yaml)")
-    if not 0 < args.threshold <= 1 or args.literals < 1:
-        raise SystemExit("--threshold must lie in (0, 1] and --literals be 1 or more")
+    if not 0 < args.threshold <= 1 or args.literals < 1 or args.top < 1:
+        raise SystemExit("--threshold must lie in (0, 1], --literals and --top be 1 or more")
     modalities = [m.strip() for m in args.modalities.split(",") if m.strip()]
     if bad := [m for m in modalities if m not in ("rgb", "depth", "rgbd")]:
         raise SystemExit(f"--modalities: unknown {bad}; choose among rgb, depth, rgbd")
     from lv3d.experiment.config import load_study
 
     groups = data_groups(load_study(args.run / "config.yaml"))
+    known = {c for conds in groups.values() for _, cfg in conds for c in cfg.data.classes}
+    if args.classes and (bad := [c for c in args.classes.split(",") if c not in known]):
+        raise SystemExit(f"--classes: {bad} not among the study's classes {sorted(known)}")
     for conds in groups.values():
         names = [name for name, _ in conds]
         where = f" ({', '.join(names)})" if len(groups) > 1 else ""
@@ -219,7 +228,7 @@ def main(argv: list[str] | None = None) -> int:
                 n_pos = sum(c == cls for c, _ in examples)
                 best = ceilings(examples, cls, args.literals, args.threshold)[:args.top]
                 print(f"{modality} {cls}{where}: {len(examples)} examples ({n_pos} {cls}); ceiling "
-                      f"{100 * best[0][0]:.1f} %" if best else f"{modality} {cls}{where}: no facts")
+                      f"{100 * best[0][0]:.1f} %")
                 if study := study_figures(args.run, f"lv3d-{modality}", cls, names):
                     print(f"  the study's lv3d-{modality}: " + ", ".join(f"{c} {100 * m:.1f} %" for c, m in study))
                 for acc, text, tp, fp in best:

@@ -83,6 +83,16 @@ def test_bad_arguments_are_one_line(tmp_path, fact_ceiling):
         fact_ceiling.main([str(tmp_path), "--threshold", "0"])
 
 
+def test_a_class_the_study_does_not_learn_is_named(tmp_path, fact_ceiling):
+    (tmp_path / "config.yaml").write_text("name: ten\ndata: {classes: [cube, cylinder], per_class: 5}\n")
+    with pytest.raises(SystemExit, match=r"--classes: \['bowl'\] not among the study's classes"):
+        fact_ceiling.main([str(tmp_path), "--classes", "cube,bowl"])
+
+
+def test_without_faces_answering_no_is_all_there_is(fact_ceiling):
+    assert fact_ceiling.ceilings([("box", {}), ("cylinder", {})], "box", 2, 0.5) == [(0.5, "false", 0, 0)]
+
+
 def test_answering_no_is_the_ceiling_where_no_clause_tells_the_class_apart(fact_ceiling):
     # a cuboid's faces are rectangles, and so are a cube's: no clause of these facts covers cuboids alone
     examples = [("cuboid", _face(rectangle=0.9)), ("cube", _face(rectangle=0.9, square=0.9)),
