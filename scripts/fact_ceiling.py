@@ -140,28 +140,11 @@ def ceilings(examples: list[tuple[str, dict[str, dict[str, float]]]], cls: str, 
 def study_examples(cfg, run: Path, modality: str) -> list[tuple[str, dict[str, dict[str, float]]]]:
     """(class, face properties of its perceived object) of every example of the study condition ``cfg`` (a
     StudyConfig) whose --out is ``run``: the labelled objects of its real frames, or the images of its rendered
-    data set."""
-    from lv3d.experiment.code_version import facts_version
+    data set, with the facts lv3d-``modality`` learns from there (lv3d.experiment.runner.study_inputs)."""
+    from lv3d.experiment.runner import study_inputs
 
-    if cfg.data.folders:
-        from lv3d.experiment.real_data import ensure_frame_facts, example_facts_of, real_data
-
-        rd = real_data(cfg.data.folders, cfg.data.classes)
-        root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else run / "facts"  # as the study's
-        frames = ensure_frame_facts(rd, root, facts_version(), modality, cfg.lv3d.refine,
-                                    seed=cfg.lv3d.perception_seed)
-        facts, _ = example_facts_of(rd, frames)
-        items = rd.items
-        if not cfg.lv3d.confidences:  # the no-confidences ablation, as the study reads it
-            from lv3d.experiment.data import without_confidences
-
-            facts = {k: without_confidences(v) for k, v in facts.items()}
-    else:
-        from lv3d.experiment.data import ensure_dataset, ensure_facts, read_items
-
-        data = ensure_dataset(cfg, run)
-        items = read_items(data)
-        facts, _ = ensure_facts(cfg, run, data, items, modality, cfg.lv3d.refine, cfg.lv3d.confidences)
+    items, inputs = study_inputs(cfg, run, progress=False)
+    facts = inputs.for_system(f"lv3d-{modality}")
     return [(it.cls, face_properties(facts[it.id].facts, facts[it.id].target)) for it in items]
 
 

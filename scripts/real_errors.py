@@ -9,7 +9,7 @@ resting on that evidence answers all of those wrong, whatever the learner does; 
 
 RUN_DIR is the study's --out: its config.yaml (the frames' folders and classes, data.cache, lv3d.refine and
 lv3d.perception_seed) and its fold files (folds/<condition>/<system>/fold<k>.json). Each example's facts are read
-as the study reads them (lv3d.experiment.real_data: ensure_frame_facts, example_facts_of), from the cache of this
+as the study reads them (lv3d.experiment.runner.study_inputs), from the cache of this
 checkout's facts version; facts the cache lacks are computed.
 """
 
@@ -37,15 +37,11 @@ def _evidence(arg: str) -> dict[str, str]:
 def example_evidence(run: Path, modality: str, preds: set[str]) -> dict[str, set[str]]:
     """Per example id of the study in ``run``, which of ``preds`` hold on a face of the perceived object under its
     labelled pixel at confidence >= EVIDENCE_CONF (none where no object lies there), in ``modality``'s facts."""
-    from lv3d.experiment.code_version import facts_version
     from lv3d.experiment.config import load_study
-    from lv3d.experiment.real_data import ensure_frame_facts, example_facts_of, real_data
+    from lv3d.experiment.runner import study_inputs
 
-    cfg = load_study(run / "config.yaml").base
-    rd = real_data(cfg.data.folders, cfg.data.classes)
-    root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else run / "facts"  # as the study's
-    frames = ensure_frame_facts(rd, root, facts_version(), modality, cfg.lv3d.refine, seed=cfg.lv3d.perception_seed)
-    facts, _ = example_facts_of(rd, frames)
+    _, inputs = study_inputs(load_study(run / "config.yaml").base, run, progress=False)
+    facts = inputs.for_system(f"lv3d-{modality}")
     return {i: {f.pred for f in sf.facts if f.pred in preds and f.conf >= EVIDENCE_CONF} for i, sf in facts.items()}
 
 

@@ -344,16 +344,8 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
         bar.update(ccfg.folds * len(ccfg.systems) - len(pending))
         if not pending:
             continue
-        if ccfg.data.folders:
-            rd = _real_examples(ccfg, progress)
-            items = rd.items
-            folds = grouped_folds(items, ccfg.folds, ccfg.seed)
-            inputs = _RealInputs(ccfg, out, rd, remote, progress)
-        else:
-            data = data_mod.ensure_dataset(ccfg, out)
-            items = data_mod.read_items(data)
-            folds = stratified_folds(items, ccfg.folds, ccfg.seed)
-            inputs = _Inputs(ccfg, out, data, items, remote)
+        items, inputs = study_inputs(ccfg, out, remote, progress)
+        folds = (grouped_folds if ccfg.data.folders else stratified_folds)(items, ccfg.folds, ccfg.seed)
         by_system: dict[str, list[int]] = {}
         for sname, k in pending:
             by_system.setdefault(sname, []).append(k)
@@ -379,6 +371,19 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
     bar.close()
     summary = write_report(out, study.base, conds, compare=study.named_conditions)
     return {"ran": ran, "skipped": skipped, "report": summary, "learn_failures": failed}
+
+
+def study_inputs(ccfg: StudyConfig, out: Path, executor=None, progress: bool = True):
+    """(the examples, what each system sees of them) of one condition whose work folder is ``out``: the labelled
+    objects of its real frames or the images of its rendered data set, and an object whose ``for_system(name)``
+    gives a system's inputs (an lv3d system's facts per example id, as the study learns from them; computed on
+    first use and cached)."""
+    if ccfg.data.folders:
+        rd = _real_examples(ccfg, progress)
+        return rd.items, _RealInputs(ccfg, out, rd, executor, progress)
+    data = data_mod.ensure_dataset(ccfg, out)
+    items = data_mod.read_items(data)
+    return items, _Inputs(ccfg, out, data, items, executor)
 
 
 def _real_examples(ccfg: StudyConfig, progress: bool):
