@@ -230,7 +230,7 @@ def _against_best(summary: dict, prefix: str) -> dict | None:
     if test is None:
         return None
     rival = summary["systems"][pair[1]]["mean"]["mean"]
-    return {**test, "rival_mean": rival, "cnn_mean": rival}
+    return {**test, "rival_mean": rival}
 
 
 def _against_best_balanced(summary: dict, balanced: dict[str, dict], prefix: str) -> dict | None:
