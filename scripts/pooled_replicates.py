@@ -6,7 +6,9 @@
 Each argument is a run folder (or a results folder) holding results.csv. Per condition, the binary accuracy of every
 (replicate, fold, class) cell of system a minus that of system b: the mean, a 95% bootstrap interval (cells
 resampled 10000 times, seed 0), wins / losses / ties and the two-sided sign and Wilcoxon signed-rank tests, as the
-runner's report gives them for one run (lv3d/experiment/stats.py)."""
+runner's report gives them for one run (lv3d/experiment/stats.py). Where the runs hold multi-class rows, each of the
+two systems' multi-class accuracy too, the mean over every (replicate, fold) cell with its 95% bootstrap interval
+(the same resampling): how far a multi-class figure moves with the images drawn."""
 
 from __future__ import annotations
 
@@ -15,18 +17,19 @@ import csv
 from collections import defaultdict
 from pathlib import Path
 
-from lv3d.experiment.stats import paired
+from lv3d.experiment.stats import mean_diff_ci, paired
 
 
-def cells(run: Path, system: str) -> dict:
-    """{(condition, fold, task): binary accuracy} of one system in one run's results.csv (class tasks only)."""
+def cells(run: Path, system: str, multiclass: bool = False) -> dict:
+    """{(condition, fold, task): binary accuracy} of one system in one run's results.csv: its class tasks, or with
+    ``multiclass`` its multi-class rows."""
     path = run / "results.csv"
     if not path.is_file():
         raise SystemExit(f"{run}: no results.csv (run `lv3d experiment run` into it first)")
     out = {}
     with path.open() as f:
         for r in csv.DictReader(f):
-            if r["system"] == system and r["task"] != "multiclass":
+            if r["system"] == system and (r["task"] == "multiclass") == multiclass:
                 out[(r["condition"], r["fold"], r["task"])] = float(r["accuracy"])
     return out
 
@@ -51,6 +54,15 @@ def main(argv=None) -> int:
               f"(95% interval {t['ci95'][0]:+.2f} to {t['ci95'][1]:+.2f}), {t['sign']['wins']} wins, "
               f"{t['sign']['losses']} losses, {t['sign']['ties']} ties, sign p = {t['sign']['p']:.3g}, "
               f"Wilcoxon p = {t['wilcoxon']['p']:.3g}")
+    for system in (args.a, args.b):
+        multi = defaultdict(list)
+        for run in args.runs:
+            for (cond, _, _), acc in sorted(cells(run, system, multiclass=True).items()):
+                multi[cond].append(100 * acc)
+        for cond, v in sorted(multi.items()):
+            lo, hi = mean_diff_ci(v, [0.0] * len(v))
+            print(f"{cond}: {system} multi-class over {len(v)} cells of {len(args.runs)} runs: "
+                  f"{sum(v) / len(v):.1f} % (95% interval {lo:.1f} to {hi:.1f})")
     return 0
 
 

@@ -11,9 +11,9 @@ per fold the mean binary accuracy over the class tasks, then the mean over folds
   (``mean ± std``).
 - Every other table has a row per condition, in the study's order, and a column per system
   (``mean / multi``). Column labels are system names, optionally followed by words in parentheses.
-- The seed protocol's replicates (section ``### Seed protocol: replicates``, first header cell ``data seed``) have
-  a row per (data seed, condition), seed 0 being the study itself and seed s the report
-  ``experiments/results/seed_protocol_seed<s>/``, and a column per lv3d system (``mean / multi``).
+- A study's replicates (section ``### <Study heading>: replicates``, first header cell ``data seed``: the seed
+  protocol's and the ten classes') have a row per (data seed, condition), seed 0 being the study itself and seed s
+  the report ``experiments/results/<study>_seed<s>/``, and a column per lv3d system (``mean / multi``).
 - The top-level README's seed-protocol table (header ``| system | clean | realsense noise |``) has a row per lv3d
   system and the best CNN, the best pretrained network and the best decision tree of each condition (highest mean
   binary accuracy), each cell ``mean / multi``, the best baseline's modality in parentheses.
@@ -51,7 +51,8 @@ SECTIONS = {
     "### Ten classes": ("ten_classes", "noise"),
     "### Ten classes: learning curve": ("ten_classes_curve", "positives"),
 }
-REPLICATES = "### Seed protocol: replicates"
+# section heading -> the study whose replicates its table holds
+REPLICATES = {"### Seed protocol: replicates": "seed_protocol", "### Ten classes: replicates": "ten_classes"}
 NOISE = {"k": "noise_depth", "p": "noise_occlusion", "colour sigma": "noise_color",
          "clutter objects": "noise_clutter", "exposure": "noise_lighting"}
 
@@ -115,14 +116,15 @@ def rewrite_table(lines: list[str], study: str) -> list[str]:
     return out
 
 
-def rewrite_replicates(lines: list[str]) -> list[str]:
-    """The replicates table ``lines``: row label ``<seed>[ (...)]``, then the condition, then a cell per system."""
+def rewrite_replicates(lines: list[str], study: str) -> list[str]:
+    """The replicates table ``lines`` of ``study``: row label ``<seed>[ (...)]``, then the condition, then a cell per
+    system."""
     header = _cells(lines[0])
     out = lines[:2]
     for line in lines[2:]:
         cells = _cells(line)
         seed = int(cells[0].split()[0])
-        s = summary("seed_protocol" if seed == 0 else f"seed_protocol_seed{seed}")[f"noise={cells[1]}"]
+        s = summary(study if seed == 0 else f"{study}_seed{seed}")[f"noise={cells[1]}"]
         row = cells[:2] + [f"{s[_system(c)][0]:.1f} / {s[_system(c)][2]:.1f}" for c in header[2:]]
         out.append("| " + " | ".join(row) + " |")
     return out
@@ -139,7 +141,7 @@ def rewrite(text: str) -> str:
         if line.startswith("| ") and i + 1 < len(lines) and lines[i + 1].startswith("|---"):
             first = _cells(line)[0]
             study = None
-            if section == REPLICATES and first == "data seed":
+            if section in REPLICATES and first == "data seed":
                 study = "replicates"
             elif section in SECTIONS and SECTIONS[section][1] == first:
                 study = SECTIONS[section][0]
@@ -149,7 +151,7 @@ def rewrite(text: str) -> str:
             while j < len(lines) and lines[j].startswith("|"):
                 j += 1
             if study == "replicates":
-                lines[i:j] = rewrite_replicates(lines[i:j])
+                lines[i:j] = rewrite_replicates(lines[i:j], REPLICATES[section])
             elif study is not None:
                 lines[i:j] = rewrite_table(lines[i:j], study)
             i = j

@@ -3,7 +3,7 @@
 # systems and conditions of the committed reports in experiments/results/, and the seed protocol's four
 # replicates (its lv3d systems on data seeds 1-4; scripts/pooled_replicates.py pools them) and the real-objects
 # study's lv3d systems on perception seeds 1 and 2 (real_objects_pseed1, _pseed2), and the ten-class study's
-# depth systems without arbiters (ten_classes_no_arbiters). The ten-class learning curve shares the ten-class
+# depth systems without arbiters (ten_classes_no_arbiters) and on data seeds 1 and 2 (ten_classes_seed1, _seed2). The ten-class learning curve shares the ten-class
 # study's images and facts. Each study's
 # baseline fold files are restored from its committed results.csv first (scripts/restore_baselines.py), then
 # `lv3d experiment run` computes the lv3d folds and rewrites the report.
@@ -16,7 +16,8 @@
 # `lv3d experiment report`); the ablations on real frames, lv3d systems only; the real-objects study on each
 # folder alone (real_objects_osd, real_objects_ycb: boxes and cylinders, no tuned CNN). Three lanes run at once on two cores; the studies of the seed protocol's images
 # share one data cache, which the seed protocol fills before the ablations start. About 75 min on two cores, and
-# up to 18 more for the ten-class learning curve (its time alone on two free cores) in the third lane.
+# up to 18 more for the ten-class learning curve (its time alone on two free cores) in the third lane; the two
+# ten-class replicates add 6 min each (alone on two cores).
 #
 # Then copy each run's results.{csv,md} and plots into experiments/results/<study>/ (the script prints the
 # commands), rewrite the tables of experiments/README.md (scripts/readme_tables.py --write) and its text.
@@ -49,6 +50,12 @@ replicate() {  # replicate SEED: the seed protocol's lv3d systems on images of a
     OMP_NUM_THREADS=1 $LV3D experiment run experiments/seed_protocol.yaml --out "$RUNS/seed_protocol_seed$1" \
         --set seed="$1" --set "$CACHE" --set "$LV3D_ONLY" --set "$TWO_PRESETS" > "$RUNS/seed_protocol_seed$1.log" 2>&1
     log "seed_protocol_seed$1: $(grep -a 'fold results computed' "$RUNS/seed_protocol_seed$1.log" | tail -1)"
+}
+
+ten_replicate() {  # ten_replicate SEED: the ten-class study's depth systems on images of another data seed (no baselines)
+    OMP_NUM_THREADS=1 $LV3D experiment run experiments/ten_classes.yaml --out "$RUNS/ten_classes_seed$1" \
+        --set seed="$1" --set "$CACHE" --set "systems=[lv3d-depth,lv3d-rgbd]" > "$RUNS/ten_classes_seed$1.log" 2>&1
+    log "ten_classes_seed$1: $(grep -a 'fold results computed' "$RUNS/ten_classes_seed$1.log" | tail -1)"
 }
 
 no_arbiters() {  # the ten-class study's depth systems without arbiters (docs/learner.md, "Arbiters"; no baselines)
@@ -93,13 +100,14 @@ FEW_SHOT="systems=[lv3d-rgb,lv3d-depth,lv3d-rgbd,cnn-rgbd,effnet-rgb,effnet-dept
 rm -f "$RUNS/.seed_protocol_done"
 pids=()
 ( study seed_protocol --set "$CACHE" --set "$TWO_PRESETS"; touch "$RUNS/.seed_protocol_done"
-  study learning_curve --set "$CACHE"; study few_shot --set "$CACHE" --set "$FEW_SHOT"; replicate 1; replicate 2 ) & pids+=($!)
+  study learning_curve --set "$CACHE"; study few_shot --set "$CACHE" --set "$FEW_SHOT"; replicate 1; replicate 2
+  ten_replicate 1 ) & pids+=($!)
 ( for n in noise_depth noise_color noise_occlusion noise_clutter noise_lighting; do study $n --set "$NOISE_CACHE"; done
   real_objects; study real_ablations --set "$REAL_CACHE"; per_folder osd osd-learn; per_folder ycb ycb-realsense
   perception_seed 1; perception_seed 2 ) & pids+=($!)
 ( study ten_classes --set "$CACHE"; study ten_classes_curve --set "$CACHE"
   until [ -e "$RUNS/.seed_protocol_done" ]; do sleep 10; done
-  study ablations --set "$CACHE"; replicate 3; replicate 4; no_arbiters ) & pids+=($!)
+  study ablations --set "$CACHE"; replicate 3; replicate 4; no_arbiters; ten_replicate 2 ) & pids+=($!)
 failed=0
 for p in "${pids[@]}"; do wait "$p" || failed=1; done
 [ "$failed" = 0 ] || { echo "a lane stopped: see $RUNS/progress and the last log it names" >&2; exit 1; }

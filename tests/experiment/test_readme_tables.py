@@ -45,3 +45,14 @@ def test_a_changed_replicate_figure_is_rewritten(mod):
     cells[3] = " 1.0 / 2.0 "
     lines[i] = "|".join(cells)
     assert mod.rewrite("\n".join(lines)) == text
+
+
+def test_a_changed_ten_class_replicate_figure_is_rewritten(mod):
+    text = mod.README.read_text()
+    lines = text.split("\n")
+    start = lines.index("### Ten classes: replicates")
+    i = next(k for k in range(start, len(lines)) if lines[k].startswith("| 2 | realsense |"))
+    cells = lines[i].split("|")
+    cells[3] = " 1.0 / 2.0 "
+    lines[i] = "|".join(cells)
+    assert mod.rewrite("\n".join(lines)) == text
