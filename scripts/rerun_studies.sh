@@ -3,8 +3,9 @@
 # systems and conditions of the committed reports in experiments/results/, and the seed protocol's four
 # replicates (its lv3d systems on data seeds 1-4; scripts/pooled_replicates.py pools them) and the real-objects
 # study's lv3d systems on perception seeds 1 and 2 (real_objects_pseed1, _pseed2), and the ten-class study's
-# depth systems without arbiters (ten_classes_no_arbiters) and on data seeds 1 and 2 (ten_classes_seed1, _seed2). The ten-class learning curve shares the ten-class
-# study's images and facts. Each study's
+# depth systems without arbiters (ten_classes_no_arbiters) and on data seeds 1 and 2 (ten_classes_seed1, _seed2;
+# pooled_replicates.py pools them too). The ten-class learning curve shares the ten-class study's images and
+# facts. Each study's
 # baseline fold files are restored from its committed results.csv first (scripts/restore_baselines.py), then
 # `lv3d experiment run` computes the lv3d folds and rewrites the report.
 #
@@ -17,7 +18,7 @@
 # folder alone (real_objects_osd, real_objects_ycb: boxes and cylinders, no tuned CNN). Three lanes run at once on two cores; the studies of the seed protocol's images
 # share one data cache, which the seed protocol fills before the ablations start. About 75 min on two cores, and
 # up to 18 more for the ten-class learning curve (its time alone on two free cores) in the third lane; the two
-# ten-class replicates add 6 min each (alone on two cores).
+# ten-class replicates add about 6 min each (alone on two cores).
 #
 # Then copy each run's results.{csv,md} and plots into experiments/results/<study>/ (the script prints the
 # commands), rewrite the tables of experiments/README.md (scripts/readme_tables.py --write) and its text.

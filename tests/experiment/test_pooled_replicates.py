@@ -32,7 +32,7 @@ def test_multi_class_cells_are_pooled_with_an_interval(tmp_path, pooled, capsys,
     for k, accs in enumerate(([0.8, 0.9], [1.0, 0.9])):
         folder = tmp_path / f"run{k}"
         folder.mkdir()
-        rows = [("c", s, f, t, 1.0) for s in ("lv3d-rgbd", "lv3d-depth") for f in (0, 1) for t in ("cube",)]
+        rows = [("c", s, f, "cube", 1.0) for s in ("lv3d-rgbd", "lv3d-depth") for f in (0, 1)]
         rows += [("c", "lv3d-rgbd", f, "multiclass", a) for f, a in enumerate(accs)]
         rows += [("c", "lv3d-depth", f, "multiclass", 0.5) for f in (0, 1)]
         write_results(folder / "results.csv", rows)
