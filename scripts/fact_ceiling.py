@@ -162,15 +162,17 @@ def data_groups(study) -> dict[str, list]:
     return groups
 
 
-def study_figures(run: Path, system: str, cls: str, conditions: list[str]) -> list[tuple[str, float]]:
-    """(condition, the class task's mean accuracy over folds) of ``system`` in the study's results.json, for
-    each of ``conditions`` it has."""
+def study_results(run: Path) -> dict:
+    """The conditions of the study's results.json ({} where the run has none yet)."""
     import json
 
     path = run / "results.json"
-    if not path.is_file():
-        return []
-    found = json.loads(path.read_text()).get("conditions", {})
+    return json.loads(path.read_text()).get("conditions", {}) if path.is_file() else {}
+
+
+def study_figures(found: dict, system: str, cls: str, conditions: list[str]) -> list[tuple[str, float]]:
+    """(condition, the class task's mean accuracy over folds) of ``system`` in the study's results (``found``,
+    :func:`study_results`), for each of ``conditions`` it has."""
     out = []
     for cond in conditions:
         mean = found.get(cond, {}).get("systems", {}).get(system, {}).get("classes", {}).get(cls, {}).get("mean")
@@ -201,6 +203,7 @@ def main(argv: list[str] | None = None) -> int:
     known = {c for conds in groups.values() for _, cfg in conds for c in cfg.data.classes}
     if args.classes and (bad := [c for c in args.classes.split(",") if c not in known]):
         raise SystemExit(f"--classes: {bad} not among the study's classes {sorted(known)}")
+    found = study_results(args.run)
     for conds in groups.values():
         names = [name for name, _ in conds]
         where = f" ({', '.join(names)})" if len(groups) > 1 else ""
@@ -212,7 +215,7 @@ def main(argv: list[str] | None = None) -> int:
                 best = ceilings(examples, cls, args.literals, args.threshold)[:args.top]
                 print(f"{modality} {cls}{where}: {len(examples)} examples ({n_pos} {cls}); ceiling "
                       f"{100 * best[0][0]:.1f} %")
-                if study := study_figures(args.run, f"lv3d-{modality}", cls, names):
+                if study := study_figures(found, f"lv3d-{modality}", cls, names):
                     print(f"  the study's lv3d-{modality}: " + ", ".join(f"{c} {100 * m:.1f} %" for c, m in study))
                 for acc, text, tp, fp in best:
                     print(f"  {100 * acc:5.1f} %  {cls}(A) :- {text}.   covers {tp}/{n_pos} {cls}, "

@@ -20,18 +20,19 @@ from pathlib import Path
 from lv3d.experiment.stats import mean_diff_ci, paired
 
 
-def cells(run: Path, system: str, multiclass: bool = False) -> dict:
-    """{(condition, fold, task): binary accuracy} of one system in one run's results.csv: its class tasks, or with
-    ``multiclass`` its multi-class rows."""
+def accuracies(run: Path) -> dict[tuple[str, str, str, str], float]:
+    """{(system, condition, fold, task): binary accuracy} of every row of one run's results.csv."""
     path = run / "results.csv"
     if not path.is_file():
         raise SystemExit(f"{run}: no results.csv (run `lv3d experiment run` into it first)")
-    out = {}
     with path.open() as f:
-        for r in csv.DictReader(f):
-            if r["system"] == system and (r["task"] == "multiclass") == multiclass:
-                out[(r["condition"], r["fold"], r["task"])] = float(r["accuracy"])
-    return out
+        return {(r["system"], r["condition"], r["fold"], r["task"]): float(r["accuracy"]) for r in csv.DictReader(f)}
+
+
+def cells(acc: dict, system: str, multiclass: bool = False) -> dict:
+    """{(condition, fold, task): binary accuracy} of one system among a run's :func:`accuracies`: its class tasks,
+    or with ``multiclass`` its multi-class rows."""
+    return {key[1:]: v for key, v in acc.items() if key[0] == system and (key[3] == "multiclass") == multiclass}
 
 
 def main(argv=None) -> int:
@@ -40,9 +41,10 @@ def main(argv=None) -> int:
     ap.add_argument("--a", default="lv3d-rgbd")
     ap.add_argument("--b", default="lv3d-depth")
     args = ap.parse_args(argv)
+    runs = [(run, accuracies(run)) for run in args.runs]  # each results.csv read once
     pairs = defaultdict(lambda: ([], []))
-    for run in args.runs:
-        a, b = cells(run, args.a), cells(run, args.b)
+    for run, acc in runs:
+        a, b = cells(acc, args.a), cells(acc, args.b)
         if not a or not b:
             raise SystemExit(f"{run}: no class-task rows of {args.a if not a else args.b}")
         for key in sorted(a.keys() & b.keys()):
@@ -56,9 +58,9 @@ def main(argv=None) -> int:
               f"Wilcoxon p = {t['wilcoxon']['p']:.3g}")
     for system in (args.a, args.b):
         multi = defaultdict(list)
-        for run in args.runs:
-            for (cond, _, _), acc in sorted(cells(run, system, multiclass=True).items()):
-                multi[cond].append(100 * acc)
+        for _, acc in runs:
+            for (cond, _, _), v in sorted(cells(acc, system, multiclass=True).items()):
+                multi[cond].append(100 * v)
         for cond, v in sorted(multi.items()):
             lo, hi = mean_diff_ci(v, [0.0] * len(v))
             print(f"{cond}: {system} multi-class over {len(v)} cells of {len(args.runs)} runs: "
