@@ -18,7 +18,7 @@ import numpy as np
 
 from .calibration import shipped as shipped_calibration
 from .cylinder import Cylinder
-from .facts import PREDICATES, Fact, SceneFacts
+from .facts import PREDICATES, REGULAR_CORNERS, Fact, SceneFacts, regular_corner_range
 from .perception.polygons import area
 from .rgbd import RGBD
 from .scene import Face, Scene, SceneObject
@@ -301,6 +301,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
             ca = c if ga is g else {k: ga["conf"][k].tolist() for k in ("p_perpendicular", "p_parallel", "p_acute",
                                                                        "p_obtuse")}
             dih_l = ga["quantities"]["dihedral_deg"].tolist()
+            dih_sd = ga["std"]["dihedral_deg"].tolist()
             par_l = ga["quantities"]["parallel_deg"].tolist()
             corner_l, corner_sd = g["quantities"]["corner_deg"].tolist(), g["std"]["corner_deg"].tolist()
             side_l, side_sd = g["quantities"]["side_px"].tolist(), g["std"]["side_px"].tolist()
@@ -355,6 +356,7 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                     if args in adjacent:
                         cands.append(("acute", args, ca["p_acute"][i][j], dih))
                         cands.append(("obtuse", args, ca["p_obtuse"][i][j], dih))
+                        curved += regular_corner_candidates(args, dih, dih_sd[i][j])
         for a, b in obj.adjacency:
             if a in face_conf and b in face_conf:
                 p = min(face_conf[a], face_conf[b])  # the shared edge is as real as the weaker face
@@ -377,6 +379,28 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         cands = [(pred, args, calibrate_one(modality, key, p, next(it) if pick else None), value)
                  for (pred, args, p, value), key, pick in zip(cands, keys, picked)]
     return cands + curved, results
+
+
+def regular_corner_candidates(args: tuple[str, str], dih_deg: float, sd_deg: float
+                              ) -> list[tuple[str, tuple[str, ...], float, float | None]]:
+    """``pentagonal_dihedral`` / ``hexagonal_dihedral`` of two adjacent faces: the probability that their interior
+    dihedral is nearer a regular pentagon's (hexagon's) corner than any other regular polygon's, i.e. that
+    360 / (180 - dihedral) rounds to 5 (6): between 100.0 and 114.5 deg (114.5 and 124.6). The dihedral's error
+    is Gaussian with grounding's Laplace spread and its model-error floor (grounding.Floors.dihedral_deg), as
+    ``perpendicular``'s; value: the dihedral. The two sides of a prism whose cap is missed or misread meet at the
+    angle of the cap's corners, which ``obtuse`` (above 97 deg) does not tell apart."""
+    import grounding
+    from scipy.special import ndtr
+
+    if not (math.isfinite(dih_deg) and math.isfinite(sd_deg)):
+        return []
+    sd = math.hypot(sd_deg, grounding.Floors().dihedral_deg)
+    out = []
+    for pred, n in REGULAR_CORNERS.items():
+        lo, hi = regular_corner_range(n)
+        p = float(ndtr((hi - dih_deg) / sd) - ndtr((lo - dih_deg) / sd))
+        out.append((pred, args, p, dih_deg))
+    return out
 
 
 def _angle_readings(jobs: list[_Job], grounded: list[dict], depth_field: np.ndarray,

@@ -15,7 +15,7 @@ from typing import Iterable
 
 from .errors import InputError
 
-SCHEMA = "lv3d.facts/3"
+SCHEMA = "lv3d.facts/4"
 
 # predicate name -> (arity, modalities that may emit it). The same table drives the learner's
 # body predicates, so all three systems share one vocabulary and differ only in what they see.
@@ -57,7 +57,20 @@ PREDICATES: dict[str, tuple[int, frozenset[str]]] = {
     "parallel": (2, frozenset({"depth", "rgbd"})),
     "acute": (2, frozenset({"depth", "rgbd"})),
     "obtuse": (2, frozenset({"depth", "rgbd"})),
+    "pentagonal_dihedral": (2, frozenset({"depth", "rgbd"})),
+    "hexagonal_dihedral": (2, frozenset({"depth", "rgbd"})),
 }
+
+# two adjacent faces meet at the interior angle of a regular N-gon's corner, 180 - 360 / N deg (the sides of a
+# regular N-gonal prism): N = 5, 108 deg; N = 6, 120 deg
+REGULAR_CORNERS = {"pentagonal_dihedral": 5, "hexagonal_dihedral": 6}
+
+
+def regular_corner_range(n: int) -> tuple[float, float]:
+    """The interior dihedrals (degrees, low, high) nearer a regular ``n``-gon's corner angle than any other
+    regular polygon's: those for which 360 / (180 - dihedral) rounds to ``n`` (5: 100.0-114.5, 6: 114.5-124.6)."""
+    return 180.0 - 360.0 / (n - 0.5), 180.0 - 360.0 / (n + 0.5)
+
 
 MODALITIES = ("rgb", "depth", "rgbd")
 _ATOM = re.compile(r"^[a-z][a-zA-Z0-9_]*$")

@@ -16,7 +16,7 @@ from grounding import (ACUTE_BELOW_DEG, EQUAL_CORNERS_DEG, OBTUSE_ABOVE_DEG, PAR
                        PLANE_ANGLE_DEG, RIGHT_ANGLE_DEG)
 
 from .errors import InputError
-from .facts import PREDICATES, Fact, SceneFacts, face_id, object_id
+from .facts import PREDICATES, REGULAR_CORNERS, Fact, SceneFacts, face_id, object_id, regular_corner_range
 from .image_shape import exact_image_shape
 
 SIDES = {3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon"}
@@ -127,6 +127,10 @@ def _exact_facts(truth: dict, k: dict, scene_id: str, modality: str = "rgbd") ->
                 facts.append(Fact("acute", (x, y), 1.0, d))
             elif d > OBTUSE_ABOVE_DEG:
                 facts.append(Fact("obtuse", (x, y), 1.0, d))
+            for pred, n in REGULAR_CORNERS.items():
+                lo, hi = regular_corner_range(n)
+                if lo <= d < hi:
+                    facts.append(Fact(pred, (x, y), 1.0, d))
     for i, j in itertools.combinations(sorted(normals), 2):
         # visible faces of a convex solid face the camera, so plane normals are outward normals
         d = 180.0 - _angle_deg(normals[i], normals[j])

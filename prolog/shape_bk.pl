@@ -37,6 +37,10 @@ bk_rule(perpendicular_neighbour(F), [adjacent(F, G), perpendicular(F, G)]).
 bk_rule(acute_neighbour(F), [acute(F, _)]).
 % the face meets a neighbour at an obtuse interior angle (pentagonal/hexagonal prism sides, pyramids)
 bk_rule(obtuse_neighbour(F), [obtuse(F, _)]).
+% the face meets a neighbour at a regular pentagon's corner angle, 108 deg (pentagonal prism sides)
+bk_rule(pentagonal_neighbour(F), [pentagonal_dihedral(F, _)]).
+% the face meets a neighbour at a regular hexagon's corner angle, 120 deg (hexagonal prism sides)
+bk_rule(hexagonal_neighbour(F), [hexagonal_dihedral(F, _)]).
 % the face is a triangle and so is a neighbour (pyramids, tetrahedra: no triangle touches a triangle on a prism)
 bk_rule(triangle_neighbour(F), [adjacent(F, G), triangle(G)]).
 % the face has a quadrilateral neighbour (prisms, boxes)

@@ -47,6 +47,8 @@ import numpy as np
 DERIVED = {"perpendicular_neighbour": (("adjacent", "perpendicular"), None),
            "acute_neighbour": (("acute",), None),
            "obtuse_neighbour": (("obtuse",), None),
+           "pentagonal_neighbour": (("pentagonal_dihedral",), None),
+           "hexagonal_neighbour": (("hexagonal_dihedral",), None),
            "triangle_neighbour": (("adjacent",), "triangle"),
            "quadrilateral_neighbour": (("adjacent",), "quadrilateral"),
            "square_neighbour": (("adjacent",), "square")}

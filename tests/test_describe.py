@@ -357,3 +357,32 @@ def test_outside_rgbd_the_angle_facts_read_the_faces_own_measurements():
     weakest = min(fr.features["support"] for fr in faces)
     assert f_perp[0]["support"] == pytest.approx(weakest)
     assert {f["support"] for f in f_side} == {fr.features["support"] for fr in faces}
+
+
+def test_two_sides_meeting_at_a_regular_polygons_corner_angle_name_that_polygon():
+    # a pentagonal prism's sides meet at 108 deg, a hexagonal one's at 120; a box's at 90 read as neither, and a
+    # measurement halfway between two corners' angles is as likely one as the other
+    from scipy.special import ndtr
+
+    from lv3d.describe import regular_corner_candidates
+    from lv3d.facts import REGULAR_CORNERS, regular_corner_range
+
+    assert regular_corner_range(5) == pytest.approx((100.0, 114.545), abs=1e-3)
+    assert regular_corner_range(6) == pytest.approx((114.545, 124.615), abs=1e-3)
+
+    def read(dih, sd):
+        return {c[0]: c for c in regular_corner_candidates(("f1", "f2"), dih, sd)}
+
+    pent, hexa = read(108.0, 0.5), read(120.0, 0.5)
+    assert set(pent) == set(REGULAR_CORNERS)
+    assert pent["pentagonal_dihedral"][2] > 0.99 and pent["hexagonal_dihedral"][2] < 0.01
+    assert hexa["hexagonal_dihedral"][2] > 0.99 and hexa["pentagonal_dihedral"][2] < 0.01
+    assert all(c[1] == ("f1", "f2") and c[3] == 120.0 for c in hexa.values())
+    assert all(c[2] < 1e-6 for c in read(90.0, 0.5).values())
+    mid = read(regular_corner_range(6)[0], 3.0)
+    assert mid["pentagonal_dihedral"][2] == pytest.approx(mid["hexagonal_dihedral"][2], abs=0.02)
+    # the spread is grounding's Laplace spread with its 1-degree model-error floor added in quadrature
+    sd = np.hypot(2.0, 1.0)
+    want = ndtr((114.545 - 112.0) / sd) - ndtr((100.0 - 112.0) / sd)
+    assert read(112.0, 2.0)["pentagonal_dihedral"][2] == pytest.approx(want, abs=1e-3)
+    assert regular_corner_candidates(("f1", "f2"), float("nan"), 1.0) == []

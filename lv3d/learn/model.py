@@ -47,8 +47,9 @@ FIT_MODULE, SCENE_MODULE = "lv3d_fit", "lv3d_scene"
 # happens to rest and so generalises worst from one view.
 BODY_ORDER = ("face_of", "cylindrical", "conical", "spherical", "circular", "elliptical", "triangle", "quadrilateral", "pentagon", "hexagon", "square", "rectangle", "regular",
               "triangle_neighbour", "quadrilateral_neighbour", "square_neighbour",
-              "perpendicular_neighbour", "acute_neighbour", "obtuse_neighbour", "right_corner",
-              "adjacent", "perpendicular", "acute", "obtuse", "parallel", "parallelogram", "horizontal", "vertical")
+              "perpendicular_neighbour", "acute_neighbour", "obtuse_neighbour", "pentagonal_neighbour",
+              "hexagonal_neighbour", "right_corner",
+              "adjacent", "perpendicular", "acute", "obtuse", "pentagonal_dihedral", "hexagonal_dihedral", "parallel", "parallelogram", "horizontal", "vertical")
 
 
 # object/1 holds for every target; horizontal/vertical say how a solid rests, not what it is, and

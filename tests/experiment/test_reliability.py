@@ -71,7 +71,7 @@ def test_corrupt_cache_files_are_computed_again(tmp_path, tiny_config, fake_worl
     for p in (out / "folds").rglob("fold*.json"):
         p.unlink()
     run_study(tiny_config, out, sets, progress=False)
-    assert json.loads(facts[0].read_text())["facts"]["schema"] == "lv3d.facts/3" and pixels.stat().st_size > 100
+    assert json.loads(facts[0].read_text())["facts"]["schema"] == "lv3d.facts/4" and pixels.stat().st_size > 100
     assert _records(out) == first
 
 

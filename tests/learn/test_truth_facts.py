@@ -36,7 +36,8 @@ def test_cube_faces_are_squares_meeting_at_right_angles():
     assert {"object(s1_o1)", "face_of(s1_o1,s1_o1_f1)", "square(s1_o1_f1)", "square(s1_o1_f2)",
             "horizontal(s1_o1_f1)", "vertical(s1_o1_f2)", "adjacent(s1_o1_f1,s1_o1_f2)",
             "perpendicular(s1_o1_f2,s1_o1_f1)", "quadrilateral(s1_o1_f2)"} <= a
-    assert not any(x.startswith(("acute", "obtuse", "triangle")) for x in a)
+    assert not any(x.startswith(("acute", "obtuse", "triangle", "pentagonal_dihedral", "hexagonal_dihedral"))
+                   for x in a)
 
 
 def test_modality_keeps_only_its_predicates():
@@ -102,3 +103,14 @@ def test_elliptical_is_in_the_colour_vocabulary_only():
 
     assert ("elliptical", 1) in body_preds("rgb")
     assert ("elliptical", 1) not in body_preds("depth") and ("elliptical", 1) not in body_preds("rgbd")
+
+
+def test_sides_meeting_at_a_hexagons_corner_angle_are_hexagonal_dihedral():
+    meta = cube_meta()
+    meta["truth"]["adjacency"] = [{"faces": [1, 2], "dihedral_deg": 120.0}]
+    a = atoms(truth_facts(meta, "s1", "depth"))
+    assert {"obtuse(s1_o1_f1,s1_o1_f2)", "hexagonal_dihedral(s1_o1_f1,s1_o1_f2)",
+            "hexagonal_dihedral(s1_o1_f2,s1_o1_f1)"} <= a
+    assert not any(x.startswith("pentagonal_dihedral") for x in a)
+    meta["truth"]["adjacency"] = [{"faces": [1, 2], "dihedral_deg": 108.0}]
+    assert "pentagonal_dihedral(s1_o1_f1,s1_o1_f2)" in atoms(truth_facts(meta, "s1", "depth"))
