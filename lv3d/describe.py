@@ -19,6 +19,7 @@ import numpy as np
 from .calibration import shipped as shipped_calibration
 from .cylinder import Cylinder
 from .facts import PREDICATES, REGULAR_CORNERS, Fact, SceneFacts, regular_corner_range
+from .interval import probability_between
 from .perception.polygons import area
 from .rgbd import RGBD
 from .scene import Face, Scene, SceneObject
@@ -247,7 +248,9 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
     intr = (k.fx, k.fy, k.cx, k.cy)
     support = None if scene.support_plane is None else _plane_row(scene.support_plane)
     cands: list[tuple[str, tuple[str, ...], float, float | None]] = []
-    curved: list[tuple[str, tuple[str, ...], float, float | None]] = []  # measured, no calibration map (yet)
+    # facts measured with no calibration map (yet): the curved surfaces and outlines, the regular corners
+    uncalibrated: list[tuple[str, tuple[str, ...], float, float | None]] = []
+    floors = grounding.Floors()
     results: list[ObjectResult] = []
     # pack every object (in chunks of MAX_FACES faces), ground them all in batched calls, then read facts
     jobs: list[_Job] = []
@@ -332,8 +335,8 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                 if not has_plane[i] and scene.modality == "rgb":  # colour alone: image-plane shape
                     cands += image_shape(f.id, corner_l[i][:n], corner_sd[i][:n], side_l[i][:n], side_sd[i][:n])
                 if reading is not None and reading.evidence is not None:
-                    curved.append(("cylindrical", (f.id,), reading.evidence, float(reading.cylinder.radius)))
-                curved += quadric_candidates(f) + ellipse_candidates(f)
+                    uncalibrated.append(("cylindrical", (f.id,), reading.evidence, float(reading.cylinder.radius)))
+                uncalibrated += quadric_candidates(f) + ellipse_candidates(f)
                 if has_plane[i]:
                     if n == 4:
                         cands.append(("square", (f.id,), c["p_square"][i], c["side_ratio"][i]))
@@ -356,13 +359,13 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
                     if args in adjacent:
                         cands.append(("acute", args, ca["p_acute"][i][j], dih))
                         cands.append(("obtuse", args, ca["p_obtuse"][i][j], dih))
-                        curved += regular_corner_candidates(args, dih, dih_sd[i][j])
+                        uncalibrated += regular_corner_candidates(args, dih, dih_sd[i][j], floors.dihedral_deg)
         for a, b in obj.adjacency:
             if a in face_conf and b in face_conf:
                 p = min(face_conf[a], face_conf[b])  # the shared edge is as real as the weaker face
                 cands.append(("adjacent", (a, b), p, None))
                 cands.append(("adjacent", (b, a), p, None))
-        curved += cap_candidates(obj, face_results)
+        uncalibrated += cap_candidates(obj, face_results, floors.dihedral_deg)
         cands.append(("object", (obj.id,), max(face_conf.values(), default=0.0), None))
         results.append(ObjectResult(obj, face_results, dihedrals, status, raw))
     if calibrate:
@@ -378,29 +381,23 @@ def ground(scene: Scene, frame: RGBD, *, refine: bool = True, field: np.ndarray 
         calibrate_one, modality = shipped_calibration().calibrate, scene.modality
         cands = [(pred, args, calibrate_one(modality, key, p, next(it) if pick else None), value)
                  for (pred, args, p, value), key, pick in zip(cands, keys, picked)]
-    return cands + curved, results
+    return cands + uncalibrated, results
 
 
-def regular_corner_candidates(args: tuple[str, str], dih_deg: float, sd_deg: float
+def regular_corner_candidates(args: tuple[str, str], dih_deg: float, sd_deg: float, floor_deg: float
                               ) -> list[tuple[str, tuple[str, ...], float, float | None]]:
     """``pentagonal_dihedral`` / ``hexagonal_dihedral`` of two adjacent faces: the probability that their interior
     dihedral is nearer a regular pentagon's (hexagon's) corner than any other regular polygon's, i.e. that
-    360 / (180 - dihedral) rounds to 5 (6): between 100.0 and 114.5 deg (114.5 and 124.6). The dihedral's error
-    is Gaussian with grounding's Laplace spread and its model-error floor (grounding.Floors.dihedral_deg), as
-    ``perpendicular``'s; value: the dihedral. The two sides of a prism whose cap is missed or misread meet at the
-    angle of the cap's corners, which ``obtuse`` (above 97 deg) does not tell apart."""
-    import grounding
-    from scipy.special import ndtr
-
+    360 / (180 - dihedral) rounds to 5 (6): between 100.0 and 114.5 deg (114.5 and 124.6 deg). The dihedral's error
+    is Gaussian with grounding's Laplace spread ``sd_deg`` and the model-error floor ``floor_deg`` in quadrature
+    (grounding.Floors.dihedral_deg), as ``perpendicular``'s; value: the dihedral. The two sides of a prism whose cap
+    is missed or misread meet at the angle of the cap's corners, which ``obtuse`` (above 97 deg) does not tell
+    apart."""
     if not (math.isfinite(dih_deg) and math.isfinite(sd_deg)):
         return []
-    sd = math.hypot(sd_deg, grounding.Floors().dihedral_deg)
-    out = []
-    for pred, n in REGULAR_CORNERS.items():
-        lo, hi = regular_corner_range(n)
-        p = float(ndtr((hi - dih_deg) / sd) - ndtr((lo - dih_deg) / sd))
-        out.append((pred, args, p, dih_deg))
-    return out
+    sd = math.hypot(sd_deg, floor_deg)
+    return [(pred, args, probability_between(*regular_corner_range(n), dih_deg, sd), dih_deg)
+            for pred, n in REGULAR_CORNERS.items()]
 
 
 def _angle_readings(jobs: list[_Job], grounded: list[dict], depth_field: np.ndarray,
@@ -480,18 +477,16 @@ def refined_cylinder(face: Face, fit) -> Cylinder:
 CAP_TOL_DEG = 10.0
 
 
-def cap_candidates(obj: SceneObject, faces: list[FaceResult]) -> list[tuple[str, tuple[str, ...], float, float | None]]:
+def cap_candidates(obj: SceneObject, faces: list[FaceResult], floor_deg: float
+                   ) -> list[tuple[str, tuple[str, ...], float, float | None]]:
     """``circular`` for each planar face of ``obj`` that meets one of its cylindrical faces with its normal along
     the cylinder's axis: the probability that the angle between them is within CAP_TOL_DEG, value the angle in
     degrees. A can's lid is read as a polygon of a few sides; this says its outline is a circle.
 
     The angle is read from grounding's refined plane and refined cylinder (``faces``, :class:`FaceResult`), with
     a Gaussian error whose variance is the sum of the normal's and the axis's (each the mean of its two tilts'
-    variances: grounding's Laplace spreads) and the model-error floor of grounding's angles between planes
-    (grounding.Floors.dihedral_deg), as plane-to-plane facts have theirs."""
-    import grounding
-
-    floor = grounding.Floors().dihedral_deg
+    variances: grounding's Laplace spreads) and the model-error floor ``floor_deg`` of grounding's angles between
+    planes (grounding.Floors.dihedral_deg), as plane-to-plane facts have theirs."""
     by_id = {fr.face.id: fr for fr in faces}
     out = []
     for a, b in obj.adjacency:
@@ -506,8 +501,7 @@ def cap_candidates(obj: SceneObject, faces: list[FaceResult]) -> list[tuple[str,
             var = float(np.mean(np.square(np.degrees(side.cylinder_reading.fit.axis_std))))
             if cap.plane_tilt_std_rad is not None:
                 var += float(np.mean(np.square(np.degrees(cap.plane_tilt_std_rad))))
-            z = math.sqrt(2.0 * (var + floor * floor))
-            p = 0.5 * (math.erf((CAP_TOL_DEG - theta) / z) - math.erf((-CAP_TOL_DEG - theta) / z))
+            p = probability_between(-CAP_TOL_DEG, CAP_TOL_DEG, theta, math.sqrt(var + floor_deg * floor_deg))
             if p > 0:
                 out.append(("circular", (cap.face.id,), p, round(theta, 2)))
     best: dict = {}

@@ -15,11 +15,12 @@ test under those Gaussians (Monte Carlo with fixed draws for the tests over seve
 from __future__ import annotations
 
 import functools
-import math
 
 import numpy as np
 
 from grounding import EQUAL_CORNERS_DEG, RIGHT_ANGLE_DEG, Floors
+
+from .interval import probability_below
 
 EQUAL_SIDES_RATIO = 1.12  # square / regular: longest side / shortest side at most this (grounding's metric test)
 DRAWS = 256
@@ -38,11 +39,6 @@ def _p(x) -> float:
     return float(np.clip(x, 0.0, 1.0))
 
 
-def _below(x: float, mu: float, sd: float) -> float:
-    """P(X < x) for X ~ N(mu, sd^2)."""
-    return 0.5 * (1.0 + math.erf((x - mu) / (sd * math.sqrt(2.0))))
-
-
 def image_shape(fid: str, corner_deg, corner_std, side_px, side_std) -> list[tuple[str, tuple[str], float, float]]:
     """Candidate facts ``(pred, (fid,), probability, value)`` of one face from its image polygon: its n
     interior corner angles (degrees) and n side lengths (pixels), each with its Laplace spread (before the
@@ -57,8 +53,8 @@ def image_shape(fid: str, corner_deg, corner_std, side_px, side_std) -> list[tup
     if n < 3 or len(s) != n:
         return []
     lo, hi = 90.0 - RIGHT_ANGLE_DEG, 90.0 + RIGHT_ANGLE_DEG
-    p_acute = np.array([_below(lo, m, d) for m, d in zip(c, cs)])
-    p_obtuse = np.array([1.0 - _below(hi, m, d) for m, d in zip(c, cs)])
+    p_acute = np.array([probability_below(lo, m, d) for m, d in zip(c, cs)])
+    p_obtuse = np.array([1.0 - probability_below(hi, m, d) for m, d in zip(c, cs)])
     p_right = 1.0 - p_acute - p_obtuse
     out = [("has_right_angle", (fid,), _p(1.0 - np.prod(1.0 - p_right)), float(np.min(np.abs(c - 90.0)))),
            ("has_acute_angle", (fid,), _p(1.0 - np.prod(1.0 - p_acute)), float(np.min(c))),

@@ -245,7 +245,7 @@ def test_a_lid_along_a_cylinder_axis_is_circular_and_a_side_face_is_not():
     obj = SceneObject("o", [side, lid, wall], [("o_f1", "o_f2"), ("o_f1", "o_f3")])
     faces = [_face_result(side, fit=_cylinder_fit((0.0, -1.0, 0.0), 0.5)),
              _face_result(lid, (0.0, -0.9986, -0.0523, 0.1), 0.5), _face_result(wall, (1.0, 0.0, 0.0, 0.1), 0.5)]
-    got = {c[1][0]: c for c in cap_candidates(obj, faces)}
+    got = {c[1][0]: c for c in cap_candidates(obj, faces, 1.0)}
     assert set(got) == {"o_f2"} and got["o_f2"][0] == "circular"
     assert got["o_f2"][2] > 0.9 and abs(got["o_f2"][3] - 3.0) < 0.1
 
@@ -264,7 +264,7 @@ def test_a_cap_reading_is_as_sure_as_its_measured_spreads():
     p = {}
     for std in (0.2, 4.0):
         faces = [_face_result(side, fit=_cylinder_fit((0.0, -1.0, 0.0), std)), _face_result(lid, n, std)]
-        (c,) = cap_candidates(obj, faces)
+        (c,) = cap_candidates(obj, faces, 1.0)
         p[std] = c[2]
     assert p[0.2] > 0.9 and p[4.0] < 0.75
 
@@ -281,7 +281,7 @@ def test_a_refinement_without_spreads_gives_no_cap_reading():
     obj = SceneObject("o", [side, lid], [("o_f1", "o_f2")])
     faces = [_face_result(side, fit=_cylinder_fit((0.0, -1.0, 0.0), np.nan)),
              _face_result(lid, (0.0, -1.0, 0.0, 0.1), 0.5)]
-    assert cap_candidates(obj, faces) == []
+    assert cap_candidates(obj, faces, 1.0) == []
 
 
 def test_a_round_face_keeps_its_polygon_facts_only_as_far_as_it_may_be_a_polygon():
@@ -371,7 +371,7 @@ def test_two_sides_meeting_at_a_regular_polygons_corner_angle_name_that_polygon(
     assert regular_corner_range(6) == pytest.approx((114.545, 124.615), abs=1e-3)
 
     def read(dih, sd):
-        return {c[0]: c for c in regular_corner_candidates(("f1", "f2"), dih, sd)}
+        return {c[0]: c for c in regular_corner_candidates(("f1", "f2"), dih, sd, 1.0)}
 
     pent, hexa = read(108.0, 0.5), read(120.0, 0.5)
     assert set(pent) == set(REGULAR_CORNERS)
@@ -381,8 +381,8 @@ def test_two_sides_meeting_at_a_regular_polygons_corner_angle_name_that_polygon(
     assert all(c[2] < 1e-6 for c in read(90.0, 0.5).values())
     mid = read(regular_corner_range(6)[0], 3.0)
     assert mid["pentagonal_dihedral"][2] == pytest.approx(mid["hexagonal_dihedral"][2], abs=0.02)
-    # the spread is grounding's Laplace spread with its 1-degree model-error floor added in quadrature
+    # the spread is grounding's Laplace spread with the model-error floor (1 degree here) added in quadrature
     sd = np.hypot(2.0, 1.0)
     want = ndtr((114.545 - 112.0) / sd) - ndtr((100.0 - 112.0) / sd)
     assert read(112.0, 2.0)["pentagonal_dihedral"][2] == pytest.approx(want, abs=1e-3)
-    assert regular_corner_candidates(("f1", "f2"), float("nan"), 1.0) == []
+    assert regular_corner_candidates(("f1", "f2"), float("nan"), 1.0, 1.0) == []

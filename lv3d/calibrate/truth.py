@@ -11,6 +11,11 @@ from grounding import (ACUTE_BELOW_DEG, EQUAL_CORNERS_DEG, EQUAL_SIDES_RATIO, OB
 from ..perception.polygons import rasterize
 
 NGONS = {"triangle": 3, "quadrilateral": 4, "pentagon": 5, "hexagon": 6}
+FACE_SHAPES = ("parallelogram", "rectangle", "square", "regular")
+# the predicates whose truth a rendered scene's ground truth gives (truth_labels); the others (the curved surfaces
+# and outlines, the regular corners) have no calibration map, so their candidates get no label and make no row
+LABELLED = frozenset({"face_of", *NGONS, *FACE_SHAPES, "horizontal", "vertical", "adjacent", "perpendicular",
+                      "parallel", "acute", "obtuse"})
 
 
 def _angle(a, b) -> float:
@@ -70,7 +75,8 @@ def face_truth(g: dict, k) -> dict:
 
 def truth_labels(cands, results, faces_mask, truth, k) -> list:
     """For each candidate (pred, args, p, value): True/False on the ground truth, or None where the truth
-    says nothing (objects other than the target, faces cut by occlusion for shape predicates)."""
+    says nothing (objects other than the target, faces cut by occlusion for shape predicates, predicates outside
+    ``LABELLED``)."""
     match: dict = {}
     target_faces: set = set()
     for res in results:
@@ -83,7 +89,7 @@ def truth_labels(cands, results, faces_mask, truth, k) -> list:
     cache = {}
     labels = []
     for pred, args, _, _ in cands:
-        if pred == "object" or not all(a in target_faces for a in args[-1:]):
+        if pred not in LABELLED or not all(a in target_faces for a in args[-1:]):
             labels.append(None)
             continue
         if pred == "face_of":
@@ -101,7 +107,7 @@ def truth_labels(cands, results, faces_mask, truth, k) -> list:
             ft = cache.setdefault(g["id"], face_truth(g, k))
             if pred in NGONS:
                 labels.append(g["sides"] == NGONS[pred])
-            elif pred in ("parallelogram", "rectangle", "square", "regular"):
+            elif pred in FACE_SHAPES:
                 labels.append(ft[pred])
             else:
                 tilt = _angle(g["plane"]["normal"], support)
@@ -120,10 +126,8 @@ def truth_labels(cands, results, faces_mask, truth, k) -> list:
             labels.append(min(between, 180 - between) < PLANE_ANGLE_DEG)
         elif pred == "acute":
             labels.append(key in adj and adj[key] < ACUTE_BELOW_DEG)
-        elif pred == "obtuse":
+        else:  # obtuse
             labels.append(key in adj and adj[key] > OBTUSE_ABOVE_DEG)
-        else:
-            labels.append(None)
     return labels
 
 
