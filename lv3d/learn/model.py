@@ -173,10 +173,13 @@ class Explanation:
     others: dict[str, float] = field(default_factory=dict)
     missing: list[str] = field(default_factory=list)  # facts the scene lacks (a near miss)
     near: bool = False  # no program proves the scene at its threshold: this is the nearest one
-    # the class whose program proved it too and ranked first or second, and the arbiter that told them apart
+    # the class whose program proved it too and ranked first or second, and the arbiter that told them apart: the
+    # label's, proving it (rival_clauses, rival_facts: the proof), or the rival's, failing to (rival_fails)
     rival: str | None = None
     rival_clauses: list[str] = field(default_factory=list)
     rival_facts: list[tuple[str, float]] = field(default_factory=list)
+    # the arbiter is the rival's, learned with the rival's examples as its positives, and fails to prove it
+    rival_fails: bool = False
 
     def __str__(self) -> str:
         if self.label == "unknown":
@@ -194,7 +197,11 @@ class Explanation:
         lines += [f"  with {a} ({c:.3f})" for a, c in self.facts]
         lines += [f"  but not {a} (absent)" for a in self.missing]
         lines += [f"  where {d} (background)" for d in self.derived]
-        if self.rival:
+        if self.rival and self.rival_fails:
+            lines.append(f"  rather than a {self.rival} (whose program proves it too), because no clause of what "
+                         f"tells a {self.rival} from a {self.label} proves it:")
+            lines += ["    " + c.replace("\n", "\n    ") for c in self.rival_clauses]
+        elif self.rival:
             lines.append(f"  rather than a {self.rival} (whose program proves it too), because")
             lines += ["    " + c.replace("\n", "\n    ") for c in self.rival_clauses]
             lines += [f"    with {a} ({c:.3f})" for a, c in self.rival_facts]
@@ -209,7 +216,9 @@ class Model:
     the higher training J), answering with the proof's confidence. When the two first-ranked classes'
     programs both prove it and the model holds arbiters for that pair (``arbiters``: (class, rival) ->
     a program that proves the class's training examples and not the rival's, :meth:`fit`), the class
-    whose arbiter proves it while the other's does not comes first. When none proves
+    whose arbiter proves it while the other's does not comes first; where the pair has one arbiter only (the
+    other's search found none), its class comes first when it proves the scene and the other when it does not
+    (negation as failure: the arbiter was learned on the two classes alone). When none proves
     it: with one program, "unknown" (the negative answer of a class task); with several, the class
     whose program it misses by least (:func:`_near_rank`: the largest share of the program's facts present,
     then the highest per-fact confidence of those, times precision; absent facts at NEAR_MISS), with
@@ -322,6 +331,12 @@ class Model:
             arb = self.arbiters.get((c, other))
             if arb is not None and arb.target in settled:
                 told[c] = (arb, settled[arb.target])
+        lone = [(c, other) for c, other in ((first, second), (second, first)) if (c, other) in self.arbiters]
+        if not told and len(lone) == 1:
+            # the pair's one arbiter (learned on the two classes alone, its class's examples the positives and
+            # the other's the negatives) does not prove the scene: by negation as failure, it is the other class
+            loser, winner = lone[0]
+            told[winner] = (self.arbiters[lone[0]], None)
         if len(told) != 1:  # neither or both: the arbiters cannot tell them apart
             return proofs
         winner = next(iter(told))
@@ -377,6 +392,8 @@ class Model:
         """The Explanation fields of the arbiter that ranked ``best`` first, if one did."""
         if "rival" not in best:
             return {}
+        if best["rival_trace"] is None:  # the rival's arbiter fails to prove it: every clause of it fails
+            return {"rival": best["rival"], "rival_clauses": list(best["rival_program"].clauses), "rival_fails": True}
         clauses, facts = _proof_parts(best["rival_program"], best["rival_trace"])
         return {"rival": best["rival"], "rival_clauses": clauses, "rival_facts": facts}
 

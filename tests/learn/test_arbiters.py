@@ -106,3 +106,32 @@ def test_the_arbiters_setting_turns_them_off():
     model = Model.fit(scenes, labels, settings={"disjunctions": 0, "arbiters": False}, seed=0)
     assert model.arbiters == {} and model.settings["arbiters"] is False
     assert model.predict(_prism("t5", "pentagon"))[0] in ("pent", "hex")  # proved by both, as the ranking has it
+
+
+def test_a_pairs_only_arbiter_decides_by_failing_too():
+    # the other class's search found no arbiter: the one there is puts its class first when it proves the scene
+    # and the other class first when it does not (it was learned on the two classes alone)
+    a = Program("a_over_b", ("a_over_b(A) :- face_of(A, B), pentagon(B).",))
+    model = Model({}, arbiters={("a", "b"): a})
+    ranked = [{"label": "a", "conf": 0.9, "trace": []}, {"label": "b", "conf": 0.8, "trace": []},
+              {"label": "c", "conf": 0.5, "trace": []}]
+    trace = [("clause", "1", 1.0), ("fact", "pentagon(f)", 0.9)]
+    kept = model._arbitrate(ranked, {"a_over_b": trace})
+    assert [p["label"] for p in kept] == ["a", "b", "c"] and kept[0]["rival_trace"] == trace
+    flipped = model._arbitrate(ranked, {})
+    assert [p["label"] for p in flipped] == ["b", "a", "c"]
+    assert flipped[0]["rival"] == "a" and flipped[0]["rival_trace"] is None
+    assert model._arbitrate(ranked[1:], {}) == ranked[1:]  # b and c: no arbiter of theirs
+
+
+def test_an_answer_a_failing_arbiter_decided_names_what_failed():
+    scenes, labels = _task()
+    model = Model.fit(scenes, labels, settings={"disjunctions": 0}, seed=0)
+    del model.arbiters[("hex", "pent")]  # as where the search finds no hexagonal prism's arbiter
+    scene = _prism("t6", "hexagon")  # proved by both prisms' programs, and by no pentagon arbiter
+    assert model.answer(scene) == ("hex", model.answer(scene)[1], "arbiter")
+    e = model.explain(scene)
+    assert e.rival == "pent" and e.rival_fails and e.rival_facts == []
+    text = str(e)
+    assert "rather than a pent (whose program proves it too), because no clause of what tells a pent from a hex " \
+           "proves it:" in text and "    pent_over_hex(A) :-\n        face_of(A, B),\n        pentagon(B)." in text
