@@ -19,7 +19,8 @@ _ROOT = Path(__file__).resolve().parents[2]      # the checkout (or site-package
 FACT_SOURCES = ("lv3d/perception", "lv3d/describe.py", "lv3d/facts.py", "lv3d/pipeline.py", "lv3d/scene.py",
                 "lv3d/plane.py", "lv3d/cylinder.py", "lv3d/sphere.py", "lv3d/cone.py", "lv3d/camera.py",
                 "lv3d/rgbd.py", "lv3d/object_facts.py", "lv3d/frame_folder.py", "lv3d/image_shape.py",
-                "lv3d/calibration.py", "lv3d/data/calibration.json", "grounding")
+                "lv3d/interval.py", "lv3d/outline_ellipse.py", "lv3d/calibration.py", "lv3d/data/calibration.json",
+                "grounding")
 # What learning from those facts depends on: the Python side of the learner and the Prolog files.
 LEARNER_SOURCES = ("lv3d/learn", "prolog")
 
