@@ -197,14 +197,12 @@ class Explanation:
         lines += [f"  with {a} ({c:.3f})" for a, c in self.facts]
         lines += [f"  but not {a} (absent)" for a in self.missing]
         lines += [f"  where {d} (background)" for d in self.derived]
-        if self.rival and self.rival_fails:
-            lines.append(f"  rather than a {self.rival} (whose program proves it too), because no clause of what "
-                         f"tells a {self.rival} from a {self.label} proves it:")
+        if self.rival:
+            why = (f"no clause of what tells a {self.rival} from a {self.label} proves it:" if self.rival_fails
+                   else "")
+            lines.append(f"  rather than a {self.rival} (whose program proves it too), because {why}".rstrip())
             lines += ["    " + c.replace("\n", "\n    ") for c in self.rival_clauses]
-        elif self.rival:
-            lines.append(f"  rather than a {self.rival} (whose program proves it too), because")
-            lines += ["    " + c.replace("\n", "\n    ") for c in self.rival_clauses]
-            lines += [f"    with {a} ({c:.3f})" for a, c in self.rival_facts]
+            lines += [f"    with {a} ({c:.3f})" for a, c in self.rival_facts]  # none where the arbiter fails
         if self.others:
             lines.append("  also proved: " + ", ".join(f"{k} {v:.3f}" for k, v in self.others.items()))
         return "\n".join(lines)
@@ -326,17 +324,18 @@ class Model:
         if len(proofs) < 2:
             return proofs
         first, second = proofs[0]["label"], proofs[1]["label"]
-        told = {}
+        told, held = {}, []
         for c, other in ((first, second), (second, first)):
             arb = self.arbiters.get((c, other))
-            if arb is not None and arb.target in settled:
-                told[c] = (arb, settled[arb.target])
-        lone = [(c, other) for c, other in ((first, second), (second, first)) if (c, other) in self.arbiters]
-        if not told and len(lone) == 1:
+            if arb is not None:
+                held.append((other, arb))
+                if arb.target in settled:
+                    told[c] = (arb, settled[arb.target])
+        if not told and len(held) == 1:
             # the pair's one arbiter (learned on the two classes alone, its class's examples the positives and
             # the other's the negatives) does not prove the scene: by negation as failure, it is the other class
-            loser, winner = lone[0]
-            told[winner] = (self.arbiters[lone[0]], None)
+            other, arb = held[0]
+            told[other] = (arb, None)
         if len(told) != 1:  # neither or both: the arbiters cannot tell them apart
             return proofs
         winner = next(iter(told))
