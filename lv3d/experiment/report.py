@@ -2,7 +2,7 @@
 ``results.csv`` (one row per condition x system x fold x task; ``tuned``: the setting a tuned baseline chose on
 that fold, as JSON), ``results.json`` (means, standard
 deviations, paired tests, the calibration of the multi-class answers and, for lv3d systems, how they were
-reached: by a proof, an arbiter, a near proof or none; which classes the answers confuse), ``results.md`` (the
+reached: by a proof, an arbiter, resemblance (near) or none; which classes the answers confuse), ``results.md`` (the
 tables), ``accuracy.png``, ``reliability.png`` (the answers' reliability diagram, last condition),
 ``confusion.png`` (the multi-class answers of each lv3d system against the true classes, last condition) and
 ``sweep.png`` when the study has several conditions.
@@ -325,7 +325,8 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing:
             lines += ["", "How the lv3d systems reached their multi-class answers (answers, and the share right): "
                       "*proof*, a class's program proves the object and ranks first; *arbiter*, two classes' "
                       "programs prove it and an arbiter between them chose; *near*, no program proves it and the "
-                      "one it misses by least names the class; *unknown*, no answer (no object, or no program):", "",
+                      "training object it resembles most names the class; *unknown*, no answer (no object, or no "
+                      "program):", "",
                       "| system | " + " | ".join(ANSWER_KINDS) + " |", "|---|" + "---|" * len(ANSWER_KINDS)]
             for s, kinds in reached.items():
                 cols = [f"{kinds[k][0]} ({100 * kinds[k][1] / kinds[k][0]:.0f} %)" if kinds.get(k, (0,))[0] else "0"

@@ -13,14 +13,15 @@ from ..facts import PREDICATES, SceneFacts
 from . import engine
 from .engine import LearnError
 from .program import Program
+from .resemblance import Reference, contrast, nearest, profile
 from .settings import NOT_MIL, check_settings
 
 # Metarules for shape concepts, in search order: a part with a property, a part with two, a
 # conjunction on the object, then a part in a relation with another part.
 SHAPE_METARULES = ("part", "part2", "part_pair")
-# When no program proves a scene, a model of several classes names the class whose program it
-# misses by least (docs/learner.md, "Classifying"): a fact the scene lacks counts as holding with
-# this confidence, the chance that perception missed a true fact.
+# When no program proves a scene, a model of several classes names the class of the training object it
+# resembles most (resemblance.py; docs/learner.md, "Classifying") and shows that class's near proof: a fact
+# the scene lacks counts as holding with this confidence, the chance that perception missed a true fact.
 NEAR_MISS = 0.1
 ANSWER_KINDS = ("proof", "arbiter", "near", "unknown")  # how Model.answer reached an answer
 # Learning from many examples (docs/learner.md, "Imperfect labels"): 16 samples of 2 positives and
@@ -180,10 +181,32 @@ class Explanation:
     rival_facts: list[tuple[str, float]] = field(default_factory=list)
     # the arbiter is the rival's, learned with the rival's examples as its positives, and fails to prove it
     rival_fails: bool = False
+    # a near answer: the training object whose facts the scene's resemble most, its class and the profiles'
+    # distance, and (predicate, the scene's confidence, the training object's) shown by both / by one of them
+    resembles: str | None = None
+    resembles_label: str | None = None
+    resembles_distance: float = 0.0
+    shared: list[tuple[str, float, float]] = field(default_factory=list)
+    differ: list[tuple[str, float, float]] = field(default_factory=list)
 
     def __str__(self) -> str:
         if self.label == "unknown":
             return f"{self.target}: unknown (no class's program proves it)"
+        if self.resembles:
+            lines = [f"{self.target} is most likely a {self.label} (confidence {self.confidence:.3f}): no program "
+                     f"proves it, and of the training objects it resembles {self.resembles}, a {self.resembles_label}, "
+                     f"most (distance {self.resembles_distance:.2f})"]
+            lines += [f"  both show {p} ({a:.3f} here, {b:.3f} there)" for p, a, b in self.shared]
+            lines += [f"  {'it shows' if a >= b else 'that one shows'} {p} ({a:.3f} here, {b:.3f} there)"
+                      for p, a, b in self.differ]
+            if self.clauses:
+                lines.append(f"  the {self.label}'s program, which it misses:")
+                lines += ["    " + c.replace("\n", "\n    ") for c in self.clauses]
+                lines += [f"    with {a} ({c:.3f})" for a, c in self.facts]
+                lines += [f"    but not {a} (absent)" for a in self.missing]
+            if self.others:
+                lines.append("  nearest proofs of the others: " + ", ".join(f"{k} {v:.3f}" for k, v in self.others.items()))
+            return "\n".join(lines)
         if self.missing:
             lines = [f"{self.target} is most likely a {self.label} (confidence {self.confidence:.3f}): no program "
                      f"proves it, and this one misses by {len(self.missing)} of its "
@@ -217,18 +240,23 @@ class Model:
     whose arbiter proves it while the other's does not comes first; where the pair has one arbiter only (the
     other's search found none), its class comes first when it proves the scene and the other when it does not
     (negation as failure: the arbiter was learned on the two classes alone). When none proves
-    it: with one program, "unknown" (the negative answer of a class task); with several, the class
-    whose program it misses by least (:func:`_near_rank`: the largest share of the program's facts present,
-    then the highest per-fact confidence of those, times precision; absent facts at NEAR_MISS), with
-    that near proof's confidence, which is below the coverage threshold."""
+    it: a class task (one class), "unknown" (its negative answer); a model of several classes, the class of the
+    training object whose facts it resembles most (``references``, resemblance.py; a class whose search found no
+    program among them), with that class's near proof
+    (absent facts at NEAR_MISS) and its confidence, which is below the coverage threshold (0 where the class has
+    no program). A model without references (saved before it kept them) names the class whose program it misses
+    by least instead (:func:`_near_rank`: the largest share of the program's facts present, then the highest
+    per-fact confidence of those, times precision)."""
 
     def __init__(self, programs: dict[str, Program], settings: dict | None = None,
                  failures: dict[str, str] | None = None,
-                 arbiters: dict[tuple[str, str], Program] | None = None):
+                 arbiters: dict[tuple[str, str], Program] | None = None,
+                 references: list[Reference] | None = None):
         self.programs = dict(programs)
         self.settings = dict(settings or {})
         self.failures = dict(failures or {})  # class -> why no program was learned
         self.arbiters = dict(arbiters or {})  # (class, rival) -> the program telling the class from the rival
+        self.references = list(references or [])  # the training objects a scene no program proves is likened to
 
     @classmethod
     def fit(cls, scenes: list[SceneFacts], labels: list[str], settings: dict | None = None, seed: int = 0,
@@ -251,7 +279,9 @@ class Model:
                 programs[c] = fit(scenes, labels, c, settings=search or None, seed=seed)
             except LearnError as e:
                 failures[c] = str(e)
-        model = cls(programs, settings, failures)
+        references = [Reference(sc.target, y, profile(sc)) for sc, y in zip(scenes, labels)
+                      if len(classes) > 1 and sc.target is not None]
+        model = cls(programs, settings, failures, references=references)
         if len(programs) > 1 and search.get("arbiters", True):
             model.arbiters = model._learn_arbiters(scenes, labels, search or None, seed)
         return model
@@ -347,9 +377,18 @@ class Model:
 
     def _decide(self, scene: SceneFacts) -> list[dict]:
         proofs = self._proofs(scene)
-        if not proofs and len(self.programs) > 1:
-            proofs = [{**p, "near": True} for p in self._proofs(scene, near=True)]
-        return proofs
+        if proofs or (len(self.programs) < 2 and not self.references):  # a class task: "unknown"
+            return proofs
+        proofs = [{**p, "near": True} for p in self._proofs(scene, near=True)] if self.programs else []
+        prof = profile(scene)
+        found = nearest(prof, self.references)
+        if found is None:
+            return proofs
+        ref, dist = found
+        mine = next((p for p in proofs if p["label"] == ref.label), None)
+        first = {**(mine or {"label": ref.label, "conf": 0.0, "trace": [], "near": True}),
+                 "resembles": (ref, dist, prof)}
+        return [first, *(p for p in proofs if p is not mine)]
 
     def _thresholds(self, opts: dict, programs: dict[str, Program] | None = None) -> dict[str, float]:
         """Each program's coverage threshold (of ``programs``, default the classes'), by the same keys: the one it
@@ -378,13 +417,24 @@ class Model:
         if not proofs:
             return Explanation("unknown", 0.0, scene.target)
         best = proofs[0]
-        clauses, facts = _proof_parts(self.programs[best["label"]], best["trace"])
+        program = self.programs.get(best["label"])
+        clauses, facts = _proof_parts(program, best["trace"]) if program is not None else ([], [])
         return Explanation(
             best["label"], best["conf"], scene.target, clauses=clauses, facts=facts,
             derived=[a for k, a, _ in best["trace"] if k == "derived"],
             others={p["label"]: p["conf"] for p in proofs[1:]},
             missing=[a for k, a, _ in best["trace"] if k == "missing"], near=best.get("near", False),
-            **self._rival_parts(best))
+            **self._rival_parts(best), **self._resemblance_parts(best))
+
+    @staticmethod
+    def _resemblance_parts(best: dict) -> dict:
+        """The Explanation fields of the training object a near answer likened the scene to, if one did."""
+        if "resembles" not in best:
+            return {}
+        ref, dist, prof = best["resembles"]
+        shared, differ = contrast(prof, ref)
+        return {"resembles": ref.object, "resembles_label": ref.label, "resembles_distance": dist,
+                "shared": shared, "differ": differ}
 
     @staticmethod
     def _rival_parts(best: dict) -> dict:
@@ -406,7 +456,9 @@ class Model:
              "scores": {k: p.score for k, p in self.programs.items()},
              "predicates": {k: p.target for k, p in self.programs.items() if p.target != k},
              "arbiters": [{"class": c, "rival": r, "predicate": p.target, "score": p.score}
-                          for (c, r), p in sorted(self.arbiters.items())]}, indent=1))
+                          for (c, r), p in sorted(self.arbiters.items())],
+             "references": [{"object": r.object, "class": r.label, "profile": r.profile} for r in self.references]},
+            indent=1))
         return out_dir
 
     @classmethod
@@ -437,7 +489,14 @@ class Model:
                 raise InputError(index, f"an arbiter of {c!r} over {r!r}, a class the model does not hold")
             p = Program.load(in_dir / f"{pred}.pl", target=pred)
             arbiters[(c, r)] = Program(p.target, p.clauses, a.get("score", {}) or {}, p.modality)
-        return cls(programs, meta.get("settings", {}), arbiters=arbiters)
+        references = []
+        for r in meta.get("references", []) if isinstance(meta.get("references"), list) else []:
+            try:
+                references.append(Reference(str(r["object"]), str(r["class"]),
+                                            {str(k): float(v) for k, v in dict(r["profile"]).items()}))
+            except (KeyError, TypeError, ValueError) as e:
+                raise InputError(index, f"malformed reference {r!r}: {e}") from None
+        return cls(programs, meta.get("settings", {}), arbiters=arbiters, references=references)
 
 
 def _proof_parts(program: Program, trace: list[tuple[str, str, float]]) -> tuple[list[str], list[tuple[str, float]]]:
