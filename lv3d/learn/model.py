@@ -13,8 +13,8 @@ from ..facts import PREDICATES, SceneFacts
 from . import engine
 from .engine import LearnError
 from .program import Program
-from .resemblance import Reference, contrast, nearest, profile
-from .settings import NOT_MIL, check_settings
+from .resemblance import Reference, closeness, contrast, nearest, profile
+from .settings import EXCLUDED, NOT_MIL, check_settings
 
 # Metarules for shape concepts, in search order: a part with a property, a part with two, a
 # conjunction on the object, then a part in a relation with another part.
@@ -51,11 +51,6 @@ BODY_ORDER = ("face_of", "cylindrical", "conical", "spherical", "circular", "ell
               "perpendicular_neighbour", "acute_neighbour", "obtuse_neighbour", "pentagonal_neighbour",
               "hexagonal_neighbour", "right_corner",
               "adjacent", "perpendicular", "acute", "obtuse", "pentagonal_dihedral", "hexagonal_dihedral", "parallel", "parallelogram", "horizontal", "vertical")
-
-
-# object/1 holds for every target; horizontal/vertical say how a solid rests, not what it is, and
-# a concept learned from one view with them fails on the next pose.
-EXCLUDED = ("object", "horizontal", "vertical")
 
 
 def body_preds(modality: str, derived: bool = True) -> list[tuple[str, int]]:
@@ -188,6 +183,14 @@ class Explanation:
     resembles_distance: float = 0.0
     shared: list[tuple[str, float, float]] = field(default_factory=list)
     differ: list[tuple[str, float, float]] = field(default_factory=list)
+    near_confidence: float = 0.0  # a resemblance answer: its class program's near proof confidence
+
+    def _proof_lines(self, indent: str) -> list[str]:
+        """The clauses, the facts they used and those the scene lacks, each line indented by ``indent``."""
+        lines = [indent + c.replace("\n", "\n" + indent) for c in self.clauses]
+        lines += [f"{indent}with {a} ({c:.3f})" for a, c in self.facts]
+        lines += [f"{indent}but not {a} (absent)" for a in self.missing]
+        return lines
 
     def __str__(self) -> str:
         if self.label == "unknown":
@@ -200,10 +203,8 @@ class Explanation:
             lines += [f"  {'it shows' if a >= b else 'that one shows'} {p} ({a:.3f} here, {b:.3f} there)"
                       for p, a, b in self.differ]
             if self.clauses:
-                lines.append(f"  the {self.label}'s program, which it misses:")
-                lines += ["    " + c.replace("\n", "\n    ") for c in self.clauses]
-                lines += [f"    with {a} ({c:.3f})" for a, c in self.facts]
-                lines += [f"    but not {a} (absent)" for a in self.missing]
+                lines.append(f"  the {self.label}'s program, which it misses (near proof {self.near_confidence:.3f}):")
+                lines += self._proof_lines("    ")
             if self.others:
                 lines.append("  nearest proofs of the others: " + ", ".join(f"{k} {v:.3f}" for k, v in self.others.items()))
             return "\n".join(lines)
@@ -216,9 +217,7 @@ class Explanation:
                      f"proves it above its threshold, and this one comes nearest"]
         else:
             lines = [f"{self.target} is a {self.label} (confidence {self.confidence:.3f}) because"]
-        lines += ["  " + c.replace("\n", "\n  ") for c in self.clauses]
-        lines += [f"  with {a} ({c:.3f})" for a, c in self.facts]
-        lines += [f"  but not {a} (absent)" for a in self.missing]
+        lines += self._proof_lines("  ")
         lines += [f"  where {d} (background)" for d in self.derived]
         if self.rival:
             why = (f"no clause of what tells a {self.rival} from a {self.label} proves it:" if self.rival_fails
@@ -242,11 +241,11 @@ class Model:
     (negation as failure: the arbiter was learned on the two classes alone). When none proves
     it: a class task (one class), "unknown" (its negative answer); a model of several classes, the class of the
     training object whose facts it resembles most (``references``, resemblance.py; a class whose search found no
-    program among them), with that class's near proof
-    (absent facts at NEAR_MISS) and its confidence, which is below the coverage threshold (0 where the class has
-    no program). A model without references (saved before it kept them) names the class whose program it misses
+    program among them), with that class's near proof (absent facts at NEAR_MISS) as what its program misses, and
+    a confidence of how much nearer that class's training objects lie than any other's (resemblance.closeness).
+    A model without references (a model.json without a "references" list) names the class whose program it misses
     by least instead (:func:`_near_rank`: the largest share of the program's facts present, then the highest
-    per-fact confidence of those, times precision)."""
+    per-fact confidence of those, times precision), with its near proof's confidence."""
 
     def __init__(self, programs: dict[str, Program], settings: dict | None = None,
                  failures: dict[str, str] | None = None,
@@ -279,8 +278,9 @@ class Model:
                 programs[c] = fit(scenes, labels, c, settings=search or None, seed=seed)
             except LearnError as e:
                 failures[c] = str(e)
-        references = [Reference(sc.target, y, profile(sc)) for sc, y in zip(scenes, labels)
-                      if len(classes) > 1 and sc.target is not None]
+        references = []
+        if len(classes) > 1:  # a class task answers "unknown" where its program fails: it likens nothing
+            references = [Reference(sc.target, y, profile(sc)) for sc, y in zip(scenes, labels) if sc.target is not None]
         model = cls(programs, settings, failures, references=references)
         if len(programs) > 1 and search.get("arbiters", True):
             model.arbiters = model._learn_arbiters(scenes, labels, search or None, seed)
@@ -387,7 +387,8 @@ class Model:
         ref, dist = found
         mine = next((p for p in proofs if p["label"] == ref.label), None)
         first = {**(mine or {"label": ref.label, "conf": 0.0, "trace": [], "near": True}),
-                 "resembles": (ref, dist, prof)}
+                 "conf": closeness(prof, self.references, ref.label), "resembles": (ref, dist, prof)}
+        first["near_conf"] = mine["conf"] if mine else 0.0
         return [first, *(p for p in proofs if p is not mine)]
 
     def _thresholds(self, opts: dict, programs: dict[str, Program] | None = None) -> dict[str, float]:
@@ -434,7 +435,7 @@ class Model:
         ref, dist, prof = best["resembles"]
         shared, differ = contrast(prof, ref)
         return {"resembles": ref.object, "resembles_label": ref.label, "resembles_distance": dist,
-                "shared": shared, "differ": differ}
+                "shared": shared, "differ": differ, "near_confidence": best["near_conf"]}
 
     @staticmethod
     def _rival_parts(best: dict) -> dict:

@@ -8,9 +8,12 @@ object with the class of the training object whose profile is nearest (docs/lear
 
 A profile is, per fact predicate, the highest confidence of its facts on the object's own faces (a face's
 property, or a relation of two of its faces), with ``face_of`` and ``object`` left out (every object has them)
-and ``horizontal`` / ``vertical`` too (how a solid happens to rest, not what it is: model.EXCLUDED), and the
+and ``horizontal`` / ``vertical`` too (how a solid happens to rest, not what it is: settings.EXCLUDED), and the
 number of faces the object shows, as a share of ``FACES_FULL``. The distance of two profiles is the sum of
 their absolute differences, a predicate one lacks counting 0 there.
+
+Such an answer's confidence is :func:`closeness`: how much nearer the object lies to the answered class's
+training objects than to any other class's, a ratio of two distances and so free of their scale.
 """
 
 from __future__ import annotations
@@ -18,13 +21,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..facts import SceneFacts
+from .settings import EXCLUDED
 
 # Faces (count): a profile's face count saturates here, as a share of it. A solid shows at most four faces at
 # once from a table-top view (a box three, a prism or a pyramid up to four), so counts beyond are noise.
 FACES_FULL = 4
 FACES = "faces"  # the profile's key of the face count
-# Predicates no profile holds: the structure every object has, and how a solid rests (model.EXCLUDED)
-NOT_PROFILED = ("object", "face_of", "horizontal", "vertical")
+# Predicates no profile holds: the structure every object has (face_of, object) and how a solid rests
+NOT_PROFILED = ("face_of", *EXCLUDED)
 # Confidence: an explanation names a fact as shown by an object at this confidence or more (the learner's
 # default coverage threshold, mil's threshold option)
 SHOWN = 0.5
@@ -64,6 +68,22 @@ def nearest(prof: dict[str, float], references: list[Reference]) -> tuple[Refere
     if not references:
         return None
     return min(((r, distance(prof, r.profile)) for r in references), key=lambda rd: (rd[1], rd[0].label, rd[0].object))
+
+
+def closeness(prof: dict[str, float], references: list[Reference], label: str) -> float:
+    """The confidence of naming ``label`` for an object of profile ``prof`` by resemblance: d_o / (d_c + d_o), where
+    d_c is the distance to the nearest training object of ``label`` and d_o to the nearest of any other class.
+    0.5 where the two are equal (the object lies as near one class as another), rising to 1 as the object comes to
+    equal a training object of ``label`` and no other; 1 where no other class has a training object, 0 where
+    ``label`` has none."""
+    mine = [distance(prof, r.profile) for r in references if r.label == label]
+    other = [distance(prof, r.profile) for r in references if r.label != label]
+    if not mine:
+        return 0.0
+    if not other:
+        return 1.0
+    d_c, d_o = min(mine), min(other)
+    return 0.5 if d_c + d_o == 0 else d_o / (d_c + d_o)
 
 
 def contrast(prof: dict[str, float], ref: Reference) -> tuple[list[tuple[str, float, float]], list[tuple[str, float, float]]]:

@@ -49,6 +49,10 @@ SETTINGS: dict[str, tuple] = {
 }
 # the settings lv3d's Python side reads itself (lv3d.learn.model), which are no options of prolog/mil.pl
 NOT_MIL = frozenset({"metarules", "derived", "arbiters"})
+# Fact predicates no program uses as a body literal and no resemblance profile holds: object/1 holds for every
+# target; horizontal/vertical say how a solid rests, not what it is, and a concept learned from one view with
+# them fails on the next pose.
+EXCLUDED = ("object", "horizontal", "vertical")
 
 
 def _num(v) -> bool:
