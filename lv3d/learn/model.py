@@ -13,7 +13,7 @@ from ..facts import PREDICATES, SceneFacts
 from . import engine
 from .engine import LearnError
 from .program import Program
-from .resemblance import Reference, closeness, contrast, nearest, profile
+from .resemblance import Reference, closeness, contrast, nearest, nearest_other, profile
 from .settings import EXCLUDED, NOT_MIL, check_settings
 
 # Metarules for shape concepts, in search order: a part with a property, a part with two, a
@@ -184,6 +184,11 @@ class Explanation:
     shared: list[tuple[str, float, float]] = field(default_factory=list)
     differ: list[tuple[str, float, float]] = field(default_factory=list)
     near_confidence: float = 0.0  # a resemblance answer: its class program's near proof confidence
+    # a resemblance answer: the training object of another class nearest the scene, its class and distance (the
+    # confidence is how much farther it lies than ``resembles``: resemblance.closeness)
+    unlike: str | None = None
+    unlike_label: str | None = None
+    unlike_distance: float = 0.0
 
     def _proof_lines(self, indent: str) -> list[str]:
         """The clauses, the facts they used and those the scene lacks, each line indented by ``indent``."""
@@ -198,7 +203,9 @@ class Explanation:
         if self.resembles:
             lines = [f"{self.target} is most likely a {self.label} (confidence {self.confidence:.3f}): no program "
                      f"proves it, and of the training objects it resembles {self.resembles}, a {self.resembles_label}, "
-                     f"most (distance {self.resembles_distance:.2f})"]
+                     f"most (distance {self.resembles_distance:.2f})"
+                     + (f"; of another class, {self.unlike}, a {self.unlike_label}, at {self.unlike_distance:.2f}"
+                        if self.unlike else "")]
             lines += [f"  both show {p} ({a:.3f} here, {b:.3f} there)" for p, a, b in self.shared]
             lines += [f"  {'it shows' if a >= b else 'that one shows'} {p} ({a:.3f} here, {b:.3f} there)"
                       for p, a, b in self.differ]
@@ -388,7 +395,7 @@ class Model:
         mine = next((p for p in proofs if p["label"] == ref.label), None)
         first = {**(mine or {"label": ref.label, "conf": 0.0, "trace": [], "near": True}),
                  "conf": closeness(prof, self.references, ref.label), "resembles": (ref, dist, prof)}
-        first["near_conf"] = mine["conf"] if mine else 0.0
+        first.update(near_conf=mine["conf"] if mine else 0.0, unlike=nearest_other(prof, self.references, ref.label))
         return [first, *(p for p in proofs if p is not mine)]
 
     def _thresholds(self, opts: dict, programs: dict[str, Program] | None = None) -> dict[str, float]:
@@ -434,8 +441,12 @@ class Model:
             return {}
         ref, dist, prof = best["resembles"]
         shared, differ = contrast(prof, ref)
-        return {"resembles": ref.object, "resembles_label": ref.label, "resembles_distance": dist,
-                "shared": shared, "differ": differ, "near_confidence": best["near_conf"]}
+        out = {"resembles": ref.object, "resembles_label": ref.label, "resembles_distance": dist,
+               "shared": shared, "differ": differ, "near_confidence": best["near_conf"]}
+        if best["unlike"] is not None:
+            other, d_other = best["unlike"]
+            out.update(unlike=other.object, unlike_label=other.label, unlike_distance=d_other)
+        return out
 
     @staticmethod
     def _rival_parts(best: dict) -> dict:

@@ -70,19 +70,24 @@ def nearest(prof: dict[str, float], references: list[Reference]) -> tuple[Refere
     return min(((r, distance(prof, r.profile)) for r in references), key=lambda rd: (rd[1], rd[0].label, rd[0].object))
 
 
+def nearest_other(prof: dict[str, float], references: list[Reference], label: str) -> tuple[Reference, float] | None:
+    """:func:`nearest` among the references of every class but ``label``."""
+    return nearest(prof, [r for r in references if r.label != label])
+
+
 def closeness(prof: dict[str, float], references: list[Reference], label: str) -> float:
     """The confidence of naming ``label`` for an object of profile ``prof`` by resemblance: d_o / (d_c + d_o), where
-    d_c is the distance to the nearest training object of ``label`` and d_o to the nearest of any other class.
-    0.5 where the two are equal (the object lies as near one class as another), rising to 1 as the object comes to
-    equal a training object of ``label`` and no other; 1 where no other class has a training object, 0 where
-    ``label`` has none."""
-    mine = [distance(prof, r.profile) for r in references if r.label == label]
-    other = [distance(prof, r.profile) for r in references if r.label != label]
-    if not mine:
+    d_c is the distance to the nearest training object of ``label`` and d_o to the nearest of any other class
+    (:func:`nearest_other`). 0.5 where the two are equal (the object lies as near one class as another), rising to
+    1 as the object comes to equal a training object of ``label`` and no other; 1 where no other class has a
+    training object, 0 where ``label`` has none."""
+    mine = nearest(prof, [r for r in references if r.label == label])
+    other = nearest_other(prof, references, label)
+    if mine is None:
         return 0.0
-    if not other:
+    if other is None:
         return 1.0
-    d_c, d_o = min(mine), min(other)
+    d_c, d_o = mine[1], other[1]
     return 0.5 if d_c + d_o == 0 else d_o / (d_c + d_o)
 
 

@@ -7,7 +7,8 @@ import pytest
 
 from lv3d.facts import Fact, SceneFacts
 from lv3d.learn import Model
-from lv3d.learn.resemblance import FACES, Reference, closeness, contrast, distance, nearest, profile
+from lv3d.learn.resemblance import (FACES, Reference, closeness, contrast, distance, nearest, nearest_other,
+                                    profile)
 
 
 def _scene(name: str, faces: list[list[tuple[str, float]]], pairs: list[tuple[str, int, int, float]] = ()
@@ -76,6 +77,7 @@ def test_closeness_is_the_share_of_the_two_nearest_distances_held_by_the_other_c
     assert closeness({}, [Reference("p", "a", {}), Reference("q", "b", {})], "a") == 0.5  # both at 0: a tie
     assert closeness(prof, refs[:2], "tetra") == 1.0  # no other class to mistake it for
     assert closeness(prof, refs, "box") == 0.0  # no training object of the class
+    assert nearest_other(prof, refs, "tetra")[0].object == "y" and nearest_other(prof, refs[:2], "tetra") is None
 
 
 def _model() -> Model:
@@ -103,6 +105,10 @@ def test_an_object_no_program_proves_gets_the_class_of_the_training_object_it_re
     text = str(e)
     assert "no program proves it" in text and f"resembles {e.resembles}, a tetra" in text
     assert "both show triangle" in text and "which it misses" not in text
+    # the nearest training object of another class, whose distance the confidence weighs against
+    assert e.unlike_label != "tetra" and e.unlike_distance == pytest.approx(
+        e.resembles_distance * conf / (1 - conf))
+    assert f"of another class, {e.unlike}, a {e.unlike_label}, at {e.unlike_distance:.2f}" in text
     # a round cap beside a rectangle: the can's program (a cylindrical face) misses it by one fact, which its
     # explanation shows with the near proof's confidence beside the resemblance's
     cap = _scene("cap", [[("circular", 0.9)], [("rectangle", 0.9)]], [("adjacent", 0, 1, 0.99)])
