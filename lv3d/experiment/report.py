@@ -180,15 +180,16 @@ def answer_calibration(recs: list[dict]) -> dict | None:
 
 def answer_kinds(recs: list[dict]) -> dict | None:
     """How a system's multi-class answers were reached (the fold files' ``answered_by``, lv3d systems), over
-    every fold and draw: {kind: (answers, right)}; None where the fold files do not say."""
-    out: dict[str, list[int]] = {}
+    every fold and draw: {kind: (answers, right, their mean confidence)}; None where the fold files do not say."""
+    out: dict[str, list] = {}
     for r in recs:
         for draw, how in zip(_multiclass_draws(r), r.get("answered_by") or []):
-            for (_, label, _), y, kind in zip(draw, r["test_classes"], how):
-                n = out.setdefault(kind, [0, 0])
+            for (_, label, conf), y, kind in zip(draw, r["test_classes"], how):
+                n = out.setdefault(kind, [0, 0, 0.0])
                 n[0] += 1
                 n[1] += label == y
-    return {k: tuple(v) for k, v in out.items()} or None
+                n[2] += float(conf)
+    return {k: (n, right, total / n) for k, (n, right, total) in out.items()} or None
 
 
 def answer_confusion(recs: list[dict]) -> dict | None:
@@ -322,15 +323,16 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing:
                 lines.append(f"| {s} | {c['answers']} | {c['ece']:.3f} | {mc:.3f} | {mr:.3f} |")
         reached = {s: per["answered_by"] for s, per in summ["systems"].items() if per.get("answered_by")}
         if reached:
-            lines += ["", "How the lv3d systems reached their multi-class answers (answers, and the share right): "
+            lines += ["", "How the lv3d systems reached their multi-class answers (answers, the share right, and their "
+                      "mean confidence): "
                       "*proof*, a class's program proves the object and ranks first; *arbiter*, two classes' "
                       "programs prove it and an arbiter between them chose; *near*, no program proves it and the "
                       "training object it resembles most names the class; *unknown*, no answer (no object, or no "
                       "program):", "",
                       "| system | " + " | ".join(ANSWER_KINDS) + " |", "|---|" + "---|" * len(ANSWER_KINDS)]
             for s, kinds in reached.items():
-                cols = [f"{kinds[k][0]} ({100 * kinds[k][1] / kinds[k][0]:.0f} %)" if kinds.get(k, (0,))[0] else "0"
-                        for k in ANSWER_KINDS]
+                cols = [f"{kinds[k][0]} ({100 * kinds[k][1] / kinds[k][0]:.0f} %, {kinds[k][2]:.2f})"
+                        if kinds.get(k, (0,))[0] else "0" for k in ANSWER_KINDS]
                 lines.append(f"| {s} | " + " | ".join(cols) + " |")
         confused = {s: per["confusion"] for s, per in summ["systems"].items() if per.get("confusion")}
         if confused:

@@ -23,8 +23,9 @@ def test_real_learner_learns_side_counts(tmp_path, tiny_config, synthetic_facts,
     summary = json.loads((out / "results.json").read_text())
     kinds = next(iter(summary["conditions"].values()))["systems"]["lv3d-rgb"]["answered_by"]
     assert set(kinds) == {"proof"} and kinds["proof"][0] == kinds["proof"][1] > 0
+    assert 0.5 <= kinds["proof"][2] <= 1.0  # their mean confidence: a proof's is at least the threshold
     md = (out / "results.md").read_text()
-    assert "How the lv3d systems reached their multi-class answers" in md and "(100 %)" in md
+    assert "How the lv3d systems reached their multi-class answers" in md and f"(100 %, {kinds['proof'][2]:.2f})" in md
     # every answer right: no class confused with another, and the matrix is drawn
     confusion = next(iter(summary["conditions"].values()))["systems"]["lv3d-rgb"]["confusion"]
     assert confusion["pairs"] == [] and sum(confusion["answers"].values()) == kinds["proof"][0]
