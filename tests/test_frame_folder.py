@@ -132,6 +132,26 @@ def test_learn_fit_predict_and_explain_on_a_folder_of_frames(frames, tmp_path, c
     assert "no ground-truth facts" in capsys.readouterr().err
 
 
+def test_explain_warns_of_the_examples_it_is_asked_about_only(frames, tmp_path, capsys):
+    folder = tmp_path / "copy"
+    folder.mkdir()
+    for p in frames.iterdir():
+        (folder / p.name).write_bytes(p.read_bytes())
+    with (folder / "objects.csv").open("a") as f:
+        f.write("frame-000,2,2,2,box,no,no,\n")  # a corner pixel: on no object, an example without one
+    args = ["--data", str(folder), "--modality", "depth", "--cache", str(tmp_path / "cache")]
+    assert main(["learn", "fit", *args, "--out", str(tmp_path / "model"), "--time-limit", "20"]) == 0
+    lost = f"{scene_atom('frame-000')}_x2"
+    assert f"example {lost} has no object" in capsys.readouterr().err  # fit names it (and leaves it out)
+    asked = f"{scene_atom('frame-002')}_x1"
+    assert main(["learn", "explain", *args, "--model", str(tmp_path / "model"), "--example", asked]) == 0
+    out, err = capsys.readouterr()
+    assert out.startswith(f"{asked} (box): ") and "has no object" not in err
+    assert main(["learn", "explain", *args, "--model", str(tmp_path / "model"), "--example", lost]) == 0
+    out, err = capsys.readouterr()
+    assert f"example {lost} has no object" in err and "perception found no object under its labelled pixel" in out
+
+
 def test_a_study_on_folders_keeps_each_frame_in_one_fold(frames, tmp_path):
     from lv3d.experiment.runner import run_study
 

@@ -81,16 +81,18 @@ def learn():
     """Learn shape concepts from a data set and classify with them."""
 
 
-def _dataset_scenes(data: Path, modality: str, facts: str | None, cache: Path | None = None):
+def _dataset_scenes(data: Path, modality: str, facts: str | None, cache: Path | None = None,
+                    warn: set[str] | None = None):
     """(scenes, labels) of a data set directory, facts from the ground truth or through the pipeline; or of
     a folder of real frames (objects.csv), every labelled object one example, facts through the pipeline,
-    cached. Examples whose pixel lies on no perceived object keep no target: one warning line each."""
+    cached. Examples whose pixel lies on no perceived object keep no target: one warning line each (of the
+    examples in ``warn`` only, where given)."""
     from ..frame_folder import is_frame_folder
 
     if is_frame_folder(data):
         if facts == "truth":
             raise InputError("--facts", f"{data} holds real frames: they have no ground-truth facts (use pipeline)")
-        return _frame_folder_scenes(data, modality, cache)
+        return _frame_folder_scenes(data, modality, cache, warn)
     if facts is None:
         facts = "pipeline"
     manifest = data / "manifest.json"
@@ -140,7 +142,7 @@ def _cache_dir(cache: Path | None) -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "lv3d"
 
 
-def _frame_folder_scenes(data: Path, modality: str, cache: Path | None):
+def _frame_folder_scenes(data: Path, modality: str, cache: Path | None, warn: set[str] | None = None):
     from ..experiment.code_version import facts_version
     from ..experiment.real_data import ensure_frame_facts, example_facts_of, real_data
     from ..frame_folder import FrameFolder
@@ -152,7 +154,8 @@ def _frame_folder_scenes(data: Path, modality: str, cache: Path | None):
     frames = ensure_frame_facts(rd, _cache_dir(cache) / "facts", facts_version(), modality, True)
     facts, errors = example_facts_of(rd, frames)
     for i in sorted(errors):
-        click.echo(f"lv3d: warning: {errors[i]} (example {i} has no object)", err=True)
+        if warn is None or i in warn:
+            click.echo(f"lv3d: warning: {errors[i]} (example {i} has no object)", err=True)
     return [facts[it.id] for it in rd.items], [it.cls for it in rd.items]
 
 
@@ -226,7 +229,9 @@ def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classe
         click.echo(f"no program for {c}: {why}", err=True)
 
 
-def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path):
+def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path,
+                      warn: set[str] | None = None):
+    """The model of ``model_dir`` and the scenes of ``data`` (:func:`_dataset_scenes`, its ``warn``)."""
     from ..learn.model import Model
 
     model = Model.load(model_dir)
@@ -236,7 +241,7 @@ def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path 
     if learned and learned != [modality]:
         raise InputError("--modality", f"the model in {model_dir} was learned from {', '.join(learned)} facts; "
                                        f"predict with --modality {learned[0]}")
-    scenes, labels = _dataset_scenes(data, modality, facts, cache)
+    scenes, labels = _dataset_scenes(data, modality, facts, cache, warn)
     return model, scenes, labels
 
 
@@ -294,7 +299,8 @@ def explain(data: Path, modality: str, facts: str | None, cache: Path | None, mo
     """Print why each example gets its label: the program that proves it and the facts (with confidences)
     the proof used."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
-    model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir)
+    # the examples asked for: only their own "no object" warnings (each is answered so below as well)
+    model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir, set(examples) or None)
     by_id = {s.scene: (s, y) for s, y in zip(scenes, labels)}
     unknown = [e for e in examples if e not in by_id]
     if unknown:
