@@ -1,0 +1,130 @@
+"""How a study's answers by resemblance would fare under other rules: per condition and lv3d system, the
+multi-class answers no program proved (``answered_by`` "near" in the fold files), how many of them each rule for
+the class gets right, and the expected calibration error (ECE, 10 bins) of all the multi-class answers with each
+confidence for those answers (proofs keep theirs). The models are the study's own (its saved programs and their
+training objects' profiles), so the rule in use (``nn`` with ``ratio``, lv3d.learn.resemblance) reproduces the
+study's figures exactly; the others answer "what if" without relearning anything.
+
+Rules for the class: ``nn`` the nearest training object's (in use); ``mean2`` the class whose two nearest training
+objects lie nearest on average; ``vote3`` the most frequent among the three nearest (ties: the nearer); ``l2``
+the nearest by squared differences.
+Confidences: ``ratio`` d_o / (d_c + d_o), d_c to the answered class's nearest training object and d_o to another
+class's (resemblance.closeness, in use); ``inverse`` (1 / d_c) over the sum of 1 / d_k over every class's nearest;
+beside them the ECE of the answers as the fold files hold them (the code the study ran).
+
+    .venv/bin/python scripts/near_answers.py runs/real_objects
+    .venv/bin/python scripts/near_answers.py runs/ten_classes --systems lv3d-depth,lv3d-rgbd
+
+RUN_DIR is the study's --out: its config.yaml, fold files (folds/<condition>/<system>/fold<k>.json) and programs
+(programs/<condition>/<system>/fold<k>/multiclass[/draw<d>]/). Each example's facts are read as the study reads
+them (lv3d.experiment.runner.study_inputs), from the cache of this checkout's facts version; facts the cache lacks
+are computed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+RULES = ("nn", "mean2", "vote3", "l2")
+CONFIDENCES = ("ratio", "inverse")
+
+
+def _rules(prof: dict, refs: list) -> dict[str, str]:
+    """The class each rule names for an object of profile ``prof`` among the training objects ``refs``."""
+    from lv3d.learn.resemblance import distance
+
+    ranked = sorted((distance(prof, r.profile), r.label, r.object) for r in refs)
+    per = defaultdict(list)
+    for d, label, _ in ranked:
+        per[label].append(d)
+    top, votes = ranked[:3], defaultdict(int)
+    for _, label, _ in top:
+        votes[label] += 1
+    squared = min((sum((prof.get(k, 0.0) - r.profile.get(k, 0.0)) ** 2 for k in prof.keys() | r.profile.keys()),
+                   r.label, r.object) for r in refs)
+    return {"nn": ranked[0][1],
+            "mean2": min(per, key=lambda c: (sum(per[c][:2]) / len(per[c][:2]), c)),
+            "vote3": max(votes, key=lambda c: (votes[c], -min(d for d, lab, _ in top if lab == c))),
+            "l2": squared[1]}
+
+
+def _inverse(prof: dict, refs: list, label: str) -> float:
+    from lv3d.learn.resemblance import distance
+
+    nearest: dict[str, float] = {}
+    for r in refs:
+        nearest[r.label] = min(nearest.get(r.label, float("inf")), distance(prof, r.profile))
+    if label not in nearest:
+        return 0.0
+    if nearest[label] == 0:
+        return 1.0 / sum(1 for d in nearest.values() if d == 0)
+    return (1.0 / nearest[label]) / sum(1.0 / d if d > 0 else float("inf") for d in nearest.values())
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("run", type=Path, help="the study's --out folder")
+    ap.add_argument("--systems", default=None, help="comma-separated lv3d systems (default: every one it ran)")
+    args = ap.parse_args(argv)
+    if not (args.run / "config.yaml").is_file():
+        raise SystemExit(f"{args.run}: not a study's --out folder (no config.yaml)")
+    import numpy as np
+
+    from lv3d.experiment.config import load_study
+    from lv3d.experiment.runner import study_inputs
+    from lv3d.experiment.stats import ece
+    from lv3d.learn import Model
+    from lv3d.learn.resemblance import closeness, profile
+
+    study = load_study(args.run / "config.yaml")
+    for cond, cfg in study.conditions.items():
+        systems = args.systems.split(",") if args.systems else [s for s in cfg.systems if s.startswith("lv3d-")]
+        items, inputs = None, None
+        for system in systems:
+            folds = sorted((args.run / "folds" / cond / system).glob("fold*.json"))
+            if not folds:
+                continue
+            if inputs is None:
+                items, inputs = study_inputs(cfg, args.run, progress=False)
+                truth = {it.id: it.cls for it in items}
+            facts = inputs.for_system(system)
+            right, n_near = defaultdict(int), 0
+            conf, ok, near_conf = {c: [] for c in CONFIDENCES}, [], []
+            for path in folds:
+                rec = json.loads(path.read_text())
+                preds, hows = rec["predictions"].get("multiclass"), rec.get("answered_by") or []
+                if not preds:
+                    continue
+                draws = preds if isinstance(preds[0][0], list) else [preds]
+                for d, (answers, how) in enumerate(zip(draws, hows)):
+                    where = args.run / "programs" / cond / system / path.stem / "multiclass"
+                    model = Model.load(where / f"draw{d}" if len(draws) > 1 else where)
+                    for (sid, label, c), kind in zip(answers, how):
+                        ok.append(label == truth[sid])
+                        near_conf.append(float(c))
+                        if kind != "near" or not model.references:
+                            for name in CONFIDENCES:
+                                conf[name].append(float(c))
+                            continue
+                        prof = profile(facts[sid])
+                        n_near += 1
+                        for rule, answer in _rules(prof, model.references).items():
+                            right[rule] += answer == truth[sid]
+                        conf["ratio"].append(closeness(prof, model.references, label))
+                        conf["inverse"].append(_inverse(prof, model.references, label))
+            if not ok:
+                continue
+            y = np.asarray(ok, float)
+            rules = ", ".join(f"{r} {right[r]}" for r in RULES)
+            eces = ", ".join(f"{name} {ece(np.asarray(conf[name]), y):.3f}" for name in CONFIDENCES)
+            print(f"{cond} {system}: {n_near} answers by resemblance of {len(ok)}; right by rule: {rules}; "
+                  f"ECE of all answers: {eces}, as the fold files hold them {ece(np.asarray(near_conf), y):.3f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
