@@ -65,6 +65,45 @@ def _inverse(prof: dict, refs: list, label: str) -> float:
     return (1.0 / nearest[label]) / sum(1.0 / d if d > 0 else float("inf") for d in nearest.values())
 
 
+def weigh(records: list[tuple[str, dict]], load_model, facts: dict, truth: dict[str, str]) -> dict:
+    """The figures of one condition and system: ``records`` its fold files as (fold name, record), ``load_model``
+    (fold name, draw, draws) -> the multi-class model of that draw, ``facts`` example id -> SceneFacts, ``truth``
+    example id -> class. {"answers", "near", "right": {rule: near answers right}, "ece": {confidence: ECE of every
+    answer}, "ece_held": ECE of the answers as the fold files hold them}; None without multi-class answers."""
+    import numpy as np
+
+    from lv3d.experiment.stats import ece
+    from lv3d.learn.resemblance import closeness, profile
+
+    right, n_near = {r: 0 for r in RULES}, 0
+    conf, ok, held = {c: [] for c in CONFIDENCES}, [], []
+    for name, rec in records:
+        preds, hows = rec.get("predictions", {}).get("multiclass"), rec.get("answered_by") or []
+        if not preds:
+            continue
+        draws = preds if isinstance(preds[0][0], list) else [preds]
+        for d, (answers, how) in enumerate(zip(draws, hows)):
+            model = load_model(name, d, len(draws))
+            for (sid, label, c), kind in zip(answers, how):
+                ok.append(label == truth[sid])
+                held.append(float(c))
+                if kind != "near" or not model.references:
+                    for cname in CONFIDENCES:
+                        conf[cname].append(float(c))
+                    continue
+                prof = profile(facts[sid])
+                n_near += 1
+                for rule, answer in _rules(prof, model.references).items():
+                    right[rule] += answer == truth[sid]
+                conf["ratio"].append(closeness(prof, model.references, label))
+                conf["inverse"].append(_inverse(prof, model.references, label))
+    if not ok:
+        return None
+    y = np.asarray(ok, float)
+    return {"answers": len(ok), "near": n_near, "right": right,
+            "ece": {c: ece(np.asarray(v), y) for c, v in conf.items()}, "ece_held": ece(np.asarray(held), y)}
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("run", type=Path, help="the study's --out folder")
@@ -72,57 +111,34 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if not (args.run / "config.yaml").is_file():
         raise SystemExit(f"{args.run}: not a study's --out folder (no config.yaml)")
-    import numpy as np
-
     from lv3d.experiment.config import load_study
     from lv3d.experiment.runner import study_inputs
-    from lv3d.experiment.stats import ece
     from lv3d.learn import Model
-    from lv3d.learn.resemblance import closeness, profile
 
     study = load_study(args.run / "config.yaml")
     for cond, cfg in study.conditions.items():
         systems = args.systems.split(",") if args.systems else [s for s in cfg.systems if s.startswith("lv3d-")]
-        items, inputs = None, None
+        inputs, truth = None, {}
         for system in systems:
-            folds = sorted((args.run / "folds" / cond / system).glob("fold*.json"))
-            if not folds:
+            paths = sorted((args.run / "folds" / cond / system).glob("fold*.json"))
+            if not paths:
                 continue
             if inputs is None:
                 items, inputs = study_inputs(cfg, args.run, progress=False)
                 truth = {it.id: it.cls for it in items}
-            facts = inputs.for_system(system)
-            right, n_near = defaultdict(int), 0
-            conf, ok, near_conf = {c: [] for c in CONFIDENCES}, [], []
-            for path in folds:
-                rec = json.loads(path.read_text())
-                preds, hows = rec["predictions"].get("multiclass"), rec.get("answered_by") or []
-                if not preds:
-                    continue
-                draws = preds if isinstance(preds[0][0], list) else [preds]
-                for d, (answers, how) in enumerate(zip(draws, hows)):
-                    where = args.run / "programs" / cond / system / path.stem / "multiclass"
-                    model = Model.load(where / f"draw{d}" if len(draws) > 1 else where)
-                    for (sid, label, c), kind in zip(answers, how):
-                        ok.append(label == truth[sid])
-                        near_conf.append(float(c))
-                        if kind != "near" or not model.references:
-                            for name in CONFIDENCES:
-                                conf[name].append(float(c))
-                            continue
-                        prof = profile(facts[sid])
-                        n_near += 1
-                        for rule, answer in _rules(prof, model.references).items():
-                            right[rule] += answer == truth[sid]
-                        conf["ratio"].append(closeness(prof, model.references, label))
-                        conf["inverse"].append(_inverse(prof, model.references, label))
-            if not ok:
+            where = args.run / "programs" / cond / system
+
+            def load_model(fold: str, draw: int, draws: int, where=where):
+                return Model.load(where / fold / "multiclass" / (f"draw{draw}" if draws > 1 else ""))
+
+            found = weigh([(p.stem, json.loads(p.read_text())) for p in paths], load_model,
+                          inputs.for_system(system), truth)
+            if found is None:
                 continue
-            y = np.asarray(ok, float)
-            rules = ", ".join(f"{r} {right[r]}" for r in RULES)
-            eces = ", ".join(f"{name} {ece(np.asarray(conf[name]), y):.3f}" for name in CONFIDENCES)
-            print(f"{cond} {system}: {n_near} answers by resemblance of {len(ok)}; right by rule: {rules}; "
-                  f"ECE of all answers: {eces}, as the fold files hold them {ece(np.asarray(near_conf), y):.3f}")
+            rules = ", ".join(f"{r} {found['right'][r]}" for r in RULES)
+            eces = ", ".join(f"{c} {found['ece'][c]:.3f}" for c in CONFIDENCES)
+            print(f"{cond} {system}: {found['near']} answers by resemblance of {found['answers']}; right by rule: "
+                  f"{rules}; ECE of all answers: {eces}, as the fold files hold them {found['ece_held']:.3f}")
     return 0
 
 
