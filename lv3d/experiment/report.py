@@ -2,7 +2,8 @@
 ``results.csv`` (one row per condition x system x fold x task; ``tuned``: the setting a tuned baseline chose on
 that fold, as JSON), ``results.json`` (means, standard
 deviations, paired tests, the calibration of the multi-class answers and, for lv3d systems, how they were
-reached: by a proof, an arbiter, resemblance (near) or none; which classes the answers confuse), ``results.md`` (the
+reached: by a proof, an arbiter, resemblance (near) or none, each kind's count, share right and mean confidence;
+which classes the answers confuse), ``results.md`` (the
 tables), ``accuracy.png``, ``reliability.png`` (the answers' reliability diagram, last condition),
 ``confusion.png`` (the multi-class answers of each lv3d system against the true classes, last condition) and
 ``sweep.png`` when the study has several conditions.
