@@ -33,11 +33,16 @@ RULES = ("nn", "mean2", "vote3", "l2")
 CONFIDENCES = ("ratio", "inverse")
 
 
-def _rules(prof: dict, refs: list) -> dict[str, str]:
-    """The class each rule names for an object of profile ``prof`` among the training objects ``refs``."""
+def _ranked(prof: dict, refs: list) -> list[tuple[float, str, str]]:
+    """(distance, class, object) of each training object in ``refs`` to an object of profile ``prof``, nearest
+    first (ties as resemblance.nearest breaks them)."""
     from lv3d.learn.resemblance import distance
 
-    ranked = sorted((distance(prof, r.profile), r.label, r.object) for r in refs)
+    return sorted((distance(prof, r.profile), r.label, r.object) for r in refs)
+
+
+def _rules(ranked: list, prof: dict, refs: list) -> dict[str, str]:
+    """The class each rule names for an object of profile ``prof``, ``ranked`` its :func:`_ranked` among ``refs``."""
     per = defaultdict(list)
     for d, label, _ in ranked:
         per[label].append(d)
@@ -52,12 +57,11 @@ def _rules(prof: dict, refs: list) -> dict[str, str]:
             "l2": squared[1]}
 
 
-def _inverse(prof: dict, refs: list, label: str) -> float:
-    from lv3d.learn.resemblance import distance
-
+def _inverse(ranked: list, label: str) -> float:
+    """The inverse-distance share of ``label`` over every class's nearest training object in ``ranked``."""
     nearest: dict[str, float] = {}
-    for r in refs:
-        nearest[r.label] = min(nearest.get(r.label, float("inf")), distance(prof, r.profile))
+    for d, c, _ in ranked:
+        nearest.setdefault(c, d)  # ranked nearest first: a class's first is its nearest
     if label not in nearest:
         return 0.0
     if nearest[label] == 0:
@@ -72,17 +76,15 @@ def weigh(records: list[tuple[str, dict]], load_model, facts: dict, truth: dict[
     answer}, "ece_held": ECE of the answers as the fold files hold them}; None without multi-class answers."""
     import numpy as np
 
+    from lv3d.experiment.report import _multiclass_draws
     from lv3d.experiment.stats import ece
     from lv3d.learn.resemblance import closeness, profile
 
     right, n_near = {r: 0 for r in RULES}, 0
     conf, ok, held = {c: [] for c in CONFIDENCES}, [], []
     for name, rec in records:
-        preds, hows = rec.get("predictions", {}).get("multiclass"), rec.get("answered_by") or []
-        if not preds:
-            continue
-        draws = preds if isinstance(preds[0][0], list) else [preds]
-        for d, (answers, how) in enumerate(zip(draws, hows)):
+        draws = _multiclass_draws(rec)  # the report's reading of a fold file's multi-class answers
+        for d, (answers, how) in enumerate(zip(draws, rec.get("answered_by") or [])):
             model = load_model(name, d, len(draws))
             for (sid, label, c), kind in zip(answers, how):
                 ok.append(label == truth[sid])
@@ -92,11 +94,12 @@ def weigh(records: list[tuple[str, dict]], load_model, facts: dict, truth: dict[
                         conf[cname].append(float(c))
                     continue
                 prof = profile(facts[sid])
+                ranked = _ranked(prof, model.references)
                 n_near += 1
-                for rule, answer in _rules(prof, model.references).items():
+                for rule, answer in _rules(ranked, prof, model.references).items():
                     right[rule] += answer == truth[sid]
-                conf["ratio"].append(closeness(prof, model.references, label))
-                conf["inverse"].append(_inverse(prof, model.references, label))
+                conf["ratio"].append(closeness(prof, model.references, label))  # the code in use
+                conf["inverse"].append(_inverse(ranked, label))
     if not ok:
         return None
     y = np.asarray(ok, float)

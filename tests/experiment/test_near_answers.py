@@ -32,7 +32,8 @@ def test_the_rule_in_use_reproduces_the_answers_and_the_others_are_counted(near_
     # p proved (kept as the fold file holds it); a and b answered by resemblance with the confidence in use
     held = [["p", "can", 0.9], ["a", "tetra", closeness(profile(facts["a"]), refs, "tetra")],
             ["b", "tetra", closeness(profile(facts["b"]), refs, "tetra")]]
-    record = {"predictions": {"multiclass": held}, "answered_by": [["proof", "near", "near"]]}
+    record = {"predictions": {"multiclass": held}, "answered_by": [["proof", "near", "near"]],
+              "test_ids": ["p", "a", "b"], "test_classes": [truth[i] for i in ("p", "a", "b")]}
     asked = []
 
     def load_model(fold, draw, draws):
