@@ -9,7 +9,7 @@ Rules for the class: ``nn`` the nearest training object's (in use); ``mean2`` th
 objects lie nearest on average; ``vote3`` the most frequent among the three nearest (ties: the nearer); ``l2``
 the nearest by squared differences.
 Confidences: ``ratio`` d_o / (d_c + d_o), d_c to the answered class's nearest training object and d_o to another
-class's (resemblance.closeness, in use); ``inverse`` (1 / d_c) over the sum of 1 / d_k over every class's nearest;
+class's (resemblance.Resemblance.confidence, in use); ``inverse`` (1 / d_c) over the sum of 1 / d_k over every class's nearest;
 beside them the ECE of the answers as the fold files hold them (the code the study ran).
 
     .venv/bin/python scripts/near_answers.py runs/real_objects
@@ -78,7 +78,7 @@ def weigh(records: list[tuple[str, dict]], load_model, facts: dict, truth: dict[
 
     from lv3d.experiment.report import _multiclass_draws
     from lv3d.experiment.stats import ece
-    from lv3d.learn.resemblance import closeness, profile
+    from lv3d.learn.resemblance import profile, resemble
 
     right, n_near = {r: 0 for r in RULES}, 0
     conf, ok, held = {c: [] for c in CONFIDENCES}, [], []
@@ -98,7 +98,7 @@ def weigh(records: list[tuple[str, dict]], load_model, facts: dict, truth: dict[
                 n_near += 1
                 for rule, answer in _rules(ranked, prof, model.references).items():
                     right[rule] += answer == truth[sid]
-                conf["ratio"].append(closeness(prof, model.references, label))  # the code in use
+                conf["ratio"].append(resemble(prof, model.references).confidence)  # the code in use
                 conf["inverse"].append(_inverse(ranked, label))
     if not ok:
         return None

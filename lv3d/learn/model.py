@@ -13,7 +13,7 @@ from ..facts import PREDICATES, SceneFacts
 from . import engine
 from .engine import LearnError
 from .program import Program
-from .resemblance import Reference, closeness, contrast, nearest, nearest_other, profile
+from .resemblance import Reference, Resemblance, contrast, profile, resemble
 from .settings import EXCLUDED, NOT_MIL, check_settings
 
 # Metarules for shape concepts, in search order: a part with a property, a part with two, a
@@ -176,19 +176,13 @@ class Explanation:
     rival_facts: list[tuple[str, float]] = field(default_factory=list)
     # the arbiter is the rival's, learned with the rival's examples as its positives, and fails to prove it
     rival_fails: bool = False
-    # a near answer: the training object whose facts the scene's resemble most, its class and the profiles'
-    # distance, and (predicate, the scene's confidence, the training object's) shown by both / by one of them
-    resembles: str | None = None
-    resembles_label: str | None = None
-    resembles_distance: float = 0.0
+    # a near answer: the training objects whose facts the scene's resemble most, of its class and of another
+    # (resemblance.Resemblance), (predicate, the scene's confidence, the training object's) shown by both / by one
+    # of the scene and the nearest, and its class program's near proof confidence
+    resembles: Resemblance | None = None
     shared: list[tuple[str, float, float]] = field(default_factory=list)
     differ: list[tuple[str, float, float]] = field(default_factory=list)
-    near_confidence: float = 0.0  # a resemblance answer: its class program's near proof confidence
-    # a resemblance answer: the training object of another class nearest the scene, its class and distance (the
-    # confidence is how much farther it lies than ``resembles``: resemblance.closeness)
-    unlike: str | None = None
-    unlike_label: str | None = None
-    unlike_distance: float = 0.0
+    near_confidence: float = 0.0
 
     def _proof_lines(self, indent: str) -> list[str]:
         """The clauses, the facts they used and those the scene lacks, each line indented by ``indent``."""
@@ -201,11 +195,12 @@ class Explanation:
         if self.label == "unknown":
             return f"{self.target}: unknown (no class's program proves it)"
         if self.resembles:
+            r = self.resembles
             lines = [f"{self.target} is most likely a {self.label} (confidence {self.confidence:.3f}): no program "
-                     f"proves it, and of the training objects it resembles {self.resembles}, a {self.resembles_label}, "
-                     f"most (distance {self.resembles_distance:.2f})"
-                     + (f"; of another class, {self.unlike}, a {self.unlike_label}, at {self.unlike_distance:.2f}"
-                        if self.unlike else "")]
+                     f"proves it, and of the training objects it resembles {r.ref.object}, a {r.ref.label}, "
+                     f"most (distance {r.distance:.2f})"
+                     + (f"; of another class, {r.other.object}, a {r.other.label}, at {r.other_distance:.2f}"
+                        if r.other else "")]
             lines += [f"  both show {p} ({a:.3f} here, {b:.3f} there)" for p, a, b in self.shared]
             lines += [f"  {'it shows' if a >= b else 'that one shows'} {p} ({a:.3f} here, {b:.3f} there)"
                       for p, a, b in self.differ]
@@ -388,14 +383,12 @@ class Model:
             return proofs
         proofs = [{**p, "near": True} for p in self._proofs(scene, near=True)] if self.programs else []
         prof = profile(scene)
-        found = nearest(prof, self.references)
+        found = resemble(prof, self.references)
         if found is None:
             return proofs
-        ref, dist = found
-        mine = next((p for p in proofs if p["label"] == ref.label), None)
-        first = {**(mine or {"label": ref.label, "conf": 0.0, "trace": [], "near": True}),
-                 "conf": closeness(prof, self.references, ref.label), "resembles": (ref, dist, prof)}
-        first.update(near_conf=mine["conf"] if mine else 0.0, unlike=nearest_other(prof, self.references, ref.label))
+        mine = next((p for p in proofs if p["label"] == found.ref.label), None)
+        first = {**(mine or {"label": found.ref.label, "conf": 0.0, "trace": [], "near": True}),
+                 "conf": found.confidence, "resembles": (found, prof), "near_conf": mine["conf"] if mine else 0.0}
         return [first, *(p for p in proofs if p is not mine)]
 
     def _thresholds(self, opts: dict, programs: dict[str, Program] | None = None) -> dict[str, float]:
@@ -439,14 +432,9 @@ class Model:
         """The Explanation fields of the training object a near answer likened the scene to, if one did."""
         if "resembles" not in best:
             return {}
-        ref, dist, prof = best["resembles"]
-        shared, differ = contrast(prof, ref)
-        out = {"resembles": ref.object, "resembles_label": ref.label, "resembles_distance": dist,
-               "shared": shared, "differ": differ, "near_confidence": best["near_conf"]}
-        if best["unlike"] is not None:
-            other, d_other = best["unlike"]
-            out.update(unlike=other.object, unlike_label=other.label, unlike_distance=d_other)
-        return out
+        found, prof = best["resembles"]
+        shared, differ = contrast(prof, found.ref)
+        return {"resembles": found, "shared": shared, "differ": differ, "near_confidence": best["near_conf"]}
 
     @staticmethod
     def _rival_parts(best: dict) -> dict:

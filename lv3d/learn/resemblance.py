@@ -12,7 +12,7 @@ and ``horizontal`` / ``vertical`` too (how a solid happens to rest, not what it 
 number of faces the object shows, as a share of ``FACES_FULL``. The distance of two profiles is the sum of
 their absolute differences, a predicate one lacks counting 0 there.
 
-Such an answer's confidence is :func:`closeness`: how much nearer the object lies to the answered class's
+Such an answer's confidence is :func:`closeness` (:class:`Resemblance`): how much nearer the object lies to the answered class's
 training objects than to any other class's, a ratio of two distances and so free of their scale.
 """
 
@@ -75,20 +75,41 @@ def nearest_other(prof: dict[str, float], references: list[Reference], label: st
     return nearest(prof, [r for r in references if r.label != label])
 
 
-def closeness(prof: dict[str, float], references: list[Reference], label: str) -> float:
-    """The confidence of naming ``label`` for an object of profile ``prof`` by resemblance: d_o / (d_c + d_o), where
-    d_c is the distance to the nearest training object of ``label`` and d_o to the nearest of any other class
-    (:func:`nearest_other`). 0.5 where the two are equal (the object lies as near one class as another), rising to
-    1 as the object comes to equal a training object of ``label`` and no other; 1 where no other class has a
-    training object, 0 where ``label`` has none."""
-    mine = nearest(prof, [r for r in references if r.label == label])
-    other = nearest_other(prof, references, label)
-    if mine is None:
-        return 0.0
-    if other is None:
+def closeness(d_class: float, d_other: float | None) -> float:
+    """The confidence of naming a class by resemblance: d_o / (d_c + d_o), where ``d_class`` (d_c) is the distance
+    to the nearest training object of the class and ``d_other`` (d_o) to the nearest of any other class. 0.5 where
+    the two are equal (the object lies as near one class as another), rising to 1 as the object comes to equal a
+    training object of the class and no other's; 1 where no other class has a training object (``d_other`` None)."""
+    if d_other is None:
         return 1.0
-    d_c, d_o = mine[1], other[1]
-    return 0.5 if d_c + d_o == 0 else d_o / (d_c + d_o)
+    return 0.5 if d_class + d_other == 0 else d_other / (d_class + d_other)
+
+
+@dataclass(frozen=True)
+class Resemblance:
+    """A near answer's grounds: the training object nearest the answered object (``ref``, whose class is the
+    answer) at ``distance``, and the nearest training object of another class (``other``, None where no other
+    class has one) at ``other_distance``."""
+
+    ref: Reference
+    distance: float
+    other: Reference | None
+    other_distance: float
+
+    @property
+    def confidence(self) -> float:
+        """:func:`closeness` of the two distances."""
+        return closeness(self.distance, self.other_distance if self.other is not None else None)
+
+
+def resemble(prof: dict[str, float], references: list[Reference]) -> Resemblance | None:
+    """The :class:`Resemblance` of an object of profile ``prof`` to the training objects; None without any."""
+    found = nearest(prof, references)
+    if found is None:
+        return None
+    ref, dist = found
+    other = nearest_other(prof, references, ref.label)
+    return Resemblance(ref, dist, *(other if other is not None else (None, 0.0)))
 
 
 def contrast(prof: dict[str, float], ref: Reference) -> tuple[list[tuple[str, float, float]], list[tuple[str, float, float]]]:

@@ -6,7 +6,7 @@ import pytest
 
 from lv3d.facts import Fact, SceneFacts
 from lv3d.learn import Model
-from lv3d.learn.resemblance import Reference, closeness, profile
+from lv3d.learn.resemblance import Reference, profile, resemble
 
 
 @pytest.fixture(scope="module")
@@ -30,8 +30,8 @@ def test_the_rule_in_use_reproduces_the_answers_and_the_others_are_counted(near_
     model = Model({}, references=refs)
     truth = {"p": "can", "a": "tetra", "b": "can"}
     # p proved (kept as the fold file holds it); a and b answered by resemblance with the confidence in use
-    held = [["p", "can", 0.9], ["a", "tetra", closeness(profile(facts["a"]), refs, "tetra")],
-            ["b", "tetra", closeness(profile(facts["b"]), refs, "tetra")]]
+    held = [["p", "can", 0.9], ["a", "tetra", resemble(profile(facts["a"]), refs).confidence],
+            ["b", "tetra", resemble(profile(facts["b"]), refs).confidence]]
     record = {"predictions": {"multiclass": held}, "answered_by": [["proof", "near", "near"]],
               "test_ids": ["p", "a", "b"], "test_classes": [truth[i] for i in ("p", "a", "b")]}
     asked = []

@@ -8,7 +8,7 @@ import pytest
 from lv3d.facts import Fact, SceneFacts
 from lv3d.learn import Model
 from lv3d.learn.resemblance import (FACES, Reference, closeness, contrast, distance, nearest, nearest_other,
-                                    profile)
+                                    profile, resemble)
 
 
 def _scene(name: str, faces: list[list[tuple[str, float]]], pairs: list[tuple[str, int, int, float]] = ()
@@ -72,11 +72,15 @@ def test_closeness_is_the_share_of_the_two_nearest_distances_held_by_the_other_c
             Reference("y", "can", {"cylindrical": 0.9})]
     prof = {"triangle": 0.7}
     # nearest tetra at 0.2 (x), nearest can at 0.7 + 0.9 = 1.6: 1.6 / (0.2 + 1.6)
-    assert closeness(prof, refs, "tetra") == pytest.approx(1.6 / 1.8)
-    assert closeness(prof, refs, "can") == pytest.approx(0.2 / 1.8)
-    assert closeness({}, [Reference("p", "a", {}), Reference("q", "b", {})], "a") == 0.5  # both at 0: a tie
-    assert closeness(prof, refs[:2], "tetra") == 1.0  # no other class to mistake it for
-    assert closeness(prof, refs, "box") == 0.0  # no training object of the class
+    found = resemble(prof, refs)
+    assert (found.ref.object, found.other.object) == ("x", "y")
+    assert (found.distance, found.other_distance) == pytest.approx((0.2, 1.6))
+    assert found.confidence == pytest.approx(1.6 / 1.8) == closeness(0.2, 1.6)
+    assert closeness(1.6, 0.2) == pytest.approx(0.2 / 1.8)
+    assert closeness(0.0, 0.0) == 0.5  # both at 0: a tie
+    alone = resemble(prof, refs[:2])  # no other class to mistake it for
+    assert alone.other is None and alone.confidence == 1.0 == closeness(0.2, None)
+    assert resemble(prof, []) is None
     assert nearest_other(prof, refs, "tetra")[0].object == "y" and nearest_other(prof, refs[:2], "tetra") is None
 
 
@@ -96,24 +100,24 @@ def test_an_object_no_program_proves_gets_the_class_of_the_training_object_it_re
     assert model._proofs(one) == []
     label, conf, how = model.answer(one)
     assert (label, how) == ("tetra", "near")
-    assert conf == pytest.approx(closeness(profile(one), model.references, "tetra")) and 0.5 < conf < 1
+    assert conf == pytest.approx(resemble(profile(one), model.references).confidence) and 0.5 < conf < 1
     e = model.explain(one)
     # the tetrahedron's program needs a neighbour face, which a near proof cannot make up: it shows none
     assert e.confidence == conf and e.clauses == [] and e.near_confidence == 0.0
-    assert e.resembles.startswith("t") and e.resembles_label == "tetra"
+    r = e.resembles
+    assert r.ref.object.startswith("t") and r.ref.label == "tetra"
     assert ("triangle", 0.95, 0.95) in e.shared
     text = str(e)
-    assert "no program proves it" in text and f"resembles {e.resembles}, a tetra" in text
+    assert "no program proves it" in text and f"resembles {r.ref.object}, a tetra" in text
     assert "both show triangle" in text and "which it misses" not in text
     # the nearest training object of another class, whose distance the confidence weighs against
-    assert e.unlike_label != "tetra" and e.unlike_distance == pytest.approx(
-        e.resembles_distance * conf / (1 - conf))
-    assert f"of another class, {e.unlike}, a {e.unlike_label}, at {e.unlike_distance:.2f}" in text
+    assert r.other.label != "tetra" and r.other_distance == pytest.approx(r.distance * conf / (1 - conf))
+    assert f"of another class, {r.other.object}, a {r.other.label}, at {r.other_distance:.2f}" in text
     # a round cap beside a rectangle: the can's program (a cylindrical face) misses it by one fact, which its
     # explanation shows with the near proof's confidence beside the resemblance's
     cap = _scene("cap", [[("circular", 0.9)], [("rectangle", 0.9)]], [("adjacent", 0, 1, 0.99)])
     label, conf, how = model.answer(cap)
-    assert (label, how) == ("can", "near") and conf == pytest.approx(closeness(profile(cap), model.references, "can"))
+    assert (label, how) == ("can", "near") and conf == pytest.approx(resemble(profile(cap), model.references).confidence)
     e = model.explain(cap)
     assert e.missing and 0 < e.near_confidence < 0.5
     assert f"the can's program, which it misses (near proof {e.near_confidence:.3f}):" in str(e)
@@ -149,5 +153,5 @@ def test_a_class_whose_search_found_no_program_is_still_named_by_resemblance():
     label, conf, how = lone.answer(_box("b9"))
     assert (label, conf, how) == ("box", 1.0, "near")  # it equals the training boxes, no other class's object
     e = lone.explain(_box("b9"))
-    assert e.clauses == [] and e.resembles_label == "box" and "program, which it misses" not in str(e)
+    assert e.clauses == [] and e.resembles.ref.label == "box" and "program, which it misses" not in str(e)
     assert Model({"can": model.programs["can"]}).answer(_box("b9"))[0] == "unknown"  # no references: a class task
