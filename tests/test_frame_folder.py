@@ -153,13 +153,19 @@ def test_explain_warns_of_the_examples_it_is_asked_about_only(frames, tmp_path, 
 
 
 def test_a_study_on_folders_keeps_each_frame_in_one_fold(frames, tmp_path):
+    import shutil
+
     from lv3d.experiment.runner import run_study
 
+    # one ball among them: too few to test in each of 3 folds, so the study learns box and prism and says so
+    folder = shutil.copytree(frames, tmp_path / "frames")
+    with (folder / "objects.csv").open("a") as f:
+        f.write("frame-000,2,5,5,ball,no,no,\n")
     config = tmp_path / "real.yaml"
     config.write_text(f"""
 name: real_tiny
 folds: 3
-data: {{folders: [{frames}], classes: [box, prism], cache: {tmp_path / 'cache'}}}
+data: {{folders: [{folder}], classes: [box, prism, ball], cache: {tmp_path / 'cache'}}}
 train: {{positives: 1, negatives_per_positive: 1, multiclass: true}}
 systems: [lv3d-depth, tree-rgbd]
 lv3d: {{settings: {{time_limit: 10}}}}
@@ -172,10 +178,27 @@ baselines: {{image_size: 16, tree_cells: 4}}
              for k in range(3)]
     assert sorted(i for t in tests for i in t) == sorted(f"{scene_atom(f'frame-{i:03d}')}_x1" for i in range(6))
     rec = json.loads((out / "folds" / "base" / "tree-rgbd" / "fold0.json").read_text())
-    assert rec["left_out"] == {"unusable_rows": [], "other_classes": {}}
-    assert (out / "results.md").is_file()
+    assert rec["left_out"] == {"unusable_rows": [], "other_classes": {"ball": 1}}
+    assert "ball" not in rec["tasks"] and {"box", "prism"} <= set(rec["tasks"])
+    assert "objects of ball, a class with fewer labelled objects than folds: 1." in (out / "results.md").read_text()
     again = run_study(config, out, progress=False)  # resumes: nothing to recompute
     assert again["ran"] == 0 and again["skipped"] == 6
+
+
+def test_a_study_on_folders_needs_two_classes_it_can_test_in_every_fold(frames, tmp_path):
+    from lv3d.errors import InputError
+    from lv3d.experiment.config import load_study
+
+    config = tmp_path / "real.yaml"
+    config.write_text(f"name: real_tiny\nfolds: 3\ndata: {{folders: [{frames}], classes: [box, prism]}}\n")
+    study = load_study(config)
+    assert study.base.data.classes == ("box", "prism") and study.base.left_out_classes == ()
+    assert "left_out_classes" not in study.base.to_dict()  # derived: no key of the YAML form nor of a cache key
+    with pytest.raises(InputError, match=r"real.yaml: data.classes: fewer than two of box, ball have at least "
+                                         r"folds \(3\).*the folders hold: box 3, prism 3"):
+        load_study(config, ["data.classes=[box, ball]"])
+    with pytest.raises(InputError, match="fewer than two of box, prism have at least folds \\(4\\)"):
+        load_study(config, ["folds=4"])
 
 
 def test_the_demo_learns_from_labelled_frames_and_explains_a_real_object(tmp_path, monkeypatch, capsys):

@@ -19,6 +19,7 @@ import hashlib
 import json
 import math
 import re
+from collections import Counter
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any, Callable
@@ -26,7 +27,7 @@ from typing import Any, Callable
 import yaml
 
 from ..errors import InputError
-from ..frame_folder import check_folders
+from ..frame_folder import FrameFolder
 from ..limits import MAX_DATASET_IMAGES
 
 LOGIC_SYSTEMS = ("lv3d-rgb", "lv3d-depth", "lv3d-rgbd")
@@ -280,6 +281,9 @@ class StudyConfig:
     lv3d: Lv3dConfig = field(default_factory=Lv3dConfig)
     baselines: BaselineConfig = field(default_factory=BaselineConfig)
     stats: StatsConfig = field(default_factory=StatsConfig)
+    # derived, no YAML key: the classes of data.classes left out of a study on folders for holding fewer labelled
+    # objects than folds, each with its count (from_dict)
+    left_out_classes: tuple = field(default=(), metadata={"derived": True})
 
     def to_dict(self) -> dict:
         """Plain nested mappings and lists (what the YAML holds, and what cache keys digest)."""
@@ -291,7 +295,7 @@ class StudyConfig:
 
 def _plain(obj):
     if hasattr(obj, "__dataclass_fields__"):
-        return {f.name: _plain(getattr(obj, f.name)) for f in fields(obj)}
+        return {f.name: _plain(getattr(obj, f.name)) for f in fields(obj) if not f.metadata.get("derived")}
     if isinstance(obj, (list, tuple)):
         return [_plain(v) for v in obj]
     if isinstance(obj, dict):
@@ -359,6 +363,26 @@ def _section(cls, raw: dict, key: str, where: str):
     return cls(**values)
 
 
+def learnable_classes(folders, classes, folds: int, where: str) -> tuple[tuple[str, ...], dict[str, int]]:
+    """The classes of ``classes`` a study on ``folders`` can learn and test: those with at least ``folds`` labelled
+    objects (each test fold holds one), in their order; and the others, each with its count, which the study leaves
+    out (and says so). InputError naming ``where`` when a folder cannot be read, or fewer than two classes remain
+    (a class task's negatives are the other classes' objects)."""
+    counts: Counter = Counter()
+    for path in folders:
+        try:
+            objects, _ = FrameFolder(Path(path).expanduser()).objects()
+        except InputError as e:
+            raise InputError(where, f"data.folders: {e}") from None
+        counts.update(o.shape for o in objects)
+    kept = tuple(c for c in classes if counts[c] >= folds)
+    if len(kept) < 2:
+        have = ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "none"
+        raise InputError(where, f"data.classes: fewer than two of {', '.join(classes)} have at least folds ({folds}) "
+                                f"labelled objects in data.folders, one to test in each fold; the folders hold: {have}")
+    return kept, {c: counts[c] for c in classes if c not in kept}
+
+
 def from_dict(cfg: dict, where: str) -> StudyConfig:
     """A merged config mapping (every key known) -> StudyConfig; InputError at the first bad value."""
     top = {}
@@ -370,7 +394,9 @@ def from_dict(cfg: dict, where: str) -> StudyConfig:
     study = StudyConfig(**top)
     d, b = study.data, study.baselines
     if d.folders is not None:
-        check_folders(d.folders, d.classes, study.folds, where)
+        kept, too_few = learnable_classes(d.folders, d.classes, study.folds, where)
+        study = replace(study, data=replace(d, classes=kept), left_out_classes=tuple(too_few.items()))
+        d = study.data
     else:
         known = _classes()
         for c in d.classes:

@@ -101,7 +101,7 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
             per["confusion"] = confusion
         left = next((r["left_out"] for r in recs if r.get("left_out") is not None), None)
         if left is not None:
-            summary["left_out"] = left
+            summary["left_out"] = {**left, "classes": dict(cfg.left_out_classes)}
             summary["examples"] = sum(len(r["test_ids"]) for r in recs)
         # settings a tuned baseline chose per fold (baselines.tune), with their inner cross-validation accuracy
         tuned = [{"fold": r["fold"], **r["tuned"]["setting"], "inner_accuracy": r["tuned"]["inner_accuracy"]}
@@ -347,9 +347,13 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing:
                 lines.append(f"| {s} | {wrong} of {total} | {top or '–'} |")
         left = summ.get("left_out")
         if left is not None:
-            other = ", ".join(f"{k} {v}" for k, v in sorted(left["other_classes"].items())) or "none"
+            few = left.get("classes", {})
+            other = ", ".join(f"{k} {v}" for k, v in sorted(left["other_classes"].items()) if k not in few) or "none"
+            too_few = "".join(f", objects of {k}, a class with fewer labelled objects than folds: {v}"
+                              for k, v in sorted(few.items()))
             lines += ["", f"Examples: {summ['examples']} labelled objects of the study's classes; left out: "
-                      f"{len(left['unusable_rows'])} unusable rows of objects.csv, objects of other classes: {other}. "
+                      f"{len(left['unusable_rows'])} unusable rows of objects.csv, objects of other classes: {other}"
+                      f"{too_few}. "
                       "*pipeline errors*: examples whose labelled pixel lies on no object that system's perception "
                       "found (answered \"unknown\")."]
             lines += [f"- {row}" for row in left["unusable_rows"][:10]]

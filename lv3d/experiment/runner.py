@@ -387,11 +387,15 @@ def study_inputs(ccfg: StudyConfig, out: Path, executor=None, progress: bool = T
 
 
 def _real_examples(ccfg: StudyConfig, progress: bool):
-    """The labelled objects of the condition's folders; each unusable row of objects.csv one line on stderr."""
+    """The labelled objects of the condition's folders; each unusable row of objects.csv, and each class of
+    data.classes with too few objects to test in every fold, one line on stderr."""
     from .real_data import real_data
 
     rd = real_data(ccfg.data.folders, ccfg.data.classes)
     if progress:
+        for c, n in ccfg.left_out_classes:
+            print(f"lv3d: warning: data.classes: {c!r} has {n} labelled object{'' if n == 1 else 's'} in data.folders, fewer than folds "
+                  f"({ccfg.folds}) (left out)", file=sys.stderr)
         for p in rd.problems:
             print(f"lv3d: warning: {p} (left out)", file=sys.stderr)
     return rd
