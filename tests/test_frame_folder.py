@@ -128,6 +128,9 @@ def test_learn_fit_predict_and_explain_on_a_folder_of_frames(frames, tmp_path, c
     assert main(["learn", "explain", *args, "--model", str(model), "--example", ex]) == 0
     out = capsys.readouterr().out
     assert out.startswith(f"{ex} (box): {ex}_o is a box") and "because" in out
+    # the same example by its frame's file name
+    assert main(["learn", "explain", *args, "--model", str(model), "--example", "frame-002_x1"]) == 0
+    assert capsys.readouterr().out.startswith(f"{ex} (box): {ex}_o is a box")
     assert main(["learn", "fit", *args, "--facts", "truth", "--out", str(tmp_path / "m2")]) == 2
     assert "no ground-truth facts" in capsys.readouterr().err
 

@@ -293,12 +293,14 @@ def predict(data: Path, modality: str, facts: str | None, cache: Path | None, mo
 @_cache
 @click.option("--model", "model_dir", type=click.Path(path_type=Path), required=True)
 @click.option("--example", "examples", multiple=True, metavar="ID",
-              help="explain this example only (an id predict prints; repeatable; default: every example)")
+              help="explain this example only (an id predict prints, or FRAME_xOBJECT with the frame's file "
+                   "name; repeatable; default: every example)")
 def explain(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path,
             examples: tuple[str, ...]):
     """Print why each example gets its label: the program that proves it and the facts (with confidences)
     the proof used."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
+    examples = tuple(_example_atom(e) for e in examples)
     # the examples asked for: only their own "no object" warnings (each is answered so below as well)
     model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir, set(examples) or None)
     by_id = {s.scene: (s, y) for s, y in zip(scenes, labels)}
@@ -311,3 +313,13 @@ def explain(data: Path, modality: str, facts: str | None, cache: Path | None, mo
             click.echo(f"{i} ({y}): unknown: perception found no object under its labelled pixel")
             continue
         click.echo(f"{i} ({y}): {model.explain(s)}")
+
+
+def _example_atom(example: str) -> str:
+    """The id of an example named by its frame's file name and its object (``My Frame-001_x2``): the frame part as
+    the atom lv3d names the frame by (frame_folder.scene_atom); an id predict prints is kept as it is."""
+    from ..frame_folder import scene_atom
+    from ..object_facts import example_id
+
+    frame, sep, obj = example.rpartition("_x")
+    return example_id(scene_atom(frame), obj) if sep and frame and obj.isdigit() else example
