@@ -202,6 +202,20 @@ def test_a_study_on_folders_needs_two_classes_it_can_test_in_every_fold(frames, 
         load_study(config, ["data.classes=[box, ball]"])
     with pytest.raises(InputError, match="fewer than two of box, prism have at least folds \\(4\\)"):
         load_study(config, ["folds=4"])
+    # no classes named: every shape of the folder, the most labelled objects first, but the catch-all "other"
+    with (frames / "objects.csv").open() as f:
+        rows = f.read()
+    more = tmp_path / "more"
+    more.mkdir()
+    for p in frames.iterdir():
+        (more / p.name).write_bytes(p.read_bytes())
+    shapes = ["other"] * 4 + ["cone"] * 4 + ["ball"] * 2
+    (more / "objects.csv").write_text(rows + "".join(f"frame-00{i % 6},{10 + i},{10 + i},2,{c},no,no,\n"
+                                                     for i, c in enumerate(shapes)))
+    study = load_study(config, ["data.classes=null", f"data.folders=[{more}]"])
+    assert study.base.data.classes == ("cone", "box", "prism") and study.base.left_out_classes == (("ball", 2),)
+    with pytest.raises(InputError, match="data.classes: give the classes to render"):
+        load_study(config, ["data.classes=null", "data.folders=null"])
 
 
 def test_the_demo_learns_from_labelled_frames_and_explains_a_real_object(tmp_path, monkeypatch, capsys):

@@ -183,9 +183,10 @@ class DataConfig:
     """The examples of the study: images rendered once, cached by (classes, per_class, noise, seed); or, with
     ``folders``, the labelled objects of real frames (lv3d.frame_folder), each object one example."""
 
-    classes: tuple = _spec(("cube", "square_pyramid", "triangular_prism", "pentagonal_prism"), "labels",
-                           names=_classes, min_len=2,
-                           doc="rendered classes; with folders, the objects.csv shapes to learn (others left out)")
+    classes: tuple | None = _spec(("cube", "square_pyramid", "triangular_prism", "pentagonal_prism"), "labels",
+                                  names=_classes, min_len=2, optional=True,
+                                  doc="rendered classes; with folders, the objects.csv shapes to learn (others left "
+                                      "out), None: every shape of them but other (learnable_classes)")
     folders: tuple | None = _spec(None, "paths", optional=True,
                                   doc="folders of labelled real frames (relative to the working directory); "
                                       "None: a rendered data set")
@@ -363,11 +364,17 @@ def _section(cls, raw: dict, key: str, where: str):
     return cls(**values)
 
 
+# objects.csv's catch-all shape (../shared/data/real/README.md): an object of none of the shapes it names, which
+# a study of every shape of its folders (data.classes None) does not learn as a class
+OTHER_SHAPE = "other"
+
+
 def learnable_classes(folders, classes, folds: int, where: str) -> tuple[tuple[str, ...], dict[str, int]]:
     """The classes of ``classes`` a study on ``folders`` can learn and test: those with at least ``folds`` labelled
     objects (each test fold holds one), in their order; and the others, each with its count, which the study leaves
-    out (and says so). InputError naming ``where`` when a folder cannot be read, or fewer than two classes remain
-    (a class task's negatives are the other classes' objects)."""
+    out (and says so). ``classes`` None: every shape the folders' objects.csv name but ``OTHER_SHAPE``, the most
+    labelled objects first (ties by name). InputError naming ``where`` when a folder cannot be read, or fewer than
+    two classes remain (a class task's negatives are the other classes' objects)."""
     counts: Counter = Counter()
     for path in folders:
         try:
@@ -375,11 +382,14 @@ def learnable_classes(folders, classes, folds: int, where: str) -> tuple[tuple[s
         except InputError as e:
             raise InputError(where, f"data.folders: {e}") from None
         counts.update(o.shape for o in objects)
+    if classes is None:
+        classes = tuple(sorted((c for c in counts if c != OTHER_SHAPE), key=lambda c: (-counts[c], c)))
     kept = tuple(c for c in classes if counts[c] >= folds)
     if len(kept) < 2:
         have = ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "none"
-        raise InputError(where, f"data.classes: fewer than two of {', '.join(classes)} have at least folds ({folds}) "
-                                f"labelled objects in data.folders, one to test in each fold; the folders hold: {have}")
+        raise InputError(where, f"data.classes: fewer than two of {', '.join(classes) or 'its classes'} have at least "
+                                f"folds ({folds}) labelled objects in data.folders, one to test in each fold; the "
+                                f"folders hold: {have}")
     return kept, {c: counts[c] for c in classes if c not in kept}
 
 
@@ -397,6 +407,9 @@ def from_dict(cfg: dict, where: str) -> StudyConfig:
         kept, too_few = learnable_classes(d.folders, d.classes, study.folds, where)
         study = replace(study, data=replace(d, classes=kept), left_out_classes=tuple(too_few.items()))
         d = study.data
+    elif d.classes is None:
+        raise InputError(where, "data.classes: give the classes to render (every shape of the folders' objects.csv, "
+                                "None, is for a study on data.folders)")
     else:
         known = _classes()
         for c in d.classes:
