@@ -155,6 +155,23 @@ def test_explain_warns_of_the_examples_it_is_asked_about_only(frames, tmp_path, 
     assert f"example {lost} has no object" in err and "perception found no object under its labelled pixel" in out
 
 
+def test_fit_learns_every_class_but_the_catch_all_other_unless_named(frames, tmp_path, capsys):
+    folder = tmp_path / "copy"
+    folder.mkdir()
+    for p in frames.iterdir():
+        (folder / p.name).write_bytes(p.read_bytes())
+    rows = (frames / "objects.csv").read_text().splitlines()
+    first = rows[1].split(",")  # frame-000's object, labelled a second time as an object of no named shape
+    (folder / "objects.csv").write_text("\n".join([*rows, ",".join([first[0], "2", *first[2:4], "other", "no", "no", ""])])
+                                        + "\n")
+    args = ["--data", str(folder), "--modality", "depth", "--cache", str(tmp_path / "cache"), "--time-limit", "20"]
+    assert main(["learn", "fit", *args, "--out", str(tmp_path / "m")]) == 0
+    out = capsys.readouterr().out
+    assert "learned from 7 examples (box 3, other 1, prism 3)" in out and "% other:" not in out and "% box:" in out
+    assert main(["learn", "fit", *args, "--classes", "box,other", "--out", str(tmp_path / "m2")]) == 0
+    assert "% other:" in capsys.readouterr().out
+
+
 def test_a_study_on_folders_keeps_each_frame_in_one_fold(frames, tmp_path):
     import shutil
 

@@ -180,7 +180,8 @@ _cache = click.option("--cache", type=click.Path(path_type=Path), default=None,
 @_modality
 @_facts
 @_cache
-@click.option("--classes", default=None, help="comma-separated classes to learn (default: all in the data)")
+@click.option("--classes", default=None, help="comma-separated classes to learn (default: every class in the data "
+                                               "but other, objects.csv's catch-all shape)")
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="directory for the programs")
 @click.option("--seed", type=click.IntRange(0, 2 ** 32 - 1), default=0, show_default=True)
 @click.option("--time-limit", type=click.FloatRange(0, 86400, min_open=True), default=None, help="seconds per class")
@@ -189,8 +190,9 @@ def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classe
     """Learn one program per class and save them as .pl files in OUT. Examples where perception found no
     object are left out (counted)."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
-    from ..output import check_out, replacing
+    from ..experiment.config import OTHER_SHAPE
     from ..learn.model import Model
+    from ..output import check_out, replacing
 
     check_out(out, (data,))  # before any work: a file, a folder lv3d did not write or one holding the data
     wanted = [c.strip() for c in classes.split(",") if c.strip()] if classes is not None else None
@@ -209,6 +211,8 @@ def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classe
     lost = [c for c in (wanted or []) if c not in present]
     if lost:
         raise click.ClickException(f"perception found no object in any example of {', '.join(lost)}")
+    if wanted is None and OTHER_SHAPE in present and len(present) > 1:
+        wanted = sorted(present - {OTHER_SHAPE})  # its examples stay, as negatives of every class
     settings = {"time_limit": time_limit} if time_limit is not None else None
     model = Model.fit(scenes, labels, settings=settings, seed=seed, classes=wanted)
     if not model.programs and model.failures:  # nothing learned: no empty model is saved
