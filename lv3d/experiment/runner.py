@@ -394,8 +394,8 @@ def _real_examples(ccfg: StudyConfig, progress: bool):
     rd = real_data(ccfg.data.folders, ccfg.data.classes)
     if progress:
         for c, n in ccfg.left_out_classes:
-            print(f"lv3d: warning: data.classes: {c!r} has {n} labelled object{'' if n == 1 else 's'} in data.folders, fewer than folds "
-                  f"({ccfg.folds}) (left out)", file=sys.stderr)
+            print(f"lv3d: warning: data.classes: {c!r} has {n} labelled object{'' if n == 1 else 's'} in "
+                  f"data.folders, fewer than folds ({ccfg.folds}) (left out)", file=sys.stderr)
         for p in rd.problems:
             print(f"lv3d: warning: {p} (left out)", file=sys.stderr)
     return rd
