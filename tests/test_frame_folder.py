@@ -172,10 +172,11 @@ def test_fit_learns_every_class_but_the_catch_all_other_unless_named(frames, tmp
     assert "% other:" in capsys.readouterr().out
 
 
-def test_a_study_on_folders_keeps_each_frame_in_one_fold(frames, tmp_path):
+def test_a_study_on_folders_keeps_each_frame_in_one_fold(frames, tmp_path, capsys):
     import shutil
 
-    from lv3d.experiment.runner import run_study
+    from lv3d.experiment.config import load_study
+    from lv3d.experiment.runner import run_study, study_inputs
 
     # one ball among them: too few to test in each of 3 folds, so the study learns box and prism and says so
     folder = shutil.copytree(frames, tmp_path / "frames")
@@ -203,6 +204,12 @@ baselines: {{image_size: 16, tree_cells: 4}}
     assert "objects of ball, a class with fewer labelled objects than folds: 1." in (out / "results.md").read_text()
     again = run_study(config, out, progress=False)  # resumes: nothing to recompute
     assert again["ran"] == 0 and again["skipped"] == 6
+    # the warning about the ball, once for the conditions of one study (they share ``warned``)
+    warned: set = set()
+    for _ in range(2):
+        study_inputs(load_study(config).base, out, progress=True, warned=warned)
+    assert capsys.readouterr().err.count("'ball' has 1 labelled object in data.folders, fewer than folds (3) "
+                                         "(left out)") == 1
 
 
 def test_a_study_on_folders_needs_two_classes_it_can_test_in_every_fold(frames, tmp_path):

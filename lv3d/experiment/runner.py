@@ -328,6 +328,7 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
     done = _finished_keys(out)
     bar = tqdm(total=len(jobs), desc=study.name, disable=not progress)
     remote = executor if getattr(executor, "name", "local") != "local" else None
+    warned: set = set()  # each warning about the examples once, not once per condition
     for cname, ccfg in conds.items():
         pending = []
         for s in ccfg.systems:
@@ -344,7 +345,7 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
         bar.update(ccfg.folds * len(ccfg.systems) - len(pending))
         if not pending:
             continue
-        items, inputs = study_inputs(ccfg, out, remote, progress)
+        items, inputs = study_inputs(ccfg, out, remote, progress, warned)
         folds = (grouped_folds if ccfg.data.folders else stratified_folds)(items, ccfg.folds, ccfg.seed)
         by_system: dict[str, list[int]] = {}
         for sname, k in pending:
@@ -373,31 +374,32 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
     return {"ran": ran, "skipped": skipped, "report": summary, "learn_failures": failed}
 
 
-def study_inputs(ccfg: StudyConfig, out: Path, executor=None, progress: bool = True):
+def study_inputs(ccfg: StudyConfig, out: Path, executor=None, progress: bool = True, warned: set | None = None):
     """(the examples, what each system sees of them) of one condition whose work folder is ``out``: the labelled
     objects of its real frames or the images of its rendered data set, and an object whose ``for_system(name)``
     gives a system's inputs (an lv3d system's facts per example id, as the study learns from them; computed on
-    first use and cached)."""
+    first use and cached). ``warned``: the warnings already printed (the conditions of one study share them),
+    each printed once."""
     if ccfg.data.folders:
-        rd = _real_examples(ccfg, progress)
+        rd = _real_examples(ccfg, progress, set() if warned is None else warned)
         return rd.items, _RealInputs(ccfg, out, rd, executor, progress)
     data = data_mod.ensure_dataset(ccfg, out)
     items = data_mod.read_items(data)
     return items, _Inputs(ccfg, out, data, items, executor)
 
 
-def _real_examples(ccfg: StudyConfig, progress: bool):
+def _real_examples(ccfg: StudyConfig, progress: bool, warned: set):
     """The labelled objects of the condition's folders; each unusable row of objects.csv, and each class of
-    data.classes with too few objects to test in every fold, one line on stderr."""
+    data.classes with too few objects to test in every fold, one line on stderr unless in ``warned``."""
     from .real_data import real_data
 
     rd = real_data(ccfg.data.folders, ccfg.data.classes)
-    if progress:
-        for c, n in ccfg.left_out_classes:
-            print(f"lv3d: warning: data.classes: {c!r} has {n} labelled object{'' if n == 1 else 's'} in "
-                  f"data.folders, fewer than folds ({ccfg.folds}) (left out)", file=sys.stderr)
-        for p in rd.problems:
-            print(f"lv3d: warning: {p} (left out)", file=sys.stderr)
+    lines = [f"data.classes: {c!r} has {n} labelled object{'' if n == 1 else 's'} in data.folders, fewer than "
+             f"folds ({ccfg.folds})" for c, n in ccfg.left_out_classes] + [str(p) for p in rd.problems]
+    for line in lines:
+        if progress and line not in warned:
+            print(f"lv3d: warning: {line} (left out)", file=sys.stderr)
+        warned.add(line)
     return rd
 
 
