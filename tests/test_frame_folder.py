@@ -201,15 +201,15 @@ baselines: {{image_size: 16, tree_cells: 4}}
     rec = json.loads((out / "folds" / "base" / "tree-rgbd" / "fold0.json").read_text())
     assert rec["left_out"] == {"unusable_rows": [], "other_classes": {"ball": 1}}
     assert "ball" not in rec["tasks"] and {"box", "prism"} <= set(rec["tasks"])
-    assert "objects of ball, a class with fewer labelled objects than folds: 1." in (out / "results.md").read_text()
+    assert "objects of ball, a class labelled in fewer frames than folds: 1." in (out / "results.md").read_text()
     again = run_study(config, out, progress=False)  # resumes: nothing to recompute
     assert again["ran"] == 0 and again["skipped"] == 6
     # the warning about the ball, once for the conditions of one study (they share ``warned``)
     warned: set = set()
     for _ in range(2):
         study_inputs(load_study(config).base, out, progress=True, warned=warned)
-    assert capsys.readouterr().err.count("'ball' has 1 labelled object in data.folders, fewer than folds (3) "
-                                         "(left out)") == 1
+    assert capsys.readouterr().err.count("'ball' is labelled in fewer frames of data.folders than folds (3): its 1 "
+                                         "object (left out)") == 1
 
 
 def test_a_study_on_folders_needs_two_classes_it_can_test_in_every_fold(frames, tmp_path):
@@ -221,10 +221,10 @@ def test_a_study_on_folders_needs_two_classes_it_can_test_in_every_fold(frames, 
     study = load_study(config)
     assert study.base.data.classes == ("box", "prism") and study.base.left_out_classes == ()
     assert "left_out_classes" not in study.base.to_dict()  # derived: no key of the YAML form nor of a cache key
-    with pytest.raises(InputError, match=r"real.yaml: data.classes: fewer than two of box, ball have at least "
-                                         r"folds \(3\).*the folders hold: box 3, prism 3"):
+    with pytest.raises(InputError, match=r"real.yaml: data.classes: fewer than two of box, ball are labelled in at "
+                                         r"least folds \(3\) frames.*the folders hold: box 3 in 3 frame\(s\), prism 3"):
         load_study(config, ["data.classes=[box, ball]"])
-    with pytest.raises(InputError, match="fewer than two of box, prism have at least folds \\(4\\)"):
+    with pytest.raises(InputError, match="fewer than two of box, prism are labelled in at least folds \\(4\\)"):
         load_study(config, ["folds=4"])
     # no classes named: every shape of the folder, the most labelled objects first, but the catch-all "other"
     with (frames / "objects.csv").open() as f:
@@ -235,9 +235,12 @@ def test_a_study_on_folders_needs_two_classes_it_can_test_in_every_fold(frames, 
         (more / p.name).write_bytes(p.read_bytes())
     shapes = ["other"] * 4 + ["cone"] * 4 + ["ball"] * 2
     (more / "objects.csv").write_text(rows + "".join(f"frame-00{i % 6},{10 + i},{10 + i},2,{c},no,no,\n"
-                                                     for i, c in enumerate(shapes)))
+                                                     for i, c in enumerate(shapes))
+                                      + "".join(f"frame-005,{30 + i},{30 + i},2,mug,no,no,\n" for i in range(4)))
+    # four mugs, all in one frame: a fold grouped by frame would hold them all, so no fold could test them
     study = load_study(config, ["data.classes=null", f"data.folders=[{more}]"])
-    assert study.base.data.classes == ("cone", "box", "prism") and study.base.left_out_classes == (("ball", 2),)
+    assert study.base.data.classes == ("cone", "box", "prism")
+    assert study.base.left_out_classes == (("mug", 4), ("ball", 2))
     with pytest.raises(InputError, match="data.classes: give the classes to render"):
         load_study(config, ["data.classes=null", "data.folders=null"])
 

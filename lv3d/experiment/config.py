@@ -282,8 +282,8 @@ class StudyConfig:
     lv3d: Lv3dConfig = field(default_factory=Lv3dConfig)
     baselines: BaselineConfig = field(default_factory=BaselineConfig)
     stats: StatsConfig = field(default_factory=StatsConfig)
-    # derived, no YAML key: the classes of data.classes left out of a study on folders for holding fewer labelled
-    # objects than folds, each with its count (from_dict)
+    # derived, no YAML key: the classes of data.classes left out of a study on folders for being labelled in fewer
+    # frames than folds, each with its number of labelled objects (from_dict, learnable_classes)
     left_out_classes: tuple = field(default=(), metadata={"derived": True})
 
     def to_dict(self) -> dict:
@@ -370,27 +370,31 @@ OTHER_SHAPE = "other"
 
 
 def learnable_classes(folders, classes, folds: int, where: str) -> tuple[tuple[str, ...], dict[str, int]]:
-    """The classes of ``classes`` a study on ``folders`` can learn and test: those with at least ``folds`` labelled
-    objects (each test fold holds one), in their order; and the others, each with its count, which the study leaves
-    out (and says so). ``classes`` None: every shape the folders' objects.csv name but ``OTHER_SHAPE``, the most
-    labelled objects first (ties by name). InputError naming ``where`` when a folder cannot be read, or fewer than
-    two classes remain (a class task's negatives are the other classes' objects)."""
-    counts: Counter = Counter()
-    for path in folders:
+    """The classes of ``classes`` a study on ``folders`` can learn and test: those labelled in at least ``folds``
+    frames (the folds are grouped by frame, and each test fold holds a frame of each class), in their order; and the
+    others, each with its number of labelled objects, which the study leaves out (and says so). ``classes`` None:
+    every shape the folders' objects.csv name but ``OTHER_SHAPE``, the most labelled objects first (ties by name).
+    InputError naming ``where`` when a folder cannot be read, or fewer than two classes remain (a class task's
+    negatives are the other classes' objects)."""
+    objects: Counter = Counter()
+    frames: dict[str, set] = {}
+    for k, path in enumerate(folders):
         try:
-            objects, _ = FrameFolder(Path(path).expanduser()).objects()
+            labelled, _ = FrameFolder(Path(path).expanduser()).objects()
         except InputError as e:
             raise InputError(where, f"data.folders: {e}") from None
-        counts.update(o.shape for o in objects)
+        for o in labelled:
+            objects[o.shape] += 1
+            frames.setdefault(o.shape, set()).add((k, o.frame))
     if classes is None:
-        classes = tuple(sorted((c for c in counts if c != OTHER_SHAPE), key=lambda c: (-counts[c], c)))
-    kept = tuple(c for c in classes if counts[c] >= folds)
+        classes = tuple(sorted((c for c in objects if c != OTHER_SHAPE), key=lambda c: (-objects[c], c)))
+    kept = tuple(c for c in classes if len(frames.get(c, ())) >= folds)
     if len(kept) < 2:
-        have = ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "none"
-        raise InputError(where, f"data.classes: fewer than two of {', '.join(classes) or 'its classes'} have at least "
-                                f"folds ({folds}) labelled objects in data.folders, one to test in each fold; the "
-                                f"folders hold: {have}")
-    return kept, {c: counts[c] for c in classes if c not in kept}
+        have = ", ".join(f"{c} {objects[c]} in {len(frames[c])} frame(s)" for c in sorted(objects)) or "none"
+        raise InputError(where, f"data.classes: fewer than two of {', '.join(classes) or 'its classes'} are labelled "
+                                f"in at least folds ({folds}) frames of data.folders (the folds are grouped by frame, "
+                                f"and each tests a frame of every class); the folders hold: {have}")
+    return kept, {c: objects[c] for c in classes if c not in kept}
 
 
 def from_dict(cfg: dict, where: str) -> StudyConfig:

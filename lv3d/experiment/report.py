@@ -349,7 +349,7 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing:
         if left is not None:
             few = left.get("classes", {})
             other = ", ".join(f"{k} {v}" for k, v in sorted(left["other_classes"].items()) if k not in few) or "none"
-            too_few = "".join(f", objects of {k}, a class with fewer labelled objects than folds: {v}"
+            too_few = "".join(f", objects of {k}, a class labelled in fewer frames than folds: {v}"
                               for k, v in sorted(few.items()))
             lines += ["", f"Examples: {summ['examples']} labelled objects of the study's classes; left out: "
                       f"{len(left['unusable_rows'])} unusable rows of objects.csv, objects of other classes: {other}"

@@ -394,8 +394,8 @@ def _real_examples(ccfg: StudyConfig, progress: bool, warned: set):
     from .real_data import real_data
 
     rd = real_data(ccfg.data.folders, ccfg.data.classes)
-    lines = [f"data.classes: {c!r} has {n} labelled object{'' if n == 1 else 's'} in data.folders, fewer than "
-             f"folds ({ccfg.folds})" for c, n in ccfg.left_out_classes] + [str(p) for p in rd.problems]
+    lines = [f"data.classes: {c!r} is labelled in fewer frames of data.folders than folds ({ccfg.folds}): its {n} "
+             f"object{'' if n == 1 else 's'}" for c, n in ccfg.left_out_classes] + [str(p) for p in rd.problems]
     for line in lines:
         if progress and line not in warned:
             print(f"lv3d: warning: {line} (left out)", file=sys.stderr)
