@@ -250,7 +250,8 @@ class BaselineConfig:
                                    doc="input pixels a side tried; each divides image_size (the cached tensors "
                                        "area-downsampled by a whole factor); 8 at least: the stem halves the "
                                        "input and two 2x2 pools follow")
-    tune_folds: int = _int(3, 2, 20, doc="inner cross-validation folds (groups of examples never split)")
+    tune_folds: int = _int(3, 2, 20, doc="inner cross-validation folds (groups of examples never split; one a group "
+                                                  "where the training folds hold fewer)")
 
 
 # BaselineConfig's tuning keys: left out of a result's key where they cannot change it (runner.result_key)

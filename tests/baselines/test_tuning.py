@@ -117,6 +117,19 @@ def test_tune_chooses_the_best_inner_accuracy_and_the_cheaper_on_a_tie(monkeypat
         settings[0].to_dict()
 
 
+def test_tune_takes_one_inner_fold_per_group_where_there_are_fewer_groups_than_folds(monkeypatch):
+    from lv3d.baselines import CNNSettings
+
+    monkeypatch.setattr(tuning, "CNNClassifier", _Fake)
+    monkeypatch.setattr(tuning, "_CACHE", {})
+    x, labels, groups = _coded(n_groups=2)  # the training folds of a small folder: two frames
+    _Fake.good, _Fake.fits = 8, []
+    out = tune(x, labels, groups, "depth", "early", CNNSettings(), grid([8], [2], [False], [8]), 3, seed=5)
+    assert out["inner_folds"] == 2 and out["n_groups"] == 2 and len(_Fake.fits) == 2
+    with pytest.raises(InputError, match="at least 2 groups"):  # one frame: no inner cross-validation
+        tune(x[:2], labels[:2], groups[:2], "depth", "early", CNNSettings(), grid([8], [2], [False], [8]), 3, seed=5)
+
+
 def test_tune_is_seeded_and_cached(monkeypatch):
     """The real CNN on a tiny grid: the same seed gives the same choice and scores; the cache answers a repeat."""
     from lv3d.baselines import CNNSettings
