@@ -119,11 +119,11 @@ def tune(x: np.ndarray, labels: list[str], groups: list[str], modality: str, arc
          settings: list[Setting], k: int, seed: int) -> dict:
     """Choose among ``settings`` (cheapest first, as :func:`grid` orders them) by ``k``-fold inner
     cross-validation of the multi-class task on (N, C, S, S) pixels ``x`` with ``labels`` and ``groups``;
-    ``base`` gives every other training setting. Where the examples hold fewer groups than ``k`` (a small folder's
-    training folds: fewer frames), one inner fold per group. Returns ``{"setting": chosen (Setting.to_dict()),
-    "inner_accuracy": its mean, "inner_folds": the folds used, "n_examples", "n_groups", "seed", "grid": [each setting
-    with its mean "accuracy" and "per_fold" accuracies, in grid order], "seconds": wall time of the
-    search}``. The same arguments give the same choice."""
+    ``base`` gives every other training setting. Where the examples hold fewer groups than ``k`` (a small
+    folder's training folds: fewer frames), one inner fold per group. Returns ``{"setting": chosen
+    (Setting.to_dict()), "inner_accuracy": its mean, "inner_folds": the folds used, "n_examples", "n_groups",
+    "seed", "grid": [each setting with its mean "accuracy" and "per_fold" accuracies, in grid order], "seconds":
+    wall time of the search}``. The same arguments give the same choice."""
     if len(labels) != len(x) or len(groups) != len(x):
         raise InputError("tuning", f"{len(x)} examples but {len(labels)} labels and {len(groups)} groups")
     if not settings:

@@ -390,7 +390,7 @@ def study_inputs(ccfg: StudyConfig, out: Path, executor=None, progress: bool = T
 
 def _real_examples(ccfg: StudyConfig, progress: bool, warned: set):
     """The labelled objects of the condition's folders; each unusable row of objects.csv, and each class of
-    data.classes with too few objects to test in every fold, one line on stderr unless in ``warned``."""
+    data.classes left out for being labelled in fewer frames than folds, one line on stderr unless in ``warned``."""
     from .real_data import real_data
 
     rd = real_data(ccfg.data.folders, ccfg.data.classes)
