@@ -35,6 +35,16 @@ def _write_folder(folder, frames):
     return folder
 
 
+def _with_rows(frames, folder, rows):
+    """A copy of the folder ``frames`` at ``folder`` with ``rows`` (objects.csv lines) added to its objects.csv."""
+    import shutil
+
+    shutil.copytree(frames, folder)
+    with (folder / "objects.csv").open("a") as f:
+        f.writelines(f"{row}\n" for row in rows)
+    return folder
+
+
 @pytest.fixture(scope="module")
 def frames(tmp_path_factory):
     names = [(f"frame-{i:03d}", cls, 11 + i) for i, cls in enumerate(["cube", "triangular_prism"] * 3)]
@@ -42,16 +52,13 @@ def frames(tmp_path_factory):
 
 
 def test_rows_that_cannot_be_used_are_named_by_file_and_line_and_the_rest_are_read(tmp_path, frames):
-    folder = tmp_path / "copy"
-    folder.mkdir()
-    for p in frames.iterdir():
-        (folder / p.name).write_bytes(p.read_bytes())
-    with (folder / "objects.csv").open("a") as f:
-        f.write("frame-000,x,5,5,box,no,no,\n")       # line 8: not a number
-        f.write("nowhere,1,5,5,box,no,no,\n")          # line 9: no such frame
-        f.write("frame-000,2,900,5,box,no,no,\n")      # line 10: outside the image
-        f.write("frame-000,3,5,5,Big Box,no,no,\n")    # line 11: not a class name
-        f.write("frame-000,1,5,5,box,no,no,\n")        # line 12: labelled twice
+    folder = _with_rows(frames, tmp_path / "copy", [
+        "frame-000,x,5,5,box,no,no,",       # line 8: not a number
+        "nowhere,1,5,5,box,no,no,",          # line 9: no such frame
+        "frame-000,2,900,5,box,no,no,",      # line 10: outside the image
+        "frame-000,3,5,5,Big Box,no,no,",    # line 11: not a class name
+        "frame-000,1,5,5,box,no,no,",        # line 12: labelled twice
+    ])
     objects, problems = FrameFolder(folder).objects()
     assert len(objects) == 6
     assert [p.line for p in problems] == [8, 9, 10, 11, 12]
@@ -136,12 +143,8 @@ def test_learn_fit_predict_and_explain_on_a_folder_of_frames(frames, tmp_path, c
 
 
 def test_explain_warns_of_the_examples_it_is_asked_about_only(frames, tmp_path, capsys):
-    folder = tmp_path / "copy"
-    folder.mkdir()
-    for p in frames.iterdir():
-        (folder / p.name).write_bytes(p.read_bytes())
-    with (folder / "objects.csv").open("a") as f:
-        f.write("frame-000,2,2,2,box,no,no,\n")  # a corner pixel: on no object, an example without one
+    # a corner pixel: on no object, an example without one
+    folder = _with_rows(frames, tmp_path / "copy", ["frame-000,2,2,2,box,no,no,"])
     args = ["--data", str(folder), "--modality", "depth", "--cache", str(tmp_path / "cache")]
     assert main(["learn", "fit", *args, "--out", str(tmp_path / "model"), "--time-limit", "20"]) == 0
     lost = f"{scene_atom('frame-000')}_x2"
@@ -156,14 +159,9 @@ def test_explain_warns_of_the_examples_it_is_asked_about_only(frames, tmp_path, 
 
 
 def test_fit_learns_every_class_but_the_catch_all_other_unless_named(frames, tmp_path, capsys):
-    folder = tmp_path / "copy"
-    folder.mkdir()
-    for p in frames.iterdir():
-        (folder / p.name).write_bytes(p.read_bytes())
-    rows = (frames / "objects.csv").read_text().splitlines()
-    first = rows[1].split(",")  # frame-000's object, labelled a second time as an object of no named shape
-    (folder / "objects.csv").write_text("\n".join([*rows, ",".join([first[0], "2", *first[2:4], "other", "no", "no", ""])])
-                                        + "\n")
+    first = (frames / "objects.csv").read_text().splitlines()[1].split(",")
+    # frame-000's object, labelled a second time as an object of no named shape
+    folder = _with_rows(frames, tmp_path / "copy", [",".join([first[0], "2", *first[2:4], "other", "no", "no", ""])])
     args = ["--data", str(folder), "--modality", "depth", "--cache", str(tmp_path / "cache"), "--time-limit", "20"]
     assert main(["learn", "fit", *args, "--out", str(tmp_path / "m")]) == 0
     out = capsys.readouterr().out
@@ -173,15 +171,11 @@ def test_fit_learns_every_class_but_the_catch_all_other_unless_named(frames, tmp
 
 
 def test_a_study_on_folders_keeps_each_frame_in_one_fold(frames, tmp_path, capsys):
-    import shutil
-
     from lv3d.experiment.config import load_study
     from lv3d.experiment.runner import run_study, study_inputs
 
     # one ball among them: too few to test in each of 3 folds, so the study learns box and prism and says so
-    folder = shutil.copytree(frames, tmp_path / "frames")
-    with (folder / "objects.csv").open("a") as f:
-        f.write("frame-000,2,5,5,ball,no,no,\n")
+    folder = _with_rows(frames, tmp_path / "frames", ["frame-000,2,5,5,ball,no,no,"])
     config = tmp_path / "real.yaml"
     config.write_text(f"""
 name: real_tiny
@@ -227,16 +221,10 @@ def test_a_study_on_folders_needs_two_classes_it_can_test_in_every_fold(frames, 
     with pytest.raises(InputError, match="fewer than two of box, prism are labelled in at least folds \\(4\\)"):
         load_study(config, ["folds=4"])
     # no classes named: every shape of the folder, the most labelled objects first, but the catch-all "other"
-    with (frames / "objects.csv").open() as f:
-        rows = f.read()
-    more = tmp_path / "more"
-    more.mkdir()
-    for p in frames.iterdir():
-        (more / p.name).write_bytes(p.read_bytes())
     shapes = ["other"] * 4 + ["cone"] * 4 + ["ball"] * 2
-    (more / "objects.csv").write_text(rows + "".join(f"frame-00{i % 6},{10 + i},{10 + i},2,{c},no,no,\n"
-                                                     for i, c in enumerate(shapes))
-                                      + "".join(f"frame-005,{30 + i},{30 + i},2,mug,no,no,\n" for i in range(4)))
+    more = _with_rows(frames, tmp_path / "more", [f"frame-00{i % 6},{10 + i},{10 + i},2,{c},no,no,"
+                                                  for i, c in enumerate(shapes)]
+                      + [f"frame-005,{30 + i},{30 + i},2,mug,no,no," for i in range(4)])
     # four mugs, all in one frame: a fold grouped by frame would hold them all, so no fold could test them
     study = load_study(config, ["data.classes=null", f"data.folders=[{more}]"])
     assert study.base.data.classes == ("cone", "box", "prism")
