@@ -70,11 +70,6 @@ def nearest(prof: dict[str, float], references: list[Reference]) -> tuple[Refere
     return min(((r, distance(prof, r.profile)) for r in references), key=lambda rd: (rd[1], rd[0].label, rd[0].object))
 
 
-def nearest_other(prof: dict[str, float], references: list[Reference], label: str) -> tuple[Reference, float] | None:
-    """:func:`nearest` among the references of every class but ``label``."""
-    return nearest(prof, [r for r in references if r.label != label])
-
-
 def closeness(d_class: float, d_other: float | None) -> float:
     """The confidence of naming a class by resemblance: d_o / (d_c + d_o), where ``d_class`` (d_c) is the distance
     to the nearest training object of the class and ``d_other`` (d_o) to the nearest of any other class. 0.5 where
@@ -89,17 +84,17 @@ def closeness(d_class: float, d_other: float | None) -> float:
 class Resemblance:
     """A near answer's grounds: the training object nearest the answered object (``ref``, whose class is the
     answer) at ``distance``, and the nearest training object of another class (``other``, None where no other
-    class has one) at ``other_distance``."""
+    class has one) at ``other_distance`` (None with it)."""
 
     ref: Reference
     distance: float
     other: Reference | None
-    other_distance: float
+    other_distance: float | None
 
     @property
     def confidence(self) -> float:
         """:func:`closeness` of the two distances."""
-        return closeness(self.distance, self.other_distance if self.other is not None else None)
+        return closeness(self.distance, self.other_distance)
 
 
 def resemble(prof: dict[str, float], references: list[Reference]) -> Resemblance | None:
@@ -108,8 +103,8 @@ def resemble(prof: dict[str, float], references: list[Reference]) -> Resemblance
     if found is None:
         return None
     ref, dist = found
-    other = nearest_other(prof, references, ref.label)
-    return Resemblance(ref, dist, *(other if other is not None else (None, 0.0)))
+    other = nearest(prof, [r for r in references if r.label != ref.label])
+    return Resemblance(ref, dist, *(other if other is not None else (None, None)))
 
 
 def contrast(prof: dict[str, float], ref: Reference) -> tuple[list[tuple[str, float, float]], list[tuple[str, float, float]]]:

@@ -17,6 +17,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import psutil
+
 from ..errors import InputError
 from . import engine
 from .engine import LearnError
@@ -27,9 +29,14 @@ MAX_VALIDATE_BYTES = 1 << 20
 # Memory for one task's process, in MB: the Prolog stacks get this much (--stack-limit), the whole
 # process this and 512 MB more (its address space, RLIMIT_AS).
 MEMORY_MB = 2048
-# Seconds the process may run past a goal's limits (reading the file, starting up) before it is
+# Seconds of CPU the process may use past a goal's limits (reading the file, starting up) before it is
 # stopped from outside.
 GRACE_S = 10.0
+# The stop from outside counts the process's CPU time, so that a machine busy with other work, which slows
+# the process without it doing more, does not stop a search that would have ended by itself. A process
+# that uses its CPU allowance this many times over in wall time without spending it (blocked) is stopped
+# all the same.
+WALL_FACTOR = 4.0
 
 
 @dataclass(frozen=True)
@@ -89,52 +96,26 @@ def run_task(path: str | Path, *, time_limit: float | None = None, settings: dic
     per_goal = 2 * limit + GRACE_S  # running the goal up to its learning call, then the search
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
                             start_new_session=True)
-    goals: list[GoalResult] = []
-    warnings: list[str] = []
-    current: dict | None = None
-    fatal = None
-    deadline = time.monotonic() + limit + GRACE_S
-    buf = b""
+    records = _Records()
+    allowance = _Allowance(proc, limit + GRACE_S)
     sel = selectors.DefaultSelector()
     sel.register(proc.stdout, selectors.EVENT_READ)
     stopped = False
     try:
         while True:
-            left = deadline - time.monotonic()
-            if left <= 0:
+            if sel.select(timeout=1.0):
+                chunk = os.read(proc.stdout.fileno(), 65536)
+                if not chunk:
+                    break
+                if records.read(chunk):
+                    allowance.restart(per_goal)
+            elif proc.poll() is not None:
+                break
+            if allowance.spent() and proc.poll() is None:
                 _stop(proc)
                 stopped = True
                 break
-            if not sel.select(timeout=min(left, 1.0)):
-                if proc.poll() is not None:
-                    rest = proc.stdout.read()
-                    buf += rest or b""
-                    break
-                continue
-            chunk = os.read(proc.stdout.fileno(), 65536)
-            if not chunk:
-                break
-            buf += chunk
-            while b"\n" in buf:
-                raw, buf = buf.split(b"\n", 1)
-                rec = raw.decode("utf-8", "replace").split("\t")
-                tag = rec[0]
-                if tag == "warning":
-                    warnings.append(rec[1] if len(rec) > 1 else "")
-                elif tag == "goal":
-                    current = {"name": rec[1], "clauses": [], "none": False, "error": None, "kind": None}
-                    deadline = time.monotonic() + per_goal
-                elif tag == "clause" and current is not None:
-                    current["clauses"].append(rec[1])
-                elif tag == "none" and current is not None:
-                    current["none"] = True
-                elif tag == "failed" and current is not None:
-                    current["kind"], current["error"] = rec[1], rec[2]
-                elif tag == "time" and current is not None:
-                    goals.append(_result(current, float(rec[1]), float(rec[2])))
-                    current = None
-                elif tag == "fatal":
-                    fatal = rec[1:]
+        records.read(proc.stdout.read() or b"")  # what it wrote before it ended or was stopped
     finally:
         sel.close()
         err = b""
@@ -142,6 +123,7 @@ def run_task(path: str | Path, *, time_limit: float | None = None, settings: dic
             _, err = proc.communicate(timeout=5)
         except subprocess.TimeoutExpired:
             _stop(proc)
+    goals, warnings, current, fatal = records.goals, records.warnings, records.current, records.fatal
     if fatal:
         kind, where, msg = (fatal + ["", "", ""])[:3]
         if kind == "input":
@@ -150,10 +132,75 @@ def run_task(path: str | Path, *, time_limit: float | None = None, settings: dic
     if current is not None:  # the process ended, or was stopped, inside a goal
         why = _ended(proc, stopped, limit, err)
         goals.append(GoalResult(current["name"], None, why[1], why[0]))
-    elif stopped or (proc.returncode not in (0, None) and not goals):
+    elif not goals and (stopped or proc.returncode not in (0, None)):
         kind, msg = _ended(proc, stopped, limit, err)
         raise LearnError(f"{path}: {msg}")
+    elif stopped:  # between two goals: those not begun have no result
+        warnings.append(f"the learner was stopped after {len(goals)} goals: "
+                        + _ended(proc, stopped, limit, err)[1])
     return TaskRun(path, tuple(goals), tuple(warnings))
+
+
+class _Records:
+    """The records mil_main.pl writes, read as they come: the goals learned, the warnings, the goal under
+    way (None between goals) and a fatal error."""
+
+    def __init__(self) -> None:
+        self.goals: list[GoalResult] = []
+        self.warnings: list[str] = []
+        self.current: dict | None = None
+        self.fatal: list[str] | None = None
+        self._buf = b""
+
+    def read(self, chunk: bytes) -> bool:
+        """Take in the output's next bytes; True when a goal started in them."""
+        *lines, self._buf = (self._buf + chunk).split(b"\n")
+        started = False
+        for raw in lines:
+            rec = raw.decode("utf-8", "replace").split("\t")
+            tag = rec[0]
+            if tag == "warning":
+                self.warnings.append(rec[1] if len(rec) > 1 else "")
+            elif tag == "goal":
+                self.current = {"name": rec[1], "clauses": [], "none": False, "error": None, "kind": None}
+                started = True
+            elif tag == "clause" and self.current is not None:
+                self.current["clauses"].append(rec[1])
+            elif tag == "none" and self.current is not None:
+                self.current["none"] = True
+            elif tag == "failed" and self.current is not None:
+                self.current["kind"], self.current["error"] = rec[1], rec[2]
+            elif tag == "time" and self.current is not None:
+                self.goals.append(_result(self.current, float(rec[1]), float(rec[2])))
+                self.current = None
+            elif tag == "fatal":
+                self.fatal = rec[1:]
+        return started
+
+
+class _Allowance:
+    """The CPU seconds a process may use from now on (and WALL_FACTOR times as many of wall time)."""
+
+    def __init__(self, proc: subprocess.Popen, seconds: float) -> None:
+        try:
+            self._process = psutil.Process(proc.pid)
+        except psutil.Error:  # ended already
+            self._process = None
+        self.restart(seconds)
+
+    def _cpu(self) -> float:
+        try:
+            t = self._process.cpu_times()
+            return t.user + t.system
+        except (psutil.Error, AttributeError):
+            return 0.0
+
+    def restart(self, seconds: float) -> None:
+        self._seconds, self._cpu0, self._wall0 = seconds, self._cpu(), time.monotonic()
+
+    def spent(self) -> bool:
+        return (self._cpu() - self._cpu0 > self._seconds
+                or time.monotonic() - self._wall0 > WALL_FACTOR * self._seconds)
 
 
 def _result(cur: dict, cpu: float, wall: float) -> GoalResult:

@@ -7,7 +7,7 @@ import pytest
 
 from lv3d.facts import Fact, SceneFacts
 from lv3d.learn import Model
-from lv3d.learn.resemblance import (FACES, Reference, closeness, contrast, distance, nearest, nearest_other,
+from lv3d.learn.resemblance import (FACES, Reference, closeness, contrast, distance, nearest,
                                     profile, resemble)
 
 
@@ -79,9 +79,8 @@ def test_closeness_is_the_share_of_the_two_nearest_distances_held_by_the_other_c
     assert closeness(1.6, 0.2) == pytest.approx(0.2 / 1.8)
     assert closeness(0.0, 0.0) == 0.5  # both at 0: a tie
     alone = resemble(prof, refs[:2])  # no other class to mistake it for
-    assert alone.other is None and alone.confidence == 1.0 == closeness(0.2, None)
+    assert alone.other is None and alone.other_distance is None and alone.confidence == 1.0 == closeness(0.2, None)
     assert resemble(prof, []) is None
-    assert nearest_other(prof, refs, "tetra")[0].object == "y" and nearest_other(prof, refs[:2], "tetra") is None
 
 
 def _model() -> Model:

@@ -93,12 +93,48 @@ def test_a_learner_that_ignores_its_time_limit_is_stopped_from_outside(tmp_path,
     fake.chmod(fake.stat().st_mode | stat.S_IXUSR)
     monkeypatch.setenv("LV3D_SWIPL", str(fake))
     monkeypatch.setattr(tasks, "GRACE_S", 1.0)
+    monkeypatch.setattr(tasks, "WALL_FACTOR", 1.0)  # it sleeps: blocked, it is stopped by the wall clock
     f = tmp_path / "t.pl"
     f.write_text(HEAD + "p(a).\n" + GOAL)
     t0 = time.monotonic()
     run = run_task(f, time_limit=0.5)
     assert time.monotonic() - t0 < 10
     assert run.goals[0].kind == "time_limit" and "was stopped" in run.goals[0].error
+
+
+def _fake_swipl(tmp_path, monkeypatch, script):
+    fake = tmp_path / "swipl"
+    fake.write_text("#!/bin/sh\ntrap '' INT TERM ALRM\n" + script)
+    fake.chmod(fake.stat().st_mode | stat.S_IXUSR)
+    monkeypatch.setenv("LV3D_SWIPL", str(fake))
+    monkeypatch.setattr(tasks, "GRACE_S", 1.0)
+    f = tmp_path / "t.pl"
+    f.write_text(HEAD + "p(a).\n" + GOAL)
+    return f
+
+
+def test_a_learner_that_spins_past_its_time_limit_is_stopped_by_its_cpu_time(tmp_path, monkeypatch):
+    f = _fake_swipl(tmp_path, monkeypatch, "printf 'goal\\ta\\n'\nwhile :; do :; done\n")
+    t0 = time.monotonic()
+    run = run_task(f, time_limit=0.5)
+    assert time.monotonic() - t0 < 8  # two CPU seconds allowed; the wall clock's stop would come at 8
+    assert run.goals[0].kind == "time_limit" and "was stopped" in run.goals[0].error
+
+
+def test_a_learner_slowed_by_a_busy_machine_is_not_stopped_within_its_cpu_allowance(tmp_path, monkeypatch):
+    # sleeping stands for a process that gets no CPU: 3 s of wall time past the 1.5 s of CPU it may use first
+    f = _fake_swipl(tmp_path, monkeypatch, "sleep 3\nprintf 'goal\\ta\\nnone\\ntime\\t0.1\\t3.0\\n'\n")
+    run = run_task(f, time_limit=0.5)
+    assert run.goals == (tasks.GoalResult("a", None, None, None, 0.1, 3.0),) and not run.warnings
+
+
+def test_a_learner_that_hangs_after_its_goals_keeps_their_results(tmp_path, monkeypatch):
+    monkeypatch.setattr(tasks, "WALL_FACTOR", 1.0)
+    f = _fake_swipl(tmp_path, monkeypatch, "printf 'goal\\ta\\nclause\\tt(A):-p(A).\\ntime\\t0.1\\t0.1\\n'\n"
+                                           "while :; do sleep 1; done\n")
+    run = run_task(f, time_limit=0.5)
+    assert run.goals[0].clauses == ("t(A):-p(A).",)
+    assert len(run.warnings) == 1 and "stopped after 1 goals" in run.warnings[0]
 
 
 def test_a_deep_program_file_is_refused_without_crashing(tmp_path):
