@@ -142,6 +142,24 @@ def test_learn_fit_predict_and_explain_on_a_folder_of_frames(frames, tmp_path, c
     assert "no ground-truth facts" in capsys.readouterr().err
 
 
+def test_a_script_reads_the_examples_of_a_folder_learns_and_explains(frames, tmp_path):
+    # what lv3d/examples.py's docstring shows a script doing, on a folder with a row on no object and a bad row
+    from lv3d.examples import read_examples
+    from lv3d.learn import Model
+
+    folder = _with_rows(frames, tmp_path / "copy", ["frame-000,2,2,2,box,no,no,", "frame-000,x,5,5,box,no,no,"])
+    ex = read_examples(folder, "depth", cache=tmp_path / "cache")
+    lost = f"{scene_atom('frame-000')}_x2"
+    assert ex.labels == ["box", "box", "prism", "box", "prism", "box", "prism"] and ex.without_object == 1
+    assert [w.example for w in ex.warnings] == [None, lost] and "line 9" in str(ex.warnings[0])
+    train = ex.learnable()
+    assert len(train.scenes) == 6 and lost not in {s.scene for s in train.scenes}
+    model = Model.fit(train.scenes, train.labels, classes=["box"], seed=0)
+    scene = train.scenes[0]
+    assert model.predict(scene)[0] == "box" and "box" in str(model.explain(scene))
+    assert read_examples(folder, "depth", cache=tmp_path / "cache").labels == ex.labels  # from the cache
+
+
 def test_explain_warns_of_the_examples_it_is_asked_about_only(frames, tmp_path, capsys):
     # a corner pixel: on no object, an example without one
     folder = _with_rows(frames, tmp_path / "copy", ["frame-000,2,2,2,box,no,no,"])

@@ -77,10 +77,11 @@ def test_learn_fit_replaces_its_own_output(tmp_path, capsys, monkeypatch):
             (out_dir / f"run{self.n}.pl").write_text("% program\n")
 
     runs = iter([1, 2])
+    from lv3d.examples import Examples
     from lv3d.facts import SceneFacts
 
     one = SceneFacts("s0", "rgbd", [], "s0_o1")
-    monkeypatch.setattr(learn_cli, "_dataset_scenes", lambda *a: ([one], ["cube"]))
+    monkeypatch.setattr(learn_cli, "_examples", lambda *a: Examples([one], ["cube"]))
     monkeypatch.setattr(Model, "fit", classmethod(lambda cls, *a, **k: Fitted(next(runs))))
     data = tmp_path / "data"
     data.mkdir()

@@ -11,7 +11,7 @@ from pathlib import Path
 import click
 
 from .. import compile_cache
-from ..errors import InputError, read_json
+from ..errors import InputError
 from ..facts import MODALITIES
 
 
@@ -81,88 +81,17 @@ def learn():
     """Learn shape concepts from a data set and classify with them."""
 
 
-def _dataset_scenes(data: Path, modality: str, facts: str | None, cache: Path | None = None,
-                    warn: set[str] | None = None):
-    """(scenes, labels) of a data set directory, facts from the ground truth or through the pipeline; or of
-    a folder of real frames (objects.csv), every labelled object one example, facts through the pipeline,
-    cached. Examples whose pixel lies on no perceived object keep no target: one warning line each (of the
-    examples in ``warn`` only, where given)."""
-    from ..frame_folder import is_frame_folder
+def _examples(data: Path, modality: str, facts: str | None, cache: Path | None = None,
+              warn: set[str] | None = None):
+    """The examples of a data set or a folder of labelled real frames (lv3d.examples.read_examples), each
+    warning of reading them one line (an example's only where ``warn`` holds its id, where given)."""
+    from ..examples import read_examples
 
-    if is_frame_folder(data):
-        if facts == "truth":
-            raise InputError("--facts", f"{data} holds real frames: they have no ground-truth facts (use pipeline)")
-        return _frame_folder_scenes(data, modality, cache, warn)
-    if facts is None:
-        facts = "pipeline"
-    manifest = data / "manifest.json"
-    if not manifest.is_file():
-        raise InputError(data, "not a data set (no manifest.json) nor a folder of labelled frames (no objects.csv)")
-    try:
-        items = json.loads(manifest.read_text())["items"]
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError) as e:
-        raise InputError(manifest, f"malformed: {e}") from None
-    if not isinstance(items, list):
-        raise InputError(manifest, "items: must be a list of {id, class, dir}")
-    for i, it in enumerate(items):
-        if not (isinstance(it, dict) and all(isinstance(it.get(k), str) and it.get(k) for k in ("id", "class", "dir"))):
-            raise InputError(manifest, f"items[{i}]: must be {{id, class, dir}} (texts), got {it!r}")
-    scenes, labels = [], []
-    for it in items:
-        item_dir = data / it["dir"]
-        if facts == "truth":
-            from ..truth_facts import truth_facts
-
-            meta_path = item_dir / "meta.json"
-            meta = read_json(meta_path, "meta.json")
-            scenes.append(truth_facts(meta, it["id"], modality))
-        else:
-            from ..pipeline import scene_facts
-            from ..rgbd import load_item
-
-            try:
-                scenes.append(scene_facts(load_item(item_dir), it["id"], modality))
-            except InputError as e:  # no object found: the image is left out of learning and counted
-                from ..facts import SceneFacts
-
-                click.echo(f"lv3d: warning: {item_dir}: {e.problem} (no example)", err=True)
-                scenes.append(SceneFacts(it["id"], modality, [], None))
-        labels.append(it["class"])
-    if not scenes:
-        raise InputError(data, "the data set lists no items")
-    return scenes, labels
-
-
-def _cache_dir(cache: Path | None) -> Path:
-    """Where facts of real frames are cached: --cache, else $XDG_CACHE_HOME/lv3d (~/.cache/lv3d)."""
-    import os
-
-    if cache is not None:
-        return Path(cache).expanduser()
-    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "lv3d"
-
-
-def _frame_folder_scenes(data: Path, modality: str, cache: Path | None, warn: set[str] | None = None):
-    from ..experiment.code_version import facts_version
-    from ..experiment.real_data import ensure_frame_facts, example_facts_of, real_data
-    from ..frame_folder import FrameFolder
-
-    objects, problems = FrameFolder(data).objects()
-    rd = real_data([str(data)], sorted({o.shape for o in objects}))
-    for p in problems:
-        click.echo(f"lv3d: warning: {p} (left out)", err=True)
-    frames = ensure_frame_facts(rd, _cache_dir(cache) / "facts", facts_version(), modality, True)
-    facts, errors = example_facts_of(rd, frames)
-    for i in sorted(errors):
-        if warn is None or i in warn:
-            click.echo(f"lv3d: warning: {errors[i]} (example {i} has no object)", err=True)
-    return [facts[it.id] for it in rd.items], [it.cls for it in rd.items]
-
-
-def _learnable(scenes, labels):
-    """The examples with a target object (perception found one), and how many were left out."""
-    keep = [(s, y) for s, y in zip(scenes, labels) if s.target is not None]
-    return [s for s, _ in keep], [y for _, y in keep], len(scenes) - len(keep)
+    ex = read_examples(data, modality, facts=facts or "pipeline", cache=cache)
+    for w in ex.warnings:
+        if warn is None or w.example is None or w.example in warn:
+            click.echo(f"lv3d: warning: {w}", err=True)
+    return ex
 
 
 _data = click.option("--data", type=click.Path(path_type=Path), required=True,
@@ -198,11 +127,13 @@ def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classe
     wanted = [c.strip() for c in classes.split(",") if c.strip()] if classes is not None else None
     if wanted is not None and not wanted:
         raise InputError("--classes", "no class given")
-    scenes, labels = _dataset_scenes(data, modality, facts, cache)
+    ex = _examples(data, modality, facts, cache)
     for c in wanted or ():
-        if c not in labels:
-            raise InputError("--classes", f"no example of {data} is a {c!r}; its classes: {', '.join(sorted(set(labels)))}")
-    scenes, labels, left_out = _learnable(scenes, labels)
+        if c not in ex.labels:
+            raise InputError("--classes", f"no example of {data} is a {c!r}; its classes: {', '.join(sorted(set(ex.labels)))}")
+    left_out = ex.without_object
+    learnable = ex.learnable()
+    scenes, labels = learnable.scenes, learnable.labels
     if left_out:
         click.echo(f"% {left_out} example(s) left out: perception found no object there", err=True)
     if not scenes:
@@ -235,7 +166,7 @@ def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classe
 
 def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path,
                       warn: set[str] | None = None):
-    """The model of ``model_dir`` and the scenes of ``data`` (:func:`_dataset_scenes`, its ``warn``)."""
+    """The model of ``model_dir`` and the scenes of ``data`` (:func:`_examples`, its ``warn``)."""
     from ..learn.model import Model
 
     model = Model.load(model_dir)
@@ -245,7 +176,8 @@ def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path 
     if learned and learned != [modality]:
         raise InputError("--modality", f"the model in {model_dir} was learned from {', '.join(learned)} facts; "
                                        f"predict with --modality {learned[0]}")
-    scenes, labels = _dataset_scenes(data, modality, facts, cache, warn)
+    ex = _examples(data, modality, facts, cache, warn)
+    scenes, labels = ex.scenes, ex.labels
     return model, scenes, labels
 
 
