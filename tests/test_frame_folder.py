@@ -263,3 +263,43 @@ def test_the_demo_learns_from_labelled_frames_and_explains_a_real_object(tmp_pat
     assert (tmp_path / "out" / "overlays").is_dir() and got["overlay"].endswith(".png")
     assert "learning box, cylinder (lv3d-rgbd)" in out and "perception found" in out
     assert "Why lv3d-rgbd says the real object" in out
+
+
+def test_a_study_split_by_folder_learns_from_one_folder_and_tests_on_the_other(frames, tmp_path):
+    from lv3d.errors import InputError
+    from lv3d.experiment.config import load_study
+    from lv3d.experiment.runner import run_study
+
+    other = _write_folder(tmp_path / "other", [(f"g{i}", cls, 41 + i) for i, cls in enumerate(["cube", "triangular_prism"] * 2)])
+    # a ball in one folder only: no fold could both learn and test it
+    other = _with_rows(other, tmp_path / "sensor2", ["g0,2,5,5,ball,no,no,"])
+    config = tmp_path / "across.yaml"
+    config.write_text(f"""
+name: across
+data: {{folders: [{frames}, {other}], split: folders, classes: null, cache: {tmp_path / 'cache'}}}
+train: {{positives: 2, negatives_per_positive: 1, multiclass: true}}
+systems: [lv3d-depth, tree-rgbd]
+lv3d: {{settings: {{time_limit: 10}}}}
+baselines: {{image_size: 16, tree_cells: 4}}
+""")
+    study = load_study(config)
+    assert study.base.folds == 2 and study.base.data.classes == ("box", "prism")
+    assert study.base.left_out_classes == (("ball", 1),)
+    out = tmp_path / "run"
+    assert run_study(config, out, progress=False)["ran"] == 4
+    tests = [json.loads((out / "folds" / "base" / "lv3d-depth" / f"fold{k}.json").read_text())["test_ids"]
+             for k in range(2)]
+    assert sorted(tests[0]) == sorted(f"{scene_atom(f'frame-{i:03d}')}_x1" for i in range(6))
+    assert sorted(tests[1]) == sorted(f"{scene_atom(f'g{i}')}_x1" for i in range(4))
+    report = (out / "results.md").read_text()
+    assert "Each folder a test fold" in report and "| system | frames | sensor2 |" in report
+    assert "objects of ball, a class not labelled in every folder: 1." in report
+    # the same folders split by frame are another study: its fold results are not these
+    from lv3d.experiment.runner import result_key
+
+    assert result_key(study.base, "lv3d-depth", 0) != result_key(load_study(config, ["data.split=frames", "folds=2"]).base,
+                                                                 "lv3d-depth", 0)
+    with pytest.raises(InputError, match="data.split: folders .* needs data.folders of two folders or more, got 1"):
+        load_study(config, [f"data.folders=[{frames}]"])
+    with pytest.raises(InputError, match="data.split: folders .* got 0"):
+        load_study(config, ["data.folders=null", "data.classes=[cube, triangular_prism]"])

@@ -178,6 +178,10 @@ def check_value(value, meta: dict, key: str, where: str):
 
 # ---- the sections ---------------------------------------------------------------------------------------
 
+# how a study on folders of real frames makes its folds (DataConfig.split)
+SPLITS = ("frames", "folders")
+
+
 @dataclass(frozen=True)
 class DataConfig:
     """The examples of the study: images rendered once, cached by (classes, per_class, noise, seed); or, with
@@ -190,6 +194,9 @@ class DataConfig:
     folders: tuple | None = _spec(None, "paths", optional=True,
                                   doc="folders of labelled real frames (relative to the working directory); "
                                       "None: a rendered data set")
+    split: str = _spec("frames", "name", names=SPLITS,
+                       doc="with folders: the folds grouped by frame (frames: `folds` of them, no frame in two) or one "
+                           "per folder (folders: learn from the other folders, test on it: another sensor or room)")
     per_class: int = _int(50, 1, MAX_DATASET_IMAGES // 2, doc="images per class (rendered only)")
     noise: str = _spec("realsense", "name", names=_presets, doc="a preset of lv3d.render.noise")
     noise_overrides: dict = _spec({}, "mapping", doc="knob -> value, on top of the preset")
@@ -370,9 +377,11 @@ def _section(cls, raw: dict, key: str, where: str):
 OTHER_SHAPE = "other"
 
 
-def learnable_classes(folders, classes, folds: int, where: str) -> tuple[tuple[str, ...], dict[str, int]]:
-    """The classes of ``classes`` a study on ``folders`` can learn and test: those labelled in at least ``folds``
-    frames (the folds are grouped by frame, and each test fold holds a frame of each class), in their order; and the
+def learnable_classes(folders, classes, folds: int, where: str, split: str = "frames"
+                      ) -> tuple[tuple[str, ...], dict[str, int]]:
+    """The classes of ``classes`` a study on ``folders`` can learn and test: with ``split`` frames, those labelled
+    in at least ``folds`` frames (the folds are grouped by frame, and each test fold holds a frame of each class);
+    with ``split`` folders, those labelled in every folder (each folder is a test fold); in their order. And the
     others, each with its number of labelled objects, which the study leaves out (and says so). ``classes`` None:
     every shape the folders' objects.csv name but ``OTHER_SHAPE``, the most labelled objects first (ties by name).
     InputError naming ``where`` when a folder cannot be read, or fewer than two classes remain (a class task's
@@ -389,12 +398,19 @@ def learnable_classes(folders, classes, folds: int, where: str) -> tuple[tuple[s
             frames.setdefault(o.shape, set()).add((k, o.frame))
     if classes is None:
         classes = tuple(sorted((c for c in objects if c != OTHER_SHAPE), key=lambda c: (-objects[c], c)))
-    kept = tuple(c for c in classes if len(frames.get(c, ())) >= folds)
+    if split == "folders":
+        kept = tuple(c for c in classes if len({k for k, _ in frames.get(c, ())}) == len(folders))
+        rule = "in every folder of data.folders (data.split folders: each folder is a test fold)"
+    else:
+        kept = tuple(c for c in classes if len(frames.get(c, ())) >= folds)
+        rule = (f"in at least folds ({folds}) frames of data.folders (the folds are grouped by frame, and each tests "
+                f"a frame of every class)")
     if len(kept) < 2:
-        have = ", ".join(f"{c} {objects[c]} in {len(frames[c])} frame(s)" for c in sorted(objects)) or "none"
+        where_from = (lambda c: f"{len({k for k, _ in frames[c]})} folder(s)") if split == "folders" else \
+            (lambda c: f"{len(frames[c])} frame(s)")
+        have = ", ".join(f"{c} {objects[c]} in {where_from(c)}" for c in sorted(objects)) or "none"
         raise InputError(where, f"data.classes: fewer than two of {', '.join(classes) or 'its classes'} are labelled "
-                                f"in at least folds ({folds}) frames of data.folders (the folds are grouped by frame, "
-                                f"and each tests a frame of every class); the folders hold: {have}")
+                                f"{rule}; the folders hold: {have}")
     return kept, {c: objects[c] for c in classes if c not in kept}
 
 
@@ -408,8 +424,13 @@ def from_dict(cfg: dict, where: str) -> StudyConfig:
             top[f.name] = check_value(cfg[f.name], f.metadata, f.name, where)
     study = StudyConfig(**top)
     d, b = study.data, study.baselines
+    if d.split == "folders":
+        if d.folders is None or len(d.folders) < 2:
+            raise InputError(where, "data.split: folders (one fold per folder) needs data.folders of two folders or "
+                                    f"more, got {len(d.folders or ())}")
+        study = replace(study, folds=len(d.folders))  # one fold per folder, whatever folds says
     if d.folders is not None:
-        kept, too_few = learnable_classes(d.folders, d.classes, study.folds, where)
+        kept, too_few = learnable_classes(d.folders, d.classes, study.folds, where, d.split)
         study = replace(study, data=replace(d, classes=kept), left_out_classes=tuple(too_few.items()))
         d = study.data
     elif d.classes is None:

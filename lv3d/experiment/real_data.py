@@ -90,6 +90,12 @@ def real_data(folders, classes) -> RealData:
     return RealData(opened, items, frames, labels, example_of, problems, other)
 
 
+def folder_folds(items: list[Item], rd: RealData) -> list[list[Item]]:
+    """One fold per folder of ``rd``, in its order: the items of the folder's frames (data.split folders)."""
+    folder_of = {atom: folder.path for atom, (folder, _) in rd.frames.items()}
+    return [sorted((it for it in items if folder_of[it.dir] == f.path), key=lambda it: it.id) for f in rd.folders]
+
+
 def _frame_job(job: tuple, shared=None) -> dict:
     """The cache record of one frame for one modality (runs in a worker)."""
     from ..object_facts import FrameFacts, frame_facts

@@ -88,6 +88,13 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
         # fold is mostly negatives, where answering "no" scores high; a fold without a positive has none
         m, sd = mean_std([_mean_balanced(r["tasks"], classes) for r in recs])
         per["balanced"] = {"mean": m, "std": sd}
+        if cfg.data.split == "folders":  # each fold a folder: what was learned elsewhere holds there?
+            names = [Path(f).name for f in cfg.data.folders]
+            names = names if len(set(names)) == len(names) else [str(f) for f in cfg.data.folders]
+            per["by_folder"] = {names[r["fold"]]: {
+                "mean": sum(r["tasks"][c]["accuracy"] for c in classes) / len(classes),
+                "balanced": _mean_balanced(r["tasks"], classes),
+                "multiclass": r["tasks"].get("multiclass", {}).get("accuracy", math.nan)} for r in recs}
         per["seconds"] = sum(r["seconds"] for r in recs)
         per["code"] = sorted({r["code"] for r in recs if r.get("code")})
         calibration = answer_calibration(recs)
@@ -102,6 +109,7 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
         left = next((r["left_out"] for r in recs if r.get("left_out") is not None), None)
         if left is not None:
             summary["left_out"] = {**left, "classes": dict(cfg.left_out_classes)}
+            summary["split"] = cfg.data.split
             summary["examples"] = sum(len(r["test_ids"]) for r in recs)
         # settings a tuned baseline chose per fold (baselines.tune), with their inner cross-validation accuracy
         tuned = [{"fold": r["fold"], **r["tuned"]["setting"], "inner_accuracy": r["tuned"]["inner_accuracy"]}
@@ -283,6 +291,16 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing:
             cols = [_pct(per["classes"][c]) for c in classes]
             lines.append(f"| {s} | " + " | ".join(cols) + f" | {_pct(per['mean'])} | {_pct(per['balanced'])} | "
                          f"{_pct(per['classes']['multiclass'])} | {per['folds_done']} | {per['errors']} |")
+        by_folder = {s: per["by_folder"] for s, per in summ["systems"].items() if per.get("by_folder")}
+        if by_folder:
+            lines += ["", "Each folder a test fold, learned from the others' objects (data.split folders): mean class "
+                      "task, balanced, multi-class (%):", "",
+                      "| system | " + " | ".join(next(iter(by_folder.values()))) + " |",
+                      "|---" * (1 + len(next(iter(by_folder.values())))) + "|"]
+            for s, folders in by_folder.items():
+                lines.append(f"| {s} | " + " | ".join(
+                    " / ".join("–" if math.isnan(v) else f"{100 * v:.1f}" for v in f.values())
+                    for f in folders.values()) + " |")
         if summ.get("short"):
             lines += ["", _short_text(summ["short"])]
         if summ["tests"]:
@@ -349,8 +367,8 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing:
         if left is not None:
             few = left.get("classes", {})
             other = ", ".join(f"{k} {v}" for k, v in sorted(left["other_classes"].items()) if k not in few) or "none"
-            too_few = "".join(f", objects of {k}, a class labelled in fewer frames than folds: {v}"
-                              for k, v in sorted(few.items()))
+            why = "not labelled in every folder" if summ.get("split") == "folders" else "labelled in fewer frames than folds"
+            too_few = "".join(f", objects of {k}, a class {why}: {v}" for k, v in sorted(few.items()))
             lines += ["", f"Examples: {summ['examples']} labelled objects of the study's classes; left out: "
                       f"{len(left['unusable_rows'])} unusable rows of objects.csv, objects of other classes: {other}"
                       f"{too_few}. "

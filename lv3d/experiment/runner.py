@@ -83,6 +83,8 @@ def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
     if d["data"].get("folders"):  # labelled real frames: the folders' content, not a rendering recipe
         relevant["data"] = {"real": _real_key(tuple(d["data"]["folders"]), tuple(d["data"]["classes"])),
                             "seed": d["seed"]}
+        if d["data"].get("split", "frames") != "frames":  # the default leaves the key as results made before it
+            relevant["data"]["split"] = d["data"]["split"]
         if system not in LOGIC_SYSTEMS:
             # the baselines' crops lie around the objects rgbd perception found: they change with it
             from .code_version import facts_version
@@ -346,7 +348,12 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
         if not pending:
             continue
         items, inputs = study_inputs(ccfg, out, remote, progress, warned)
-        folds = (grouped_folds if ccfg.data.folders else stratified_folds)(items, ccfg.folds, ccfg.seed)
+        if ccfg.data.split == "folders":
+            from .real_data import folder_folds
+
+            folds = folder_folds(items, inputs.rd)
+        else:
+            folds = (grouped_folds if ccfg.data.folders else stratified_folds)(items, ccfg.folds, ccfg.seed)
         by_system: dict[str, list[int]] = {}
         for sname, k in pending:
             by_system.setdefault(sname, []).append(k)
@@ -394,8 +401,10 @@ def _real_examples(ccfg: StudyConfig, progress: bool, warned: set):
     from .real_data import real_data
 
     rd = real_data(ccfg.data.folders, ccfg.data.classes)
-    lines = [f"data.classes: {c!r} is labelled in fewer frames of data.folders than folds ({ccfg.folds}): its {n} "
-             f"object{'' if n == 1 else 's'}" for c, n in ccfg.left_out_classes] + [str(p) for p in rd.problems]
+    rule = "in some folders of data.folders only" if ccfg.data.split == "folders" else \
+        f"in fewer frames of data.folders than folds ({ccfg.folds})"
+    lines = [f"data.classes: {c!r} is labelled {rule}: its {n} object{'' if n == 1 else 's'}"
+             for c, n in ccfg.left_out_classes] + [str(p) for p in rd.problems]
     for line in lines:
         if progress and line not in warned:
             print(f"lv3d: warning: {line} (left out)", file=sys.stderr)
