@@ -48,6 +48,7 @@ SECTIONS = {
     "### Real objects": ("real_objects", "positives"),
     "### Real objects, Kinect table-tops alone": ("real_objects_osd", "positives"),
     "### Real objects, RealSense clutter alone": ("real_objects_ycb", "positives"),
+    "### Real objects across sensors": ("real_across_sensors", "positives"),
     "### Ten classes": ("ten_classes", "noise"),
     "### Ten classes: learning curve": ("ten_classes_curve", "positives"),
 }
