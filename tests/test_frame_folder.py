@@ -123,6 +123,8 @@ def test_learn_fit_predict_and_explain_on_a_folder_of_frames(frames, tmp_path, c
     rows = [line.split("\t") for line in out.splitlines() if "\t" in line]
     assert len(rows) == 6 and out.splitlines()[-1].startswith("accuracy ")
     assert out.splitlines()[-2].startswith("per class: box ")
+    per = {c: tuple(map(int, k.split("/"))) for c, k in (p.split() for p in out.splitlines()[-2][len("per class: "):].split(", "))}
+    assert f"balanced {sum(r / n for r, n in per.values()) / len(per):.3f}" in out.splitlines()[-1]
     # a model of some of the folder's classes: the others' examples are answered, and left out of its accuracy
     assert main(["learn", "fit", *args, "--classes", "box", "--out", str(tmp_path / "box_only")]) == 0
     capsys.readouterr()

@@ -190,7 +190,7 @@ def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path 
 @click.option("--explain/--no-explain", default=False, help="print each answer's proof")
 def predict(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path, explain: bool):
     """Classify every example of a data set or folder with saved programs; print accuracy, over the examples of
-    the classes the model holds a program for, and each class's. An example where perception found no object
+    the classes the model holds a program for, each class's, and their mean (balanced accuracy). An example where perception found no object
     is answered "unknown" (and counts as wrong); examples of other classes are answered but left out of the
     accuracy (the model cannot name them), and counted."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
@@ -218,7 +218,10 @@ def predict(data: Path, modality: str, facts: str | None, cache: Path | None, mo
                    ", ".join(f"{y} {k}" for y, k in others.items()) + f" (its classes: {', '.join(sorted(held))})")
     click.echo("per class: " + ", ".join(f"{y} {right[y]}/{seen[y]}" for y in sorted(held) if seen[y]))
     correct = sum(right[y] for y in held)
-    click.echo(f"accuracy {correct}/{n} = {correct / n:.3f}" if n else
+    tested = [y for y in held if seen[y]]
+    balanced = sum(right[y] / seen[y] for y in tested) / len(tested) if tested else 0.0
+    click.echo(f"accuracy {correct}/{n} = {correct / n:.3f}, balanced {balanced:.3f} (the mean of each class's share "
+               f"right)" if n else
                "accuracy: none of the examples is of a class the model holds a program for")
 
 
