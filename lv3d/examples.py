@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import InputError, read_json
-from .facts import SceneFacts
+from .facts import MODALITIES, SceneFacts
 from .frame_folder import FrameFolder, is_frame_folder
 
 SOURCES = ("pipeline", "truth")
@@ -76,6 +76,8 @@ def read_examples(data: str | Path, modality: str, *, facts: str = "pipeline", c
     caching real frames' facts (default :func:`default_cache`). InputError for data that is neither, or
     malformed."""
     data = Path(data)
+    if modality not in MODALITIES:
+        raise InputError("--modality", f"must be one of {', '.join(MODALITIES)}, got {modality!r}")
     if facts not in SOURCES:
         raise InputError("--facts", f"must be one of {', '.join(SOURCES)}, got {facts!r}")
     if is_frame_folder(data):

@@ -160,6 +160,14 @@ def test_a_script_reads_the_examples_of_a_folder_learns_and_explains(frames, tmp
     scene = train.scenes[0]
     assert model.predict(scene)[0] == "box" and "box" in str(model.explain(scene))
     assert read_examples(folder, "depth", cache=tmp_path / "cache").labels == ex.labels  # from the cache
+    from lv3d.errors import InputError
+
+    with pytest.raises(InputError, match="--modality: must be one of rgb, depth, rgbd, got 'rgb-d'"):
+        read_examples(folder, "rgb-d")
+    with pytest.raises(InputError, match="no ground-truth facts"):
+        read_examples(folder, "depth", facts="truth")
+    with pytest.raises(InputError, match="not a data set"):
+        read_examples(tmp_path, "depth")
 
 
 def test_explain_warns_of_the_examples_it_is_asked_about_only(frames, tmp_path, capsys):
