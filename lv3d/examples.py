@@ -1,4 +1,4 @@
-"""The examples lv3d learns from: the facts of each example of a rendered data set or of a folder of labelled
+"""The examples lv3d learns from: the facts of each example of a rendered data set or of folders of labelled
 real frames, with its class. ``lv3d learn`` reads its data through :func:`read_examples`; a script does the same:
 
     from lv3d.examples import read_examples
@@ -68,32 +68,39 @@ def default_cache() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "lv3d"
 
 
-def read_examples(data: str | Path, modality: str, *, facts: str = "pipeline", cache: str | Path | None = None
-                  ) -> Examples:
+def read_examples(data, modality: str, *, facts: str = "pipeline", cache: str | Path | None = None) -> Examples:
     """The examples of ``data`` as a system that sees ``modality`` (rgb, depth, rgbd) gets them: a folder of
-    labelled real frames (objects.csv) or a rendered data set (manifest.json). ``facts``: from perception and
-    grounding ("pipeline") or, on a rendered data set, from its ground truth ("truth"). ``cache``: the folder
-    caching real frames' facts (default :func:`default_cache`). InputError for data that is neither, or
-    malformed."""
-    data = Path(data)
+    labelled real frames (objects.csv), a list of such folders (their examples together, in their order; a frame
+    name two folders share is told apart by its folder's name), or a rendered data set (manifest.json).
+    ``facts``: from perception and grounding ("pipeline") or, on a rendered data set, from its ground truth
+    ("truth"). ``cache``: the folder caching real frames' facts (default :func:`default_cache`). InputError for
+    data that is none of these, or malformed."""
+    paths = [Path(d) for d in data] if isinstance(data, (list, tuple)) else [Path(data)]
+    if not paths:
+        raise InputError("--data", "no data given")
     if modality not in MODALITIES:
         raise InputError("--modality", f"must be one of {', '.join(MODALITIES)}, got {modality!r}")
     if facts not in SOURCES:
         raise InputError("--facts", f"must be one of {', '.join(SOURCES)}, got {facts!r}")
-    if is_frame_folder(data):
+    real = [is_frame_folder(p) for p in paths]
+    if all(real):
         if facts == "truth":
-            raise InputError("--facts", f"{data} holds real frames: they have no ground-truth facts (use pipeline)")
-        return _frame_folder_examples(data, modality, Path(cache).expanduser() if cache else default_cache())
-    return _dataset_examples(data, modality, facts)
+            raise InputError("--facts", f"{paths[0]} holds real frames: they have no ground-truth facts (use pipeline)")
+        return _frame_folder_examples(paths, modality, Path(cache).expanduser() if cache else default_cache())
+    if len(paths) > 1:
+        other = paths[real.index(False)]
+        raise InputError(other, "not a folder of labelled frames (no objects.csv): several --data must all be "
+                                "such folders (a rendered data set is read alone)")
+    return _dataset_examples(paths[0], modality, facts)
 
 
-def _frame_folder_examples(data: Path, modality: str, cache: Path) -> Examples:
+def _frame_folder_examples(folders: list[Path], modality: str, cache: Path) -> Examples:
     from .experiment.code_version import facts_version
     from .experiment.real_data import ensure_frame_facts, example_facts_of, real_data
 
-    objects, problems = FrameFolder(data).objects()
-    rd = real_data([str(data)], sorted({o.shape for o in objects}))
-    warnings = [ExampleWarning(None, f"{p} (left out)") for p in problems]
+    shapes = {o.shape for folder in folders for o in FrameFolder(folder).objects()[0]}
+    rd = real_data([str(f) for f in folders], sorted(shapes))
+    warnings = [ExampleWarning(None, f"{p} (left out)") for p in rd.problems]
     frames = ensure_frame_facts(rd, cache / "facts", facts_version(), modality, True)
     facts, errors = example_facts_of(rd, frames)
     warnings += [ExampleWarning(i, f"{errors[i]} (example {i} has no object)") for i in sorted(errors)]

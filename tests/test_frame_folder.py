@@ -313,3 +313,17 @@ baselines: {{image_size: 16, tree_cells: 4}}
         load_study(config, [f"data.folders=[{frames}]"])
     with pytest.raises(InputError, match="data.split: folders .* got 0"):
         load_study(config, ["data.folders=null", "data.classes=[cube, triangular_prism]"])
+
+
+def test_fit_reads_several_folders_together_and_tells_their_frames_apart(frames, tmp_path, capsys):
+    # the same frames again in a folder of another name: two frames of one name, told apart by their folders
+    import shutil
+
+    again = shutil.copytree(frames, tmp_path / "session2")
+    args = ["--data", str(frames), "--data", str(again), "--modality", "depth", "--cache", str(tmp_path / "cache")]
+    assert main(["learn", "fit", *args, "--out", str(tmp_path / "model"), "--time-limit", "20"]) == 0
+    assert "learned from 12 examples (box 6, prism 6)" in capsys.readouterr().out
+    assert main(["learn", "explain", *args, "--model", str(tmp_path / "model"), "--example", "session2_frame-002_x1"]) == 0
+    assert " is a box" in capsys.readouterr().out
+    assert main(["learn", "fit", "--data", str(frames), "--data", str(tmp_path), "--out", str(tmp_path / "m2")]) == 2
+    assert "several --data must all be such folders" in capsys.readouterr().err

@@ -81,21 +81,26 @@ def learn():
     """Learn shape concepts from a data set and classify with them."""
 
 
-def _examples(data: Path, modality: str, facts: str | None, cache: Path | None = None,
+def _examples(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None = None,
               warn: set[str] | None = None):
-    """The examples of a data set or a folder of labelled real frames (lv3d.examples.read_examples), each
+    """The examples of a data set or of folders of labelled real frames (lv3d.examples.read_examples), each
     warning of reading them one line (an example's only where ``warn`` holds its id, where given)."""
     from ..examples import read_examples
 
-    ex = read_examples(data, modality, facts=facts or "pipeline", cache=cache)
+    ex = read_examples(list(data), modality, facts=facts or "pipeline", cache=cache)
     for w in ex.warnings:
         if warn is None or w.example is None or w.example in warn:
             click.echo(f"lv3d: warning: {w}", err=True)
     return ex
 
 
-_data = click.option("--data", type=click.Path(path_type=Path), required=True,
-                     help="a rendered data set (manifest.json) or a folder of labelled real frames (objects.csv)")
+_data = click.option("--data", type=click.Path(path_type=Path), required=True, multiple=True,
+                     help="a rendered data set (manifest.json) or a folder of labelled real frames (objects.csv); "
+                          "repeatable for several such folders, whose examples are read together")
+
+
+def _named(data: tuple[Path, ...]) -> str:
+    return ", ".join(str(d) for d in data)
 _modality = click.option("--modality", type=click.Choice(MODALITIES), default="rgbd", show_default=True)
 _facts = click.option("--facts", type=click.Choice(["truth", "pipeline"]), default=None,
                       help="facts from perception + grounding (pipeline, the default) or, on a rendered data set "
@@ -114,7 +119,7 @@ _cache = click.option("--cache", type=click.Path(path_type=Path), default=None,
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="directory for the programs")
 @click.option("--seed", type=click.IntRange(0, 2 ** 32 - 1), default=0, show_default=True)
 @click.option("--time-limit", type=click.FloatRange(0, 86400, min_open=True), default=None, help="seconds per class")
-def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classes: str | None, out: Path, seed: int,
+def fit(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, classes: str | None, out: Path, seed: int,
         time_limit: float | None):
     """Learn one program per class and save them as .pl files in OUT. Examples where perception found no
     object are left out (counted)."""
@@ -123,21 +128,21 @@ def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classe
     from ..learn.model import Model
     from ..output import check_out, replacing
 
-    check_out(out, (data,))  # before any work: a file, a folder lv3d did not write or one holding the data
+    check_out(out, data)  # before any work: a file, a folder lv3d did not write or one holding the data
     wanted = [c.strip() for c in classes.split(",") if c.strip()] if classes is not None else None
     if wanted is not None and not wanted:
         raise InputError("--classes", "no class given")
     ex = _examples(data, modality, facts, cache)
     for c in wanted or ():
         if c not in ex.labels:
-            raise InputError("--classes", f"no example of {data} is a {c!r}; its classes: {', '.join(sorted(set(ex.labels)))}")
+            raise InputError("--classes", f"no example of {_named(data)} is a {c!r}; its classes: {', '.join(sorted(set(ex.labels)))}")
     left_out = ex.without_object
     learnable = ex.learnable()
     scenes, labels = learnable.scenes, learnable.labels
     if left_out:
         click.echo(f"% {left_out} example(s) left out: perception found no object there", err=True)
     if not scenes:
-        raise click.ClickException(f"{data}: perception found no object in any example; nothing to learn from")
+        raise click.ClickException(f"{_named(data)}: perception found no object in any example; nothing to learn from")
     present = set(labels)
     lost = [c for c in (wanted or []) if c not in present]
     if lost:
@@ -149,7 +154,7 @@ def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classe
     if not model.programs and model.failures:  # nothing learned: no empty model is saved
         why = "; ".join(f"{c}: {w}" for c, w in model.failures.items())
         raise click.ClickException(f"no program learned for any class ({why})")
-    with replacing(out, (data,)) as tmp:  # written beside OUT, then moved into its place
+    with replacing(out, data) as tmp:  # written beside OUT, then moved into its place
         model.save(tmp)
     click.echo(f"% learned from {len(scenes)} examples ({', '.join(f'{c} {labels.count(c)}' for c in sorted(present))})")
     for c, p in model.programs.items():
@@ -164,7 +169,7 @@ def fit(data: Path, modality: str, facts: str | None, cache: Path | None, classe
         click.echo(f"no program for {c}: {why}", err=True)
 
 
-def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path,
+def _model_and_scenes(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, model_dir: Path,
                       warn: set[str] | None = None):
     """The model of ``model_dir`` and the scenes of ``data`` (:func:`_examples`, its ``warn``)."""
     from ..learn.model import Model
@@ -188,7 +193,7 @@ def _model_and_scenes(data: Path, modality: str, facts: str | None, cache: Path 
 @_cache
 @click.option("--model", "model_dir", type=click.Path(path_type=Path), required=True)
 @click.option("--explain/--no-explain", default=False, help="print each answer's proof")
-def predict(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path, explain: bool):
+def predict(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, model_dir: Path, explain: bool):
     """Classify every example of a data set or folder with saved programs; print accuracy, over the examples of
     the classes the model holds a program for, each class's, and their mean (balanced accuracy). An example where perception found no object
     is answered "unknown" (and counts as wrong); examples of other classes are answered but left out of the
@@ -234,7 +239,7 @@ def predict(data: Path, modality: str, facts: str | None, cache: Path | None, mo
 @click.option("--example", "examples", multiple=True, metavar="ID",
               help="explain this example only (an id predict prints, or FRAME_xOBJECT with the frame's file "
                    "name; repeatable; default: every example)")
-def explain(data: Path, modality: str, facts: str | None, cache: Path | None, model_dir: Path,
+def explain(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, model_dir: Path,
             examples: tuple[str, ...]):
     """Print why each example gets its label: the program that proves it and the facts (with confidences)
     the proof used."""
@@ -245,7 +250,7 @@ def explain(data: Path, modality: str, facts: str | None, cache: Path | None, mo
     by_id = {s.scene: (s, y) for s, y in zip(scenes, labels)}
     unknown = [e for e in examples if e not in by_id]
     if unknown:
-        raise InputError("--example", f"no example {unknown[0]!r} in {data}; e.g. {', '.join(list(by_id)[:5])}")
+        raise InputError("--example", f"no example {unknown[0]!r} in {_named(data)}; e.g. {', '.join(list(by_id)[:5])}")
     for i in examples or list(by_id):
         s, y = by_id[i]
         if s.target is None:
