@@ -71,7 +71,8 @@ def default_cache() -> Path:
 def read_examples(data, modality: str, *, facts: str = "pipeline", cache: str | Path | None = None) -> Examples:
     """The examples of ``data`` as a system that sees ``modality`` (rgb, depth, rgbd) gets them: a folder of
     labelled real frames (objects.csv), a list of such folders (their examples together, in their order; a frame
-    name two folders share is told apart by its folder's name), or a rendered data set (manifest.json).
+    whose name an earlier folder has is named with its folder's name in front), or a rendered data set
+    (manifest.json).
     ``facts``: from perception and grounding ("pipeline") or, on a rendered data set, from its ground truth
     ("truth"). ``cache``: the folder caching real frames' facts (default :func:`default_cache`). InputError for
     data that is none of these, or malformed."""
