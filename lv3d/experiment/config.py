@@ -398,17 +398,16 @@ def learnable_classes(folders, classes, folds: int, where: str, split: str = "fr
             frames.setdefault(o.shape, set()).add((k, o.frame))
     if classes is None:
         classes = tuple(sorted((c for c in objects if c != OTHER_SHAPE), key=lambda c: (-objects[c], c)))
-    if split == "folders":
-        kept = tuple(c for c in classes if len({k for k, _ in frames.get(c, ())}) == len(folders))
-        rule = "in every folder of data.folders (data.split folders: each folder is a test fold)"
-    else:
-        kept = tuple(c for c in classes if len(frames.get(c, ())) >= folds)
-        rule = (f"in at least folds ({folds}) frames of data.folders (the folds are grouped by frame, and each tests "
-                f"a frame of every class)")
+    by_folder = split == "folders"
+    # in how many folders (split folders) or frames (split frames) each class is labelled, and how many it needs
+    spread = {c: len({k for k, _ in fr}) if by_folder else len(fr) for c, fr in frames.items()}
+    need, unit = (len(folders), "folder(s)") if by_folder else (folds, "frame(s)")
+    kept = tuple(c for c in classes if spread.get(c, 0) >= need)
+    rule = "in every folder of data.folders (data.split folders: each folder is a test fold)" if by_folder else \
+        f"in at least folds ({folds}) frames of data.folders (the folds are grouped by frame, and each tests a frame " \
+        "of every class)"
     if len(kept) < 2:
-        where_from = (lambda c: f"{len({k for k, _ in frames[c]})} folder(s)") if split == "folders" else \
-            (lambda c: f"{len(frames[c])} frame(s)")
-        have = ", ".join(f"{c} {objects[c]} in {where_from(c)}" for c in sorted(objects)) or "none"
+        have = ", ".join(f"{c} {objects[c]} in {spread[c]} {unit}" for c in sorted(objects)) or "none"
         raise InputError(where, f"data.classes: fewer than two of {', '.join(classes) or 'its classes'} are labelled "
                                 f"{rule}; the folders hold: {have}")
     return kept, {c: objects[c] for c in classes if c not in kept}
