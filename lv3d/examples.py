@@ -26,7 +26,7 @@ from pathlib import Path
 
 from .errors import InputError, read_json
 from .facts import MODALITIES, SceneFacts
-from .frame_folder import FrameFolder, is_frame_folder
+from .frame_folder import is_frame_folder
 
 SOURCES = ("pipeline", "truth")
 
@@ -99,8 +99,7 @@ def _frame_folder_examples(folders: list[Path], modality: str, cache: Path) -> E
     from .experiment.code_version import facts_version
     from .experiment.real_data import ensure_frame_facts, example_facts_of, real_data
 
-    shapes = {o.shape for folder in folders for o in FrameFolder(folder).objects()[0]}
-    rd = real_data([str(f) for f in folders], sorted(shapes))
+    rd = real_data([str(f) for f in folders])
     warnings = [ExampleWarning(None, f"{p} (left out)") for p in rd.problems]
     frames = ensure_frame_facts(rd, cache / "facts", facts_version(), modality, True)
     facts, errors = example_facts_of(rd, frames)

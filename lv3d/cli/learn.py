@@ -81,6 +81,10 @@ def learn():
     """Learn shape concepts from a data set and classify with them."""
 
 
+def _named(data: tuple[Path, ...]) -> str:
+    return ", ".join(str(d) for d in data)
+
+
 def _examples(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None = None,
               warn: set[str] | None = None):
     """The examples of a data set or of folders of labelled real frames (lv3d.examples.read_examples), each
@@ -97,10 +101,6 @@ def _examples(data: tuple[Path, ...], modality: str, facts: str | None, cache: P
 _data = click.option("--data", type=click.Path(path_type=Path), required=True, multiple=True,
                      help="a rendered data set (manifest.json) or a folder of labelled real frames (objects.csv); "
                           "repeatable for several such folders, whose examples are read together")
-
-
-def _named(data: tuple[Path, ...]) -> str:
-    return ", ".join(str(d) for d in data)
 _modality = click.option("--modality", type=click.Choice(MODALITIES), default="rgbd", show_default=True)
 _facts = click.option("--facts", type=click.Choice(["truth", "pipeline"]), default=None,
                       help="facts from perception + grounding (pipeline, the default) or, on a rendered data set "

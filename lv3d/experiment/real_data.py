@@ -62,8 +62,8 @@ class RealData:
         return {"unusable_rows": [str(p) for p in self.problems], "other_classes": dict(self.other_classes)}
 
 
-def real_data(folders, classes) -> RealData:
-    """The examples of the folders' labelled objects whose class is one of ``classes``."""
+def real_data(folders, classes=None) -> RealData:
+    """The examples of the folders' labelled objects whose class is one of ``classes`` (None: every class)."""
     from ..object_facts import example_id
 
     opened = [FrameFolder(Path(p).expanduser()) for p in folders]
@@ -79,7 +79,7 @@ def real_data(folders, classes) -> RealData:
             atoms[atom] = (folder, frame)
             mine = [o for o in objects if o.frame == frame]
             for o in mine:
-                if o.shape not in classes:
+                if classes is not None and o.shape not in classes:
                     other[o.shape] = other.get(o.shape, 0) + 1
                     continue
                 labels.setdefault(atom, []).append(o)
