@@ -250,7 +250,7 @@ def main(argv=None) -> int:
     if not a.no_speed:
         ms, cpu_ms, firsts = speed(a.speed_frames, a.speed_runs)
         first = float(np.median(firsts))
-        print(f"== speed (one core; this machine is shared, so figures are pessimistic)")
+        print("== speed (one core; this machine is shared, so figures are pessimistic)")
         print(f"  refinement + facts per 640x480 frame, median after warm-up: {ms:.1f} ms "
               f"({beside('<=', FRAME_MS_TARGET, ms, '.0f', ' ms')}); "
               f"CPU time {cpu_ms:.1f} ms")

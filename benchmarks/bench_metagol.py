@@ -166,7 +166,6 @@ def main(argv=None) -> int:
                 if have_metagol:
                     runs = run_metagol(driver, ex, "" if is_dir else g.name, a.limit)
                     mg = runs.get(g.name, {"cpu": None, "status": "error", "clauses": []})
-                ours_status = "program" if g.clauses else ("none" if g.error is None else g.kind)
                 ours_clauses = list(g.clauses or [])
                 m_clauses = mg.get("clauses", [])
                 m_status = mg.get("status")

@@ -70,10 +70,6 @@ class Intrinsics:
     def to_dict(self) -> dict:
         return asdict(self)
 
-    def matrix(self) -> np.ndarray:
-        """The 3x3 camera matrix K."""
-        return np.array([[self.fx, 0, self.cx], [0, self.fy, self.cy], [0, 0, 1]], dtype=np.float64)
-
     def project(self, points: np.ndarray) -> np.ndarray:
         """Camera-frame points (n, 3) in metres to pixels (n, 2)."""
         p = np.asarray(points, dtype=np.float64)

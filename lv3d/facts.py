@@ -11,7 +11,6 @@ import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable
 
 from .errors import InputError
 
@@ -162,13 +161,3 @@ def face_id(scene: str, obj: int, face: int) -> str:
 
 def object_id(scene: str, obj: int) -> str:
     return f"{scene}_o{obj}"
-
-
-def merge(facts: Iterable[Fact]) -> list[Fact]:
-    """One fact per atom, keeping the most confident (facts from two sources about the same atom)."""
-    best: dict[str, Fact] = {}
-    for f in facts:
-        k = f.atom()
-        if k not in best or f.conf > best[k].conf:
-            best[k] = f
-    return list(best.values())

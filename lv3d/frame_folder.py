@@ -262,21 +262,3 @@ def scene_atom(name: str) -> str:
     if not base or not base[0].isalpha():
         base = "f" + (f"_{base}" if base else "")
     return f"{base}_{hashlib.sha1(name.encode()).hexdigest()[:6]}"
-
-
-def check_folders(folders, classes, folds: int, where: str) -> None:
-    """InputError (naming the study config ``where`` and its key) unless every folder is a labelled-frame folder
-    and every class of ``classes`` has at least ``folds`` labelled objects in them."""
-    counts: dict[str, int] = {}
-    for path in folders:
-        try:
-            objects, _ = FrameFolder(Path(path).expanduser()).objects()
-        except InputError as e:
-            raise InputError(where, f"data.folders: {e}") from None
-        for o in objects:
-            counts[o.shape] = counts.get(o.shape, 0) + 1
-    for c in classes:
-        if counts.get(c, 0) < folds:
-            have = ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "none"
-            raise InputError(where, f"data.classes: {c!r} has {counts.get(c, 0)} labelled objects in data.folders, "
-                                    f"fewer than folds ({folds}); the folders hold: {have}")

@@ -57,3 +57,8 @@ def dihedral_deg(outward_a: np.ndarray, outward_b: np.ndarray) -> float:
     90 for adjacent cube faces, 60 between lateral faces of an equilateral triangular prism."""
     c = float(np.clip(np.dot(outward_a, outward_b) / (np.linalg.norm(outward_a) * np.linalg.norm(outward_b)), -1, 1))
     return 180.0 - float(np.degrees(np.arccos(c)))
+
+
+def angle_deg(a: Plane, b: Plane) -> float:
+    """Angle (degrees, in [0, 90]) between two planes' normals, whichever way each faces."""
+    return float(np.degrees(np.arccos(np.clip(abs(float(a.n @ b.n)), 0.0, 1.0))))

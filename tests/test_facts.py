@@ -1,7 +1,7 @@
 import pytest
 
 from lv3d.errors import InputError
-from lv3d.facts import Fact, SceneFacts, merge
+from lv3d.facts import Fact, SceneFacts
 
 
 def test_fact_renders_as_prolog_and_round_trips_through_json():
@@ -24,8 +24,3 @@ def test_modality_filter_hides_depth_facts_from_rgb():
     assert [f.pred for f in sf.for_modality("rgb").facts] == ["triangle"]
     with pytest.raises(InputError):
         sf.for_modality("infrared")
-
-
-def test_merge_keeps_the_most_confident_copy():
-    out = merge([Fact("triangle", ("f",), 0.4), Fact("triangle", ("f",), 0.7)])
-    assert len(out) == 1 and out[0].conf == 0.7

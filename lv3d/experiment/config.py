@@ -22,7 +22,7 @@ import re
 from collections import Counter
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import Callable
 
 import yaml
 
@@ -297,9 +297,6 @@ class StudyConfig:
     def to_dict(self) -> dict:
         """Plain nested mappings and lists (what the YAML holds, and what cache keys digest)."""
         return _plain(self)
-
-    def with_systems(self, systems) -> "StudyConfig":
-        return replace(self, systems=tuple(systems))
 
 
 def _plain(obj):

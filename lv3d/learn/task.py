@@ -182,18 +182,22 @@ class _Allowance:
     """The CPU seconds a process may use from now on (and WALL_FACTOR times as many of wall time)."""
 
     def __init__(self, proc: subprocess.Popen, seconds: float) -> None:
+        self._last = 0.0
         try:
-            self._process = psutil.Process(proc.pid)
-        except psutil.Error:  # ended already
+            self._process: psutil.Process | None = psutil.Process(proc.pid)
+        except psutil.Error:  # ended already: it uses no more
             self._process = None
         self.restart(seconds)
 
     def _cpu(self) -> float:
-        try:
-            t = self._process.cpu_times()
-            return t.user + t.system
-        except (psutil.Error, AttributeError):
-            return 0.0
+        """The process's CPU seconds so far; once it has ended, the last it was seen to have used."""
+        if self._process is not None:
+            try:
+                t = self._process.cpu_times()
+                self._last = t.user + t.system
+            except psutil.Error:  # ended since: its time no longer grows
+                self._process = None
+        return self._last
 
     def restart(self, seconds: float) -> None:
         self._seconds, self._cpu0, self._wall0 = seconds, self._cpu(), time.monotonic()

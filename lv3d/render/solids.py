@@ -101,10 +101,6 @@ class Solid:
                 seen.setdefault((min(a, b), max(a, b)), []).append(i)
         return {e: (fs[0], fs[1]) for e, fs in seen.items()}
 
-    def radius_xy(self) -> float:
-        """Largest horizontal distance of a vertex from the z axis (metres)."""
-        return float(np.hypot(self.vertices[:, 0], self.vertices[:, 1]).max())
-
 
 def prism(n: int, edge: float, length: float, cls: str) -> Solid:
     """Right prism over a regular ``n``-gon with side ``edge``, ``length`` tall along z, centred at the origin."""

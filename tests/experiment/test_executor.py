@@ -1,7 +1,6 @@
 """A study's cells on other processes and on a Dask cluster give the default's results, bit for bit."""
 
 import json
-from pathlib import Path
 
 import pytest
 

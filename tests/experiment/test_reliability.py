@@ -10,10 +10,8 @@ import textwrap
 import time
 from pathlib import Path
 
-import pytest
 
 from lv3d.cli import main
-from lv3d.errors import InputError
 from lv3d.experiment.runner import run_study
 from lv3d.output import LOCK, claim, clean_stale, lock_folder
 

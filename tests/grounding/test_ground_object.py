@@ -78,7 +78,6 @@ def test_refinement_reduces_vertex_error_and_unrefined_still_has_confidences():
 
 
 def test_faces_without_planes_get_no_metric_confidences():
-    rng = np.random.default_rng(6)
     faces3d, adj = wedge(90.0)
     polys = [project(f) for f in faces3d]
     field = grounding.edge_distance_field(render_polygons(polys, [(200, 120, 60), (60, 140, 210)]))

@@ -1,8 +1,8 @@
-"""A depth plane's mask as an image polygon (boundary.py)."""
+"""A depth plane's mask as an image polygon, and a polygon grown outward (boundary.py)."""
 import numpy as np
 
-from lv3d.perception.boundary import mask_polygon
-from lv3d.perception.polygons import rasterize
+from lv3d.perception.boundary import grow_convex, mask_polygon
+from lv3d.perception.polygons import area, rasterize
 
 from .conftest import mask_iou as _iou
 
@@ -23,3 +23,19 @@ def test_a_face_seen_square_on_gives_its_corners_only():
     poly = mask_polygon(mask, 1, (480, 640))
     assert len(poly) == 4
     assert np.abs(poly[:, None, :] - square[None]).sum(-1).min(axis=0).max() < 2.5
+
+
+def test_grow_convex_moves_every_side_outward():
+    sq = np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)
+    grown = grow_convex(sq, 1.0)
+    assert np.allclose(np.sort(grown, axis=0), np.sort(np.array([[-1, -1], [11, -1], [11, 11], [-1, 11]]), axis=0))
+    assert abs(area(grown) - 144) < 1e-9
+
+
+def test_grow_convex_keeps_a_sharp_corner_near_its_place():
+    from lv3d.perception.polygons import clockwise
+
+    sliver = clockwise(np.array([[0, 0], [100, 2], [0, 4]], float))  # a 2-degree tip at (100, 2)
+    grown = grow_convex(sliver, 1.0)
+    assert area(grown) > area(sliver)  # grown outward, not inward
+    assert np.linalg.norm(grown - sliver, axis=1).max() <= 2.0 + 1e-9

@@ -3,7 +3,6 @@ along the valley between them; one convex or gently concave surface, and a piece
 
 import cv2
 import numpy as np
-import pytest
 
 from lv3d.perception.depth.cloud import PointGrid, crop_normals
 from lv3d.perception.depth.creases import CreaseSettings, crease_cells, split_at_creases

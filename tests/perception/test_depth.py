@@ -3,11 +3,18 @@ import numpy as np
 from lv3d.perception.depth.cloud import crop_normals, point_grid, remove_flying, slope_noise
 from lv3d.perception.depth import depth_scene
 from lv3d.perception.depth.objects import heavy_noise, segment_objects, support_band
-from lv3d.perception.depth.planes import outward_normal
+from lv3d.perception.depth.stage import _support
 from lv3d.perception.depth.support import support_plane
 from lv3d.plane import dihedral_deg
 
 from .conftest import box_on_table, cell_grid
+
+
+def outward_normal(plane, centroid):
+    """The plane's normal turned away from the object's centroid: outward for a convex object."""
+    n = plane.plane.n
+    s = float(n @ (plane.points.mean(axis=0) - centroid))
+    return n if s > 0 or abs(s) < 1e-4 else -n
 
 
 def _angle(a, b):
@@ -108,7 +115,6 @@ def test_support_plane_is_the_table(box_frame):
     frame, _ = box_frame
     grid = point_grid(frame.depth, frame.intrinsics)
     sp = support_plane(grid.xyz[grid.valid].astype(float), seed=0)
-    table_normal = frame.intrinsics  # noqa: F841 (the table is world z = 0; its normal points up in the image)
     assert sp is not None and -sp.normal[1] > 0.5
     objs = segment_objects(grid, sp)
     assert len(objs) == 1
@@ -158,3 +164,33 @@ def test_largest_piece_is_the_largest_8_connected_piece_wherever_the_mask_lies()
     assert not largest_piece(np.zeros((4, 4), bool)).any()
     one = np.ones((3, 3), bool)
     assert largest_piece(one).all() and largest_piece(one) is not one
+
+
+def test_support_band_is_narrow_on_clean_depth_and_wider_on_noisy_depth():
+    clean, _ = box_on_table()
+    noisy, _ = box_on_table(noise_m=0.004, seed=3)
+    bands = []
+    for frame in (clean, noisy):
+        grid = point_grid(frame.depth, frame.intrinsics, 2, normals=False)
+        bands.append(support_band(grid, _support(grid, 0)))
+    assert bands[0] <= 0.005 and bands[1] > 2 * bands[0]
+
+
+def test_a_face_seen_edge_on_stays_with_its_object():
+    from lv3d.camera import Intrinsics
+    from lv3d.perception.depth.objects import segment_objects
+
+    k = Intrinsics(200, 200, 79.5, 59.5, 160, 120)
+    depth = np.zeros((120, 160), np.float32)
+    depth[30:90, 40:100] = 1.0
+    # 5 grid columns (10 px) whose depth steps by 2.5 % per column: a face nearly along the line of sight
+    for c in range(5):
+        depth[30:90, 100 + 2 * c:102 + 2 * c] = 1.0 * 1.025 ** (c + 1)
+    grid = point_grid(depth, k, stride=2, normals=False)
+    strip = np.zeros(grid.shape, bool)
+    strip[16:44, 50:55] = True
+    without = segment_objects(grid, None, regrow=0)
+    with_regrow = segment_objects(grid, None)
+    assert len(without) == len(with_regrow) == 1
+    assert np.count_nonzero(without[0].mask & strip) < 0.5 * strip.sum()
+    assert np.count_nonzero(with_regrow[0].mask & strip) > 0.8 * strip.sum()

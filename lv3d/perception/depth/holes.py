@@ -28,14 +28,13 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from ...plane import Plane
+from ...plane import Plane, angle_deg
 from ...rgbd import RGBD
 from ...scene import Face
 from ..boundary import grow_convex
 from .cloud import PointGrid
 from ..edges import edge_support
 from .ranges import check_ranges
-from .face_plane import angle_deg
 from ..polygons import area, clockwise, drop_short_sides, rasterize
 from .support import noise_threshold, ransac_plane
 

@@ -247,14 +247,3 @@ def plane_adjacency(planes: list[DepthPlane], min_contact: int = 4,
             if contact >= min_contact and ang >= min_angle_deg:
                 out.append((i, j))
     return out
-
-
-def outward_normal(plane: DepthPlane, centroid: np.ndarray) -> np.ndarray:
-    """The plane's normal turned away from the object's centroid (metres, camera frame): outward for a convex
-    object. Visible faces of a convex object face the camera too, which breaks ties."""
-    n = plane.plane.n
-    c = plane.points.mean(axis=0)
-    s = float(n @ (c - centroid))
-    if abs(s) < 1e-4:
-        return n  # centroid on the plane (one face seen): towards the camera is outward
-    return n if s > 0 else -n
