@@ -129,6 +129,23 @@ def test_a_learner_slowed_by_a_busy_machine_is_not_stopped_within_its_cpu_allowa
     assert run.goals == (tasks.GoalResult("a", None, None, None, 0.1, 3.0),) and not run.warnings
 
 
+def test_the_cpu_allowance_of_a_process_that_has_ended_keeps_what_it_used():
+    import subprocess
+    import sys
+
+    # 0.3 s of CPU, then 0.5 s asleep, in which the allowance reads all of it
+    code = "import time\nt = time.process_time()\nwhile time.process_time() - t < 0.3: pass\ntime.sleep(0.5)"
+    proc = subprocess.Popen([sys.executable, "-c", code])
+    allowance = tasks._Allowance(proc, 0.1)
+    seen = 0.0
+    while proc.poll() is None:
+        seen = allowance._cpu()
+        time.sleep(0.02)
+    proc.wait()
+    assert seen >= 0.3
+    assert allowance._cpu() >= seen and allowance.spent()  # ended and reaped: its last reading stays, never 0
+
+
 def test_a_learner_that_hangs_after_its_goals_keeps_their_results(tmp_path, monkeypatch):
     monkeypatch.setattr(tasks, "WALL_FACTOR", 1.0)
     f = _fake_swipl(tmp_path, monkeypatch, "printf 'goal\\ta\\nclause\\tt(A):-p(A).\\ntime\\t0.1\\t0.1\\n'\n"
