@@ -26,7 +26,8 @@
 # Then copy each run's results.{csv,md} and plots into experiments/results/<study>/ (the script prints the
 # commands), rewrite the tables of experiments/README.md (scripts/readme_tables.py --write) and its text.
 # What each report's rerun moved: scripts/compare_reports.py experiments/results/<study>/results.csv
-# RUNS_DIR/<study>/results.csv.
+# RUNS_DIR/<study>/results.csv. Whether the facts are those of the previous code, byte for byte:
+# scripts/compare_facts.py RUNS_DIR OLD NEW (the two facts versions).
 # Resumable: rerunning skips finished folds. Progress: RUNS_DIR/progress, one line per finished study.
 set -euo pipefail
 cd "$(dirname "$0")/.."
