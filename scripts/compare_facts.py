@@ -28,16 +28,18 @@ def variant_dirs(root: Path, version: str) -> list[Path]:
     return sorted(p for p in root.rglob(f"facts/*/{version}/*") if p.is_dir())
 
 
-def counterpart(new_dir: Path, old: str, old_dirs: list[Path]) -> Path | None:
-    """OLD's folder for the facts of ``new_dir``: the same key and variant, else the same variant and file names."""
+def contents(d: Path) -> tuple[str, tuple[str, ...]]:
+    """A facts folder's variant and the names of its files: what pairs two folders of one data under two keys."""
+    return d.name, tuple(sorted(p.name for p in d.glob("*.json")))
+
+
+def counterpart(new_dir: Path, old: str, old_by_contents: dict) -> Path | None:
+    """OLD's folder for the facts of ``new_dir``: the same key and variant, else the first of OLD's folders
+    (``old_by_contents``: :func:`contents` -> folder) with the same variant and file names."""
     same_key = new_dir.parent.parent / old / new_dir.name
     if same_key.is_dir():
         return same_key
-    names = sorted(p.name for p in new_dir.glob("*.json"))
-    for d in old_dirs:
-        if d.name == new_dir.name and sorted(p.name for p in d.glob("*.json")) == names:
-            return d
-    return None
+    return old_by_contents.get(contents(new_dir))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -53,9 +55,12 @@ def main(argv: list[str] | None = None) -> int:
     if not new_dirs:
         print(f"compare_facts: {a.runs}: no facts of version {a.new}", file=sys.stderr)
         return 2
+    old_by_contents: dict = {}
+    for d in old_dirs:  # listed once, not once per folder of NEW
+        old_by_contents.setdefault(contents(d), d)
     same, differ, alone = 0, [], 0
     for d in new_dirs:
-        other = counterpart(d, a.old, old_dirs)
+        other = counterpart(d, a.old, old_by_contents)
         for f in sorted(d.glob("*.json")):
             g = other / f.name if other is not None else None
             if g is None or not g.is_file():
