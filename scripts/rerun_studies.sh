@@ -43,18 +43,21 @@ LV3D_ONLY="systems=[lv3d-rgb,lv3d-depth,lv3d-rgbd]"
 
 log() { echo "$(date +%T) $*" | tee -a "$RUNS/progress"; }
 
-study() {  # study NAME [--set ...]: restore the baselines, run, log to RUNS/NAME.log
+run_logged() {  # run_logged NAME [--set ...]: run the study, appending to RUNS/NAME.log, and log its line
     local name=$1; shift
-    $PY scripts/restore_baselines.py "experiments/$name.yaml" "experiments/results/$name/results.csv" \
-        --out "$RUNS/$name" "$@" > "$RUNS/$name.log" 2>&1
     OMP_NUM_THREADS=1 $LV3D experiment run "experiments/$name.yaml" --out "$RUNS/$name" "$@" >> "$RUNS/$name.log" 2>&1
     log "$name: $(grep -a 'fold results computed' "$RUNS/$name.log" | tail -1)"
 }
 
+study() {  # study NAME [--set ...]: restore the baselines, then run, logged to RUNS/NAME.log
+    $PY scripts/restore_baselines.py "experiments/$1.yaml" "experiments/results/$1/results.csv" \
+        --out "$RUNS/$1" "${@:2}" > "$RUNS/$1.log" 2>&1
+    run_logged "$@"
+}
+
 whole_study() {  # whole_study NAME [--set ...]: run with its baselines trained too (their answers' calibration
-    local name=$1; shift  # and confusions stay in the report; restored baselines carry their scores only)
-    OMP_NUM_THREADS=1 $LV3D experiment run "experiments/$name.yaml" --out "$RUNS/$name" "$@" > "$RUNS/$name.log" 2>&1
-    log "$name: $(grep -a 'fold results computed' "$RUNS/$name.log" | tail -1)"
+    : > "$RUNS/$1.log"  # and confusions stay in the report; restored baselines carry their scores only)
+    run_logged "$@"
 }
 
 replicate() {  # replicate SEED: the seed protocol's lv3d systems on images of another data seed (no baselines)
