@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.bench_real import _one_core, default_folders, labelled_folder
+from benchmarks.bench_real import _one_core, named_folders, labelled_folder
 from lv3d.errors import InputError
 
 
@@ -66,7 +66,8 @@ def timed(fn, calls: list[tuple[np.ndarray, float]], repeats: int) -> tuple[floa
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="bench_creases.py", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("folders", nargs="*", type=Path, help="folders in the real layout (default: the dev folders)")
+    ap.add_argument("folders", nargs="*", type=Path,
+                    help="folders in the real layout, or a folder of them (default: the dev folders)")
     ap.add_argument("--limit", type=int, metavar="N", help="only the first N frames of each folder")
     ap.add_argument("--repeats", type=int, default=3, help="rounds of timing; the least counts (default 3)")
     args = ap.parse_args(argv)
@@ -77,7 +78,7 @@ def main(argv=None) -> int:
     from lv3d.perception.depth.creases import h_maxima
 
     _one_core()  # OpenCV's dilation, as perception's other calls, on one thread
-    folders = args.folders or default_folders()
+    folders = named_folders(args.folders)
     if not folders:
         print("bench_creases.py: no real frames with objects.csv (../shared/data/real): nothing to time")
         return 0

@@ -66,7 +66,8 @@ def enlarge(folder: Path, out: Path, factor: int, limit: int | None) -> Path:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="bench_frame_size.py", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("folders", nargs="*", type=Path, help="folders in the real layout (default: bench_real's)")
+    ap.add_argument("folders", nargs="*", type=Path,
+                    help="folders in the real layout, or a folder of them (default: bench_real's)")
     ap.add_argument("--factor", type=int, default=2, help="how many times as large (default 2: 1280x960)")
     ap.add_argument("--limit", type=int, default=8, metavar="N", help="the first N frames of each folder (default 8)")
     ap.add_argument("--modalities", default="depth,rgbd", help="bench_real's --modalities (default depth,rgbd)")

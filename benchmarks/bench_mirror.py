@@ -75,7 +75,8 @@ def mirror(folder: Path, out: Path, limit: int | None, flip: str = "left-right")
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="bench_mirror.py", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("folders", nargs="*", type=Path, help="folders in the real layout (default: bench_real's)")
+    ap.add_argument("folders", nargs="*", type=Path,
+                    help="folders in the real layout, or a folder of them (default: bench_real's)")
     ap.add_argument("--limit", type=int, metavar="N", help="the first N frames of each folder (default: all)")
     ap.add_argument("--modalities", default="depth,rgbd", help="bench_real's --modalities (default depth,rgbd)")
     ap.add_argument("--seed", default="0", metavar="S[,S...]", help="bench_real's perception seeds (default 0)")

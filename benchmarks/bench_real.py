@@ -2,6 +2,7 @@
 
     .venv/bin/python -m benchmarks.bench_real                          # every folder under ../shared/data/real with objects.csv
     .venv/bin/python -m benchmarks.bench_real ../shared/data/real/osd-learn --limit 5 --modalities depth,rgbd
+    .venv/bin/python -m benchmarks.bench_real /data/frames                          # a folder of such folders: each
     .venv/bin/python -m benchmarks.bench_real --json out/bench_real.json
     .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --seed 0,1,2     # pooled over perception seeds
     .venv/bin/python -m benchmarks.bench_real --modalities depth,rgbd --set stride=2   # depth settings other than the defaults
@@ -806,13 +807,27 @@ def profile_table(stats: pstats.Stats, frames: int, top: int = 25) -> str:
     return "\n".join(lines)
 
 
+def labelled_within(parent: Path) -> list[Path]:
+    """The folders directly under ``parent`` that hold an objects.csv, in name order."""
+    return sorted(p for p in parent.iterdir() if (p / "objects.csv").is_file()) if parent.is_dir() else []
+
+
 def default_folders() -> list[Path]:
-    return sorted(p for p in REAL.iterdir() if (p / "objects.csv").is_file()) if REAL.is_dir() else []
+    return labelled_within(REAL)
+
+
+def named_folders(folders: list[Path]) -> list[Path]:
+    """The folders named on a command line, a folder of such folders (``../shared/data/real``: no objects.csv of
+    its own, some under it) standing for those under it; else :func:`default_folders`."""
+    if not folders:
+        return default_folders()
+    return [f for folder in folders for f in
+            ([folder] if (folder / "objects.csv").exists() else labelled_within(folder) or [folder])]
 
 
 def folders_to_run(folders: list[Path]) -> list[Path]:
-    """``folders``, or else :func:`default_folders`; an InputError naming REAL where that is none."""
-    folders = folders or default_folders()
+    """:func:`named_folders`; an InputError naming REAL where that is none."""
+    folders = named_folders(folders)
     if not folders:
         raise InputError(REAL, "no folder with objects.csv (name folders on the command line)")
     return folders
@@ -837,8 +852,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="bench_real.py", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("folders", nargs="*", type=Path,
-                    help="folders in the real layout (default: every folder under ../shared/data/real with "
-                         "objects.csv)")
+                    help="folders in the real layout, or a folder of them (default: every folder under "
+                         "../shared/data/real with objects.csv)")
     ap.add_argument("--limit", type=int, metavar="N", help="only the first N frames of each folder")
     ap.add_argument("--modalities", type=_modalities, default=list(MODALITIES), metavar="M1,M2",
                     help="among rgb, depth, rgbd (default: all three)")

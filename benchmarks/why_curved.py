@@ -64,7 +64,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.bench_real import _one_core, default_folders, depth_settings
+from benchmarks.bench_real import _one_core, named_folders, depth_settings
 from lv3d.errors import InputError
 from lv3d.frame_folder import FrameFolder
 
@@ -380,7 +380,8 @@ def write_csv(path: Path, rows: list[dict]) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="why_curved.py", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("folders", nargs="*", type=Path, help="folders in the real layout (default: the dev folders)")
+    ap.add_argument("folders", nargs="*", type=Path,
+                    help="folders in the real layout, or a folder of them (default: the dev folders)")
     ap.add_argument("--shapes", default="cylinder,box",
                     help="the classes of objects.csv to show, any of its words (default cylinder,box)")
     ap.add_argument("--limit", type=int, metavar="N", help="only the first N frames of each folder")
@@ -401,7 +402,7 @@ def main(argv=None) -> int:
         print(f"why_curved.py: error: {e}", file=sys.stderr)
         return 2
     _one_core()
-    folders = args.folders or default_folders()
+    folders = named_folders(args.folders)
     if not folders:
         print("why_curved.py: no real frames with objects.csv (../shared/data/real): nothing to weigh")
         return 0

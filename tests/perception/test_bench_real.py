@@ -352,6 +352,22 @@ def test_one_osd_frame_end_to_end_writes_every_figure(tmp_path, capsys):
     assert "fuse_ms" not in row  # a stage no frame of the run has (depth: no colour fusion) has no column
 
 
+def test_a_folder_of_labelled_folders_stands_for_those_under_it(tmp_path):
+    for name in ("b", "a", "plain"):
+        (tmp_path / "parent" / name).mkdir(parents=True)
+    for name in ("a", "b"):
+        (tmp_path / "parent" / name / "objects.csv").write_text("frame,object,u,v,shape\n")
+    (tmp_path / "own").mkdir()
+    (tmp_path / "own" / "objects.csv").write_text("frame,object,u,v,shape\n")
+    (tmp_path / "own" / "sub").mkdir()
+    (tmp_path / "own" / "sub" / "objects.csv").write_text("frame,object,u,v,shape\n")
+    parent, own, empty = tmp_path / "parent", tmp_path / "own", tmp_path / "parent" / "plain"
+    assert bench.named_folders([parent]) == [parent / "a", parent / "b"]
+    assert bench.named_folders([own, parent]) == [own, parent / "a", parent / "b"]  # its own objects.csv: itself
+    assert bench.named_folders([empty]) == [empty]  # nothing labelled under it: itself, for its own error
+    assert bench.named_folders([]) == bench.default_folders()
+
+
 def test_objects_csv_naming_a_missing_frame_stops_before_any_work(tmp_path, capsys):
     (tmp_path / "f0_rgb.png").write_bytes(b"")
     (tmp_path / "f0_depth_mm.png").write_bytes(b"")
