@@ -28,7 +28,9 @@
 # What each report's rerun moved: scripts/compare_reports.py experiments/results/<study>/results.csv
 # RUNS_DIR/<study>/results.csv. Whether the facts are those of the previous code, byte for byte:
 # scripts/compare_facts.py RUNS_DIR OLD NEW (the two facts versions).
-# Resumable: rerunning skips finished folds. Progress: RUNS_DIR/progress, one line per finished study.
+# Resumable: rerunning skips finished folds. Into the RUNS_DIR of the previous rerun, a change that leaves every
+# fact as it was computes the facts anew and keeps every lv3d fold (their key is their facts' content and the
+# learning code's version). Progress: RUNS_DIR/progress, one line per finished study.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 RUNS=${1:-runs/rerun}

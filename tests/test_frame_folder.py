@@ -307,8 +307,8 @@ baselines: {{image_size: 16, tree_cells: 4}}
     # the same folders split by frame are another study: its fold results are not these
     from lv3d.experiment.runner import result_key
 
-    assert result_key(study.base, "lv3d-depth", 0) != result_key(load_study(config, ["data.split=frames", "folds=2"]).base,
-                                                                 "lv3d-depth", 0)
+    by_frames = load_study(config, ["data.split=frames", "folds=2"]).base
+    assert result_key(study.base, "lv3d-depth", 0, "f") != result_key(by_frames, "lv3d-depth", 0, "f")
     with pytest.raises(InputError, match="data.split: folders .* needs data.folders of two folders or more, got 1"):
         load_study(config, [f"data.folders=[{frames}]"])
     with pytest.raises(InputError, match="data.split: folders .* got 0"):

@@ -1,9 +1,13 @@
 """Which version of lv3d's own code a cached result was made with.
 
 Facts and lv3d fold results are cached between runs; a cache keyed by settings alone would hand
-back results of code that has since changed. Their keys therefore include a digest of the source
-files they depend on, so that a change to perception, grounding, the fact writer or the learner
-recomputes them, while baseline results (which depend on none of that) are kept.
+back results of code that has since changed. Cached facts are therefore keyed by a digest of the
+source files they depend on (:func:`facts_version`), so that a change to perception, grounding or the
+fact writer recomputes them. An lv3d fold result is keyed by the facts it learned from (their
+content, lv3d.experiment.data.facts_digest) and by a digest of the code that learns from them
+(:func:`learning_version`): a change to the learner recomputes it, and so does a change to perception
+that changes a fact, while one that leaves every fact as it was (a refactor, a faster way to the same
+result) keeps it. Baseline results depend on none of that and are kept.
 """
 
 from __future__ import annotations
@@ -21,8 +25,10 @@ FACT_SOURCES = ("lv3d/perception", "lv3d/describe.py", "lv3d/facts.py", "lv3d/pi
                 "lv3d/rgbd.py", "lv3d/object_facts.py", "lv3d/frame_folder.py", "lv3d/image_shape.py",
                 "lv3d/interval.py", "lv3d/outline_ellipse.py", "lv3d/calibration.py", "lv3d/data/calibration.json",
                 "grounding")
-# What learning from those facts depends on: the Python side of the learner and the Prolog files.
+# What learning from those facts depends on: the Python side of the learner and the Prolog files; and with the
+# fact schema the learner turns facts into Prolog with, all the code that learns from given facts.
 LEARNER_SOURCES = ("lv3d/learn", "prolog")
+LEARNING_SOURCES = LEARNER_SOURCES + ("lv3d/facts.py",)
 
 
 def _files(part: str) -> list[Path]:
@@ -53,4 +59,10 @@ def facts_version() -> str:
 
 
 def learner_version() -> str:
+    """The version of all of lv3d's code an lv3d result depends on (facts and learner): the one reports name."""
     return source_digest(FACT_SOURCES + LEARNER_SOURCES)
+
+
+def learning_version() -> str:
+    """The version of the code that learns from given facts, part of an lv3d fold result's key."""
+    return source_digest(LEARNING_SOURCES)

@@ -14,6 +14,7 @@ run left half-made there is removed first.
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 import zipfile
@@ -146,6 +147,15 @@ def ensure_facts(cfg: StudyConfig, out: Path, data: Path, items: list[Item], mod
         if error:
             errors[it.id] = error
     return facts, errors
+
+
+def facts_digest(facts: dict[str, SceneFacts]) -> str:
+    """A 16-hex digest of what an lv3d system learns from and is tested on: every example's facts (their
+    content, in id order), whichever code made them. Part of an lv3d fold result's key (runner.result_key)."""
+    h = hashlib.sha256()
+    for key in sorted(facts):
+        h.update(json.dumps([key, facts[key].to_json()], sort_keys=True, separators=(",", ":")).encode())
+    return h.hexdigest()[:16]
 
 
 def read_pixels(path: Path, items: list[Item], size: int) -> dict[str, np.ndarray] | None:

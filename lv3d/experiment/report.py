@@ -97,6 +97,9 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
                 "multiclass": r["tasks"].get("multiclass", {}).get("accuracy", math.nan)} for r in recs}
         per["seconds"] = sum(r["seconds"] for r in recs)
         per["code"] = sorted({r["code"] for r in recs if r.get("code")})
+        holds = sorted({v for r in recs for v in r.get("holds_under", [])} - set(per["code"]))
+        if holds:  # later code versions with the same facts and learning code (runner._holds_under)
+            per["holds_under"] = holds
         calibration = answer_calibration(recs)
         if calibration:
             per["calibration"] = calibration
@@ -389,10 +392,14 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing:
                           f"{100 * lo:+.1f} to {100 * hi:+.1f} ({bal['cells']} cells)."]
         lines.append("")
     lines += closing
-    versions = sorted({v for summ in summaries.values() for per in summ["systems"].values() for v in per.get("code", [])})
+    pers = [per for summ in summaries.values() for per in summ["systems"].values()]
+    versions = sorted({v for per in pers for v in per.get("code", [])})
+    holds = sorted({v for per in pers for v in per.get("holds_under", [])} - set(versions))
     if versions:
         lines.append("lv3d results made with lv3d code version " + ", ".join(f"`{v}`" for v in versions) +
-                     " (a digest of its source: lv3d/experiment/code_version.py).")
+                     " (a digest of its source: lv3d/experiment/code_version.py)" +
+                     ("; they hold for version " + ", ".join(f"`{v}`" for v in holds) + " too, whose facts "
+                      "and learning code are the same" if holds else "") + ".")
         lines.append("")
     return "\n".join(lines)
 

@@ -30,7 +30,7 @@ from tqdm import tqdm
 from ..errors import InputError
 from ..output import claim, clean_stale, locked, write_atomic
 from . import data as data_mod
-from .code_version import learner_version
+from .code_version import learner_version, learning_version
 from .config import LOGIC_SYSTEMS, TUNE_KEYS, Study, StudyConfig, digest, load_study
 from .executor import LocalExecutor
 from .folds import Item, class_task, fold_path, grouped_folds, multiclass_task, split, stratified_folds
@@ -51,8 +51,11 @@ def tune_seed(seed: int, fold: int) -> int:
     return task_seed(seed, fold, TUNE_TASK)
 
 
-def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
-    """What a fold result depends on: a finished result with another key is recomputed."""
+def result_key(cfg: StudyConfig, system: str, fold: int, facts: str | None = None) -> str:
+    """What a fold result depends on: a finished result with another key is recomputed. ``facts``: for an lv3d
+    system, the digest of the facts it learns from (data.facts_digest), which stands for the perception and
+    grounding code that made them: a result is kept across a change to that code which leaves every fact as it
+    was."""
     d = cfg.to_dict() if isinstance(cfg, StudyConfig) else cfg
     relevant = {k: d[k] for k in ("seed", "folds", "data", "train")}
     if relevant["train"].get("draws") == 1:  # one draw: the key leaves draws out, as results made without it have
@@ -63,7 +66,10 @@ def result_key(cfg: StudyConfig, system: str, fold: int) -> str:
         # workers: speed only; the default perception seed leaves the key as results made before it existed
         relevant["settings"] = {k: v for k, v in d["lv3d"].items()
                                 if k != "workers" and not (k == "perception_seed" and v == 0)}
-        relevant["code"] = learner_version()  # changed perception, grounding or learner: recompute
+        if facts is None:
+            raise ValueError(f"the key of an {system} result needs the digest of its facts")
+        relevant["code"] = learning_version()  # a changed learner recomputes, and so do changed facts:
+        relevant["facts"] = facts
     else:
         # tuning changes the CNNs only; off, the key is the one results made before the setting existed have
         tuned = system.startswith("cnn-") and d["baselines"].get("tune")
@@ -332,11 +338,18 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
     remote = executor if getattr(executor, "name", "local") != "local" else None
     warned: set = set()  # each warning about the examples once, not once per condition
     for cname, ccfg in conds.items():
+        items = inputs = None
+        facts_of: dict[str, str] = {}  # an lv3d system's results are keyed by the facts it learns from
+        if any(s in LOGIC_SYSTEMS for s in ccfg.systems):
+            items, inputs = study_inputs(ccfg, out, remote, progress, warned)
+            facts_of = {s: data_mod.facts_digest(inputs.for_system(s)) for s in ccfg.systems if s in LOGIC_SYSTEMS}
         pending = []
         for s in ccfg.systems:
             for k in range(ccfg.folds):
-                path, key = fold_path(out, cname, s, k), result_key(ccfg, s, k)
+                path, key = fold_path(out, cname, s, k), result_key(ccfg, s, k, facts_of.get(s))
                 if _finished(path, key):
+                    if s in LOGIC_SYSTEMS:
+                        _holds_under(path, learner_version())
                     continue
                 if key in done:  # same system, data and settings in another condition (a baseline in an ablation)
                     record = json.loads(done[key].read_text())
@@ -347,7 +360,8 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
         bar.update(ccfg.folds * len(ccfg.systems) - len(pending))
         if not pending:
             continue
-        items, inputs = study_inputs(ccfg, out, remote, progress, warned)
+        if inputs is None:
+            items, inputs = study_inputs(ccfg, out, remote, progress, warned)
         if ccfg.data.split == "folders":
             from .real_data import folder_folds
 
@@ -365,8 +379,8 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
                 k, test = ks[i], cells[i][4]
                 if sname in LOGIC_SYSTEMS:
                     _write_programs(out / "programs" / cname / sname / f"fold{k}", files)
-                record.update(key=result_key(ccfg, sname, k), condition=cname, system=sname, fold=k,
-                              test_ids=[it.id for it in test], test_classes=[it.cls for it in test],
+                record.update(key=result_key(ccfg, sname, k, facts_of.get(sname)), condition=cname, system=sname,
+                              fold=k, test_ids=[it.id for it in test], test_classes=[it.cls for it in test],
                               pipeline_errors=inputs.errors.get(modality_of(sname), {}) if sname in LOGIC_SYSTEMS
                               else {}, code=learner_version() if sname in LOGIC_SYSTEMS else None)
                 if ccfg.data.folders:  # rows of objects.csv and classes the study could not use: counted
@@ -426,6 +440,17 @@ def _finished_keys(out: Path) -> dict[str, Path]:
         except (OSError, ValueError, KeyError, TypeError):
             continue
     return keys
+
+
+def _holds_under(path: Path, code: str) -> None:
+    """Record in an lv3d fold file, kept because its key matched, that its results hold under lv3d code version
+    ``code`` too (the same facts, the same learning code) where that is not the version that computed them: the
+    report names both (``holds_under``)."""
+    record = json.loads(path.read_text())
+    if record.get("code") in (None, code) or code in record.get("holds_under", []):
+        return
+    record["holds_under"] = [*record.get("holds_under", []), code]
+    _write_json(path, record)
 
 
 def _finished(path: Path, key: str) -> bool:

@@ -233,11 +233,55 @@ def test_the_perception_seed_reaches_perception_and_keys_its_facts(tmp_path, tin
     ccfg = load_study(tiny_config, sets).conditions["base"].to_dict()
     before = {**ccfg, "lv3d": {k: v for k, v in ccfg["lv3d"].items() if k != "perception_seed"}}
     assert ccfg["lv3d"]["perception_seed"] == 0
-    assert result_key(ccfg, "lv3d-depth", 0) == result_key(before, "lv3d-depth", 0)
+    assert result_key(ccfg, "lv3d-depth", 0, "f") == result_key(before, "lv3d-depth", 0, "f")
     other = {**ccfg, "lv3d": {**ccfg["lv3d"], "perception_seed": 7}}
-    assert result_key(other, "lv3d-depth", 0) != result_key(ccfg, "lv3d-depth", 0)
+    assert result_key(other, "lv3d-depth", 0, "f") != result_key(ccfg, "lv3d-depth", 0, "f")
     # rendered images do not depend on perception: the baselines' keys stay
     assert result_key(other, "tree-rgbd", 0) == result_key(ccfg, "tree-rgbd", 0)
+
+
+def test_lv3d_results_are_kept_while_their_facts_and_learning_code_are(tmp_path, tiny_config, fake_world,
+                                                                      monkeypatch):
+    import pytest
+
+    from lv3d.experiment import runner
+    from lv3d.experiment.config import load_study
+    from lv3d.facts import Fact
+    from tests.experiment.conftest import fake_scene_facts
+
+    sets, out = ["systems=[lv3d-depth, tree-rgbd]", "folds=2"], tmp_path / "s"
+    run_study(tiny_config, out, sets, progress=False)
+    fits, fold = fake_world.fits, out / "folds" / "base" / "lv3d-depth" / "fold0.json"
+    made_by = json.loads(fold.read_text())["code"]
+    # perception's code changed and every fact stayed: the facts are computed anew, the results kept, and the
+    # report says they hold for the new version
+    monkeypatch.setattr("lv3d.experiment.data.facts_version", lambda: "refactored")
+    monkeypatch.setattr(runner, "learner_version", lambda: "newversion00")
+    assert run_study(tiny_config, out, sets, progress=False)["ran"] == 0 and fake_world.fits == fits
+    assert list((out / "facts").glob("*/refactored/depth-refine1/*.json"))
+    rec = json.loads(fold.read_text())
+    assert rec["code"] == made_by and rec["holds_under"] == ["newversion00"]
+    assert (f"made with lv3d code version `{made_by}` (a digest of its source: lv3d/experiment/code_version.py); "
+            "they hold for version `newversion00` too") in (out / "results.md").read_text()
+    run_study(tiny_config, out, sets, progress=False)
+    assert json.loads(fold.read_text())["holds_under"] == ["newversion00"]  # said once
+    # a fact changed: the lv3d results are computed again, the baseline's kept
+    def other_facts(frame, scene_id, modality, refine=True, confidences=True, seed=0):
+        sf = fake_scene_facts(frame, scene_id, modality, refine, confidences, seed)
+        return type(sf)(sf.scene, sf.modality, [*sf.facts[:-1], Fact(sf.facts[-1].pred, sf.facts[-1].args, 0.8)],
+                        sf.target)
+
+    monkeypatch.setattr("lv3d.pipeline.scene_facts", other_facts)
+    monkeypatch.setattr("lv3d.experiment.data.facts_version", lambda: "changed")
+    assert run_study(tiny_config, out, sets, progress=False)["ran"] == 2
+    rec = json.loads(fold.read_text())
+    assert rec["code"] == "newversion00" and "holds_under" not in rec
+    # the learning code changed: computed again
+    monkeypatch.setattr(runner, "learning_version", lambda: "other learner")
+    assert run_study(tiny_config, out, sets, progress=False)["ran"] == 2
+    # an lv3d result's key cannot be made without its facts
+    with pytest.raises(ValueError, match="digest of its facts"):
+        runner.result_key(load_study(tiny_config, sets).base, "lv3d-depth", 0)
 
 
 def test_baselines_on_real_frames_are_keyed_by_the_perception_their_crops_came_from(tiny_config, monkeypatch):
