@@ -36,6 +36,10 @@ def box(tmp_path_factory):
                     "frames": [K]}, "k_width.json": {**K, "width": 640.7}, "k_nan.json": {**K, "fx": "60"}}.items():
         (root / name).write_text(json.dumps(k))
     (root / "k_bad.json").write_text("{not json")
+    (root / "frames").mkdir()  # a folder of frames in the real layout
+    cv2.imwrite(str(root / "frames" / "f1_rgb.png"), np.full((48, 64, 3), 128, np.uint8))
+    cv2.imwrite(str(root / "frames" / "f1_depth_mm.png"), np.full((48, 64), 900, np.uint16))
+    (root / "frames" / "intrinsics.json").write_text(json.dumps(K))
     (root / "file.txt").write_text("a file of the user's")
     data = root / "data"
     from lv3d.render.dataset import make_dataset
@@ -183,6 +187,16 @@ CASES = [
     "calibrate check {box}/file.txt --draws 0",
     "calibrate check {box}/file.txt --modality rgb",
     "calibrate check",
+    # label: a folder not in the layout, an --out it must not write, options
+    "label {box}/nope --out {out}",
+    "label {box}/data --out {out}",
+    "label {box}/file.txt --out {out}",
+    "label {box}/frames --out {box}/frames",
+    "label {box}/frames --out {box}/file.txt",
+    "label {box}/frames --out {box}",
+    "label {box}/frames --seed -1 --out {out}",
+    "label {box}/frames --max-objects 0 --out {out}",
+    "label {box}/frames",
     # demo and the top level
     "demo --out {out} --per-class 0",
     "demo --out {out} --train 0",

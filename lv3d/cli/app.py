@@ -13,6 +13,7 @@ from ..errors import InputError
 COMMANDS = {
     "dataset": "lv3d.cli.dataset:dataset",
     "extract": "lv3d.cli.extract:extract",
+    "label": "lv3d.cli.label:label",
     "mil": "lv3d.cli.learn:mil",
     "learn": "lv3d.cli.learn:learn",
     "experiment": "lv3d.cli.experiment:experiment",

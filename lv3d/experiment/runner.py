@@ -68,7 +68,7 @@ def result_key(cfg: StudyConfig, system: str, fold: int, facts: str | None = Non
                                 if k != "workers" and not (k == "perception_seed" and v == 0)}
         if facts is None:
             raise ValueError(f"the key of an {system} result needs the digest of its facts")
-        relevant["code"] = learning_version()  # a changed learner recomputes, and so do changed facts:
+        relevant["code"] = learning_version()  # a change to the learning code or to a fact recomputes
         relevant["facts"] = facts
     else:
         # tuning changes the CNNs only; off, the key is the one results made before the setting existed have
