@@ -7,7 +7,9 @@ on lv3d's code: ``lv3d/experiment/code_version.py``).
     .venv/bin/lv3d experiment run experiments/seed_protocol.yaml --out runs/seed_protocol
 
 Each restored fold file carries the key the runner computes for that system and fold under the
-config as it is now, so the runner skips it; it holds what the report reads (per task: accuracy,
+config as it is now (on real frames, with the crops where the current code's rgbd perception puts them: their
+facts are computed here, into the study's cache, where they are not there yet), so the runner skips it; it holds
+what the report reads (per task: accuracy,
 balanced accuracy, test size, seconds; the setting a tuned baseline chose), not the predictions, and says it
 was restored. Pass the
 same ``--set`` overrides as the run. A config whose conditions, systems or folds do not match the
@@ -25,7 +27,7 @@ from pathlib import Path
 
 from lv3d.errors import InputError
 from lv3d.experiment.config import LOGIC_SYSTEMS, load_study
-from lv3d.experiment.runner import _write_json, fold_path, result_key
+from lv3d.experiment.runner import _write_json, fold_path, result_key, study_inputs
 from lv3d.output import claim
 
 
@@ -60,16 +62,19 @@ def restore(config: Path, results: Path, out: Path, overrides: list[str] = ()) -
     written = 0
     claim(out, (config, results))  # the study's --out: refused unless new, empty or lv3d's own
     for cname, ccfg in study.conditions.items():
+        # on real frames a baseline's key holds where its crops lie, as the runner's does
+        inputs = study_inputs(ccfg, out, progress=False)[1] if ccfg.data.folders else None
         for s in ccfg.systems:
             if s in LOGIC_SYSTEMS:
                 continue
+            seen = inputs.seen(s) if inputs is not None else None
             for k in range(ccfg.folds):
                 tasks = cells.get((cname, s, k))
                 if not tasks:
                     raise InputError(results, f"no rows for condition {cname!r}, system {s!r}, fold {k} of {config}")
                 tasks = {t: {n: v for n, v in sc.items() if v is not None} for t, sc in tasks.items()}
-                record = {"key": result_key(ccfg, s, k), "condition": cname, "system": s, "fold": k, "tasks": tasks,
-                          "seconds": round(sum(sc["seconds"] for sc in tasks.values()), 3), "pipeline_errors": {},
+                record = {"key": result_key(ccfg, s, k, seen), "condition": cname, "system": s, "fold": k,
+                          "tasks": tasks, "seconds": round(sum(sc["seconds"] for sc in tasks.values()), 3), "pipeline_errors": {},
                           "code": None, "restored_from": str(results)}
                 if (cname, s, k) in tuned:
                     record["tuned"] = tuned[(cname, s, k)]

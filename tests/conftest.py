@@ -1,5 +1,6 @@
 """Shared test settings: JAX in float64 on the CPU with a persistent compilation cache."""
 
+import importlib.util
 import os
 from pathlib import Path
 
@@ -24,3 +25,17 @@ def _compile_cache():
     from lv3d import compile_cache
 
     compile_cache.enable()
+
+
+@pytest.fixture(scope="session")
+def load_script():
+    """Loads a module of scripts/ (maintenance scripts, not part of the package) by file name, e.g. "readme_tables"."""
+
+    def load(name: str):
+        path = Path(__file__).resolve().parents[1] / "scripts" / f"{name}.py"
+        spec = importlib.util.spec_from_file_location(name, path)
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        return mod
+
+    return load

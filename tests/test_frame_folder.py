@@ -198,7 +198,7 @@ def test_fit_learns_every_class_but_the_catch_all_other_unless_named(frames, tmp
     assert "% other:" in capsys.readouterr().out
 
 
-def test_a_study_on_folders_keeps_each_frame_in_one_fold(frames, tmp_path, capsys):
+def test_a_study_on_folders_keeps_each_frame_in_one_fold(frames, tmp_path, capsys, monkeypatch, load_script):
     from lv3d.experiment.config import load_study
     from lv3d.experiment.runner import run_study, study_inputs
 
@@ -226,6 +226,17 @@ baselines: {{image_size: 16, tree_cells: 4}}
     assert "objects of ball, a class labelled in fewer frames than folds: 1." in (out / "results.md").read_text()
     again = run_study(config, out, progress=False)  # resumes: nothing to recompute
     assert again["ran"] == 0 and again["skipped"] == 6
+    # perception's code changed and found the same facts and boxes: its facts are computed anew, and both the lv3d
+    # results (the same facts) and the baseline's (its crops where they were) are kept
+    import lv3d.experiment.code_version as cv
+
+    monkeypatch.setattr(cv, "facts_version", lambda: "refactored")
+    again = run_study(config, out, progress=False)
+    assert again["ran"] == 0 and list((tmp_path / "cache" / "facts").glob("*/refactored/depth-refine1/*"))
+    # the baselines restored from the report (scripts/restore_baselines.py) carry the key the run computes
+    restore = load_script("restore_baselines")
+    assert restore.restore(config, out / "results.csv", tmp_path / "rerun") == 3
+    assert run_study(config, tmp_path / "rerun", progress=False)["ran"] == 3  # the lv3d folds only
     # the warning about the ball, once for the conditions of one study (they share ``warned``)
     warned: set = set()
     for _ in range(2):

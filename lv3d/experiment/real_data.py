@@ -169,16 +169,27 @@ def crop_box(box: list[int] | None, u: int, v: int, shape: tuple[int, int]) -> t
     return cu - side // 2, cv - side // 2, side
 
 
-def ensure_real_pixels(rd: RealData, cache: Path, size: int, rgbd_frames: dict, version: str, seed: int = 0
-                       ) -> dict[str, np.ndarray]:
+def crops_digest(rgbd_frames: dict) -> str:
+    """A 16-hex digest of where the baselines' crops lie: the box of the object rgbd perception found under each
+    labelled pixel, frame by frame (``rgbd_frames``: frame atom -> FrameFacts). What a baseline on real frames
+    sees changes with these boxes only, whichever code found them (a change to the facts' confidences keeps
+    them)."""
+    import hashlib
+    import json
+
+    boxes = {atom: {str(k): b for k, b in sorted(rgbd_frames[atom].boxes.items())} for atom in sorted(rgbd_frames)}
+    return hashlib.sha256(json.dumps(boxes, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def ensure_real_pixels(rd: RealData, cache: Path, size: int, rgbd_frames: dict) -> dict[str, np.ndarray]:
     """{item id: (4, size, size) float32 crop tensor} (lv3d.baselines.pixels' channels), cached. The crops lie
-    around the objects rgbd perception found (``rgbd_frames``), so the cache is kept per facts ``version`` and
-    perception ``seed``, as those frames are."""
+    around the objects rgbd perception found (``rgbd_frames``), so the cache is kept per :func:`crops_digest`
+    of those frames."""
     from ..baselines.pixels import crop_tensor
     from ..object_facts import example_id
-    from .data import read_pixels, seed_suffix, write_pixels
+    from .data import read_pixels, write_pixels
 
-    path = Path(cache) / rd.key / version / f"pixels-{size}{seed_suffix(seed)}.npz"
+    path = Path(cache) / rd.key / f"crops-{crops_digest(rgbd_frames)}" / f"pixels-{size}.npz"
     ids = [it.id for it in rd.items]
     if path.is_file():
         got = read_pixels(path, rd.items, size)

@@ -51,11 +51,12 @@ def tune_seed(seed: int, fold: int) -> int:
     return task_seed(seed, fold, TUNE_TASK)
 
 
-def result_key(cfg: StudyConfig, system: str, fold: int, facts: str | None = None) -> str:
-    """What a fold result depends on: a finished result with another key is recomputed. ``facts``: for an lv3d
-    system, the digest of the facts it learns from (data.facts_digest), which stands for the perception and
-    grounding code that made them: a result is kept across a change to that code which leaves every fact as it
-    was."""
+def result_key(cfg: StudyConfig, system: str, fold: int, seen: str | None = None) -> str:
+    """What a fold result depends on: a finished result with another key is recomputed. ``seen``: the digest of
+    what perception gave the system, for an lv3d system the facts it learns from (data.facts_digest), for a
+    baseline on real frames where its crops lie (real_data.crops_digest). It stands for the perception and
+    grounding code that made them: a result is kept across a change to that code which leaves them as they
+    were."""
     d = cfg.to_dict() if isinstance(cfg, StudyConfig) else cfg
     relevant = {k: d[k] for k in ("seed", "folds", "data", "train")}
     if relevant["train"].get("draws") == 1:  # one draw: the key leaves draws out, as results made without it have
@@ -66,10 +67,10 @@ def result_key(cfg: StudyConfig, system: str, fold: int, facts: str | None = Non
         # workers: speed only; the default perception seed leaves the key as results made before it existed
         relevant["settings"] = {k: v for k, v in d["lv3d"].items()
                                 if k != "workers" and not (k == "perception_seed" and v == 0)}
-        if facts is None:
+        if seen is None:
             raise ValueError(f"the key of an {system} result needs the digest of its facts")
         relevant["code"] = learning_version()  # a change to the learning code or to a fact recomputes
-        relevant["facts"] = facts
+        relevant["facts"] = seen
     else:
         # tuning changes the CNNs only; off, the key is the one results made before the setting existed have
         tuned = system.startswith("cnn-") and d["baselines"].get("tune")
@@ -91,11 +92,10 @@ def result_key(cfg: StudyConfig, system: str, fold: int, facts: str | None = Non
                             "seed": d["seed"]}
         if d["data"].get("split", "frames") != "frames":  # the default leaves the key as results made before it
             relevant["data"]["split"] = d["data"]["split"]
-        if system not in LOGIC_SYSTEMS:
-            # the baselines' crops lie around the objects rgbd perception found: they change with it
-            from .code_version import facts_version
-
-            relevant["crops"] = {"facts": facts_version(), "seed": d["lv3d"].get("perception_seed", 0)}
+        if system not in LOGIC_SYSTEMS:  # the baselines' crops lie around the objects rgbd perception found
+            if seen is None:
+                raise ValueError(f"the key of a {system} result on real frames needs the digest of its crops")
+            relevant["crops"] = seen
     return digest(relevant)
 
 
@@ -253,12 +253,16 @@ class _RealInputs:
                 self._facts[m] = facts
             return self._facts[m]
         if self._pixels is None:
-            from .code_version import facts_version
-
             self._pixels = ensure_real_pixels(self.rd, data_mod.cache_root(self.cfg, self.out),
-                                              self.cfg.baselines.image_size, self.frames("rgbd"), facts_version(),
-                                              self.cfg.lv3d.perception_seed)
+                                              self.cfg.baselines.image_size, self.frames("rgbd"))
         return self._pixels
+
+    def seen(self, name: str) -> str:
+        """The digest of what perception gives system ``name``: its facts (lv3d) or where its crops lie."""
+        from .real_data import crops_digest
+
+        return data_mod.facts_digest(self.for_system(name)) if name in LOGIC_SYSTEMS else \
+            crops_digest(self.frames("rgbd"))
 
 
 class _Inputs:
@@ -282,6 +286,10 @@ class _Inputs:
         if self._pixels is None:
             self._pixels = data_mod.ensure_pixels(self.data, self.items, self.cfg.baselines.image_size)
         return self._pixels
+
+    def seen(self, name: str) -> str | None:
+        """The digest of the facts lv3d system ``name`` learns from; None for a baseline (it sees the images)."""
+        return data_mod.facts_digest(self.for_system(name)) if name in LOGIC_SYSTEMS else None
 
 
 def _write_json(path: Path, obj) -> None:
@@ -339,14 +347,14 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
     warned: set = set()  # each warning about the examples once, not once per condition
     for cname, ccfg in conds.items():
         items = inputs = None
-        facts_of: dict[str, str] = {}  # an lv3d system's results are keyed by the facts it learns from
-        if any(s in LOGIC_SYSTEMS for s in ccfg.systems):
+        seen: dict[str, str | None] = {}  # what perception gave each system (its facts, its crops): part of its key
+        if ccfg.data.folders or any(s in LOGIC_SYSTEMS for s in ccfg.systems):
             items, inputs = study_inputs(ccfg, out, remote, progress, warned)
-            facts_of = {s: data_mod.facts_digest(inputs.for_system(s)) for s in ccfg.systems if s in LOGIC_SYSTEMS}
+            seen = {s: inputs.seen(s) for s in ccfg.systems}
         pending = []
         for s in ccfg.systems:
             for k in range(ccfg.folds):
-                path, key = fold_path(out, cname, s, k), result_key(ccfg, s, k, facts_of.get(s))
+                path, key = fold_path(out, cname, s, k), result_key(ccfg, s, k, seen.get(s))
                 if _finished(path, key):
                     if s in LOGIC_SYSTEMS:
                         _holds_under(path, learner_version())
@@ -379,7 +387,7 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
                 k, test = ks[i], cells[i][4]
                 if sname in LOGIC_SYSTEMS:
                     _write_programs(out / "programs" / cname / sname / f"fold{k}", files)
-                record.update(key=result_key(ccfg, sname, k, facts_of.get(sname)), condition=cname, system=sname,
+                record.update(key=result_key(ccfg, sname, k, seen.get(sname)), condition=cname, system=sname,
                               fold=k, test_ids=[it.id for it in test], test_classes=[it.cls for it in test],
                               pipeline_errors=inputs.errors.get(modality_of(sname), {}) if sname in LOGIC_SYSTEMS
                               else {}, code=learner_version() if sname in LOGIC_SYSTEMS else None)

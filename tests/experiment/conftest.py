@@ -1,7 +1,6 @@
 """Tiny studies on a synthetic data set and a fake learner, so that the runner is tested on its own."""
 
 import csv
-import importlib.util
 import json
 import sys
 import types
@@ -146,20 +145,6 @@ def tiny_config(tmp_path):
 def synthetic_facts(monkeypatch):
     """The synthetic data set and facts of ``fake_world``, but the real learner."""
     _synthetic_data_and_facts(monkeypatch)
-
-
-@pytest.fixture(scope="session")
-def load_script():
-    """Loads a module of scripts/ (maintenance scripts, not part of the package) by file name, e.g. "readme_tables"."""
-
-    def load(name: str):
-        path = Path(__file__).resolve().parents[2] / "scripts" / f"{name}.py"
-        spec = importlib.util.spec_from_file_location(name, path)
-        mod = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(mod)
-        return mod
-
-    return load
 
 
 @pytest.fixture(scope="session")

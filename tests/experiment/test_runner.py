@@ -4,6 +4,7 @@ import json
 import math
 
 from lv3d.experiment.runner import run_study
+from lv3d.facts import Fact, SceneFacts
 
 
 def _accuracies(out):
@@ -246,7 +247,6 @@ def test_lv3d_results_are_kept_while_their_facts_and_learning_code_are(tmp_path,
 
     from lv3d.experiment import runner
     from lv3d.experiment.config import load_study
-    from lv3d.facts import Fact
     from tests.experiment.conftest import fake_scene_facts
 
     sets, out = ["systems=[lv3d-depth, tree-rgbd]", "folds=2"], tmp_path / "s"
@@ -284,15 +284,29 @@ def test_lv3d_results_are_kept_while_their_facts_and_learning_code_are(tmp_path,
         runner.result_key(load_study(tiny_config, sets).base, "lv3d-depth", 0)
 
 
-def test_baselines_on_real_frames_are_keyed_by_the_perception_their_crops_came_from(tiny_config, monkeypatch):
+def test_baselines_on_real_frames_are_keyed_by_where_their_crops_lie(tiny_config, monkeypatch):
+    import pytest
+
     from lv3d.experiment import runner
     from lv3d.experiment.config import load_study
+    from lv3d.experiment.real_data import crops_digest
+    from lv3d.object_facts import FrameFacts
 
     monkeypatch.setattr(runner, "_real_key", lambda folders, classes: "frames")
     ccfg = load_study(tiny_config, []).conditions["base"].to_dict()
     real = {**ccfg, "data": {**ccfg["data"], "folders": ["somewhere"]}}
-    seeded = {**real, "lv3d": {**real["lv3d"], "perception_seed": 7}}
-    before = runner.result_key(real, "effnet-rgbd", 0)
-    assert runner.result_key(seeded, "effnet-rgbd", 0) != before
-    monkeypatch.setattr("lv3d.experiment.code_version.facts_version", lambda: "other perception")
-    assert runner.result_key(real, "effnet-rgbd", 0) != before  # perception changed: the crops did too
+    with pytest.raises(ValueError, match="digest of its crops"):
+        runner.result_key(real, "effnet-rgbd", 0)
+    assert runner.result_key(real, "effnet-rgbd", 0, "a") != runner.result_key(real, "effnet-rgbd", 0, "b")
+    assert runner.result_key(ccfg, "effnet-rgbd", 0) == runner.result_key(ccfg, "effnet-rgbd", 0, None)  # rendered
+
+    def frames(box, conf):
+        facts = SceneFacts("f0", "rgbd", [Fact("object", ("f0_o1",), conf)], "f0_o1")
+        return {"f0": FrameFacts("f0", "rgbd", facts, {1: "f0_o1"}, {1: box})}
+
+    # the crops follow the boxes perception found under the labelled pixels, not the facts' confidences
+    assert crops_digest(frames([1, 2, 30, 40], 0.9)) == crops_digest(frames([1, 2, 30, 40], 0.5))
+    assert crops_digest(frames([1, 2, 30, 40], 0.9)) != crops_digest(frames([1, 2, 30, 41], 0.9))
+    assert crops_digest(frames(None, 0.9)) != crops_digest(frames([1, 2, 30, 40], 0.9))
+
+
