@@ -135,8 +135,12 @@ def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None) -> No
         for name, image in overlays.items():
             if not cv2.imwrite(str(tmp / "overlays" / f"{name}.png"), image):
                 raise InputError(out_dir, f"cannot write overlays/{name}.png")
-    left = "".join(f"; {len(v)} {what}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}"
-                   for v, what in ((empty, "frames with no object"), (unread, "frames not read")) if v)
-    click.echo(f"{out_dir / 'objects.csv'}: {len(rows)} objects in {len(names) - len(unread)} frames{left}. "
+    def count(n: int, what: str) -> str:
+        return f"{n} {what}" if n == 1 else f"{n} {what}s"
+
+    left = "".join(f"; {count(len(v), 'frame')} {what}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}"
+                   for v, what in ((empty, "with no object"), (unread, "not read")) if v)
+    click.echo(f"{out_dir / 'objects.csv'}: {count(len(rows), 'object')} in {count(len(names) - len(unread), 'frame')}"
+               f"{left}. "
                f"Fill in each row's shape (delete the rows you do not want; {out_dir / 'overlays'} numbers the "
                f"objects), then put the file in {folder} as objects.csv.")
