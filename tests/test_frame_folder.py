@@ -223,7 +223,8 @@ baselines: {{image_size: 16, tree_cells: 4}}
     rec = json.loads((out / "folds" / "base" / "tree-rgbd" / "fold0.json").read_text())
     assert rec["left_out"] == {"unusable_rows": [], "other_classes": {"ball": 1}}
     assert "ball" not in rec["tasks"] and {"box", "prism"} <= set(rec["tasks"])
-    assert "objects of ball, a class labelled in fewer frames than folds: 1." in (out / "results.md").read_text()
+    assert "objects of ball, a class not labelled in at least folds (3) frames of data.folders: 1." in \
+        (out / "results.md").read_text()
     again = run_study(config, out, progress=False)  # resumes: nothing to recompute
     assert again["ran"] == 0 and again["skipped"] == 6
     # perception's code changed and found the same facts and boxes: its facts are computed anew, and both the lv3d
@@ -241,7 +242,7 @@ baselines: {{image_size: 16, tree_cells: 4}}
     warned: set = set()
     for _ in range(2):
         study_inputs(load_study(config).base, out, progress=True, warned=warned)
-    assert capsys.readouterr().err.count("'ball' is labelled in fewer frames of data.folders than folds (3): its 1 "
+    assert capsys.readouterr().err.count("'ball' is not labelled in at least folds (3) frames of data.folders: its 1 "
                                          "object (left out)") == 1
 
 
@@ -314,7 +315,7 @@ baselines: {{image_size: 16, tree_cells: 4}}
     assert sorted(tests[1]) == sorted(f"{scene_atom(f'g{i}')}_x1" for i in range(4))
     report = (out / "results.md").read_text()
     assert "Each folder a test fold" in report and "| system | frames | sensor2 |" in report
-    assert "objects of ball, a class not labelled in every folder: 1." in report
+    assert "objects of ball, a class not labelled in every folder of data.folders: 1." in report
     # the same folders split by frame are another study: its fold results are not these
     from lv3d.experiment.runner import result_key
 

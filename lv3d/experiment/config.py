@@ -374,6 +374,14 @@ def _section(cls, raw: dict, key: str, where: str):
 OTHER_SHAPE = "other"
 
 
+def class_rule(split: str, folds: int) -> str:
+    """What a class of a study on folders must be to be learned and tested, in words: with ``split`` folders
+    (each folder a test fold) labelled in every folder, else (folds grouped by frame, each testing a frame of
+    every class) labelled in at least ``folds`` frames."""
+    return "labelled in every folder of data.folders" if split == "folders" else \
+        f"labelled in at least folds ({folds}) frames of data.folders"
+
+
 def learnable_classes(folders, classes, folds: int, where: str, split: str = "frames"
                       ) -> tuple[tuple[str, ...], dict[str, int]]:
     """The classes of ``classes`` a study on ``folders`` can learn and test: with ``split`` frames, those labelled
@@ -400,13 +408,12 @@ def learnable_classes(folders, classes, folds: int, where: str, split: str = "fr
     spread = {c: len({k for k, _ in fr}) if by_folder else len(fr) for c, fr in frames.items()}
     need, unit = (len(folders), "folder(s)") if by_folder else (folds, "frame(s)")
     kept = tuple(c for c in classes if spread.get(c, 0) >= need)
-    rule = "in every folder of data.folders (data.split folders: each folder is a test fold)" if by_folder else \
-        f"in at least folds ({folds}) frames of data.folders (the folds are grouped by frame, and each tests a frame " \
-        "of every class)"
+    why = "data.split folders: each folder is a test fold" if by_folder else \
+        "the folds are grouped by frame, and each tests a frame of every class"
     if len(kept) < 2:
         have = ", ".join(f"{c} {objects[c]} in {spread[c]} {unit}" for c in sorted(objects)) or "none"
-        raise InputError(where, f"data.classes: fewer than two of {', '.join(classes) or 'its classes'} are labelled "
-                                f"{rule}; the folders hold: {have}")
+        raise InputError(where, f"data.classes: fewer than two of {', '.join(classes) or 'its classes'} are "
+                                f"{class_rule(split, folds)} ({why}); the folders hold: {have}")
     return kept, {c: objects[c] for c in classes if c not in kept}
 
 

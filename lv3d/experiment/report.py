@@ -19,7 +19,7 @@ from pathlib import Path
 
 from ..learn.model import ANSWER_KINDS
 from ..output import write_atomic
-from .config import LOGIC_SYSTEMS, StudyConfig, is_number
+from .config import LOGIC_SYSTEMS, StudyConfig, class_rule, is_number
 from .folds import fold_path
 from .stats import ece, mean_std, paired, reliability_bins
 
@@ -112,7 +112,7 @@ def summarise(out: Path, cfg: StudyConfig, condition: str) -> tuple[dict, list[d
         left = next((r["left_out"] for r in recs if r.get("left_out") is not None), None)
         if left is not None:
             summary["left_out"] = {**left, "classes": dict(cfg.left_out_classes)}
-            summary["split"] = cfg.data.split
+            summary["class_rule"] = class_rule(cfg.data.split, cfg.folds)
             summary["examples"] = sum(len(r["test_ids"]) for r in recs)
         # settings a tuned baseline chose per fold (baselines.tune), with their inner cross-validation accuracy
         tuned = [{"fold": r["fold"], **r["tuned"]["setting"], "inner_accuracy": r["tuned"]["inner_accuracy"]}
@@ -370,8 +370,7 @@ def markdown(name: str, summaries: dict[str, dict], classes: list[str], closing:
         if left is not None:
             few = left.get("classes", {})
             other = ", ".join(f"{k} {v}" for k, v in sorted(left["other_classes"].items()) if k not in few) or "none"
-            why = "not labelled in every folder" if summ.get("split") == "folders" else "labelled in fewer frames than folds"
-            too_few = "".join(f", objects of {k}, a class {why}: {v}" for k, v in sorted(few.items()))
+            too_few = "".join(f", objects of {k}, a class not {summ['class_rule']}: {v}" for k, v in sorted(few.items()))
             lines += ["", f"Examples: {summ['examples']} labelled objects of the study's classes; left out: "
                       f"{len(left['unusable_rows'])} unusable rows of objects.csv, objects of other classes: {other}"
                       f"{too_few}. "

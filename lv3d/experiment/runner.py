@@ -419,13 +419,14 @@ def study_inputs(ccfg: StudyConfig, out: Path, executor=None, progress: bool = T
 
 def _real_examples(ccfg: StudyConfig, progress: bool, warned: set):
     """The labelled objects of the condition's folders; each unusable row of objects.csv, and each class of
-    data.classes left out for being labelled in fewer frames than folds, one line on stderr unless in ``warned``."""
+    data.classes left out (config.class_rule), one line on stderr unless in ``warned``."""
     from .real_data import real_data
 
+    from .config import class_rule
+
     rd = real_data(ccfg.data.folders, ccfg.data.classes)
-    rule = "in some folders of data.folders only" if ccfg.data.split == "folders" else \
-        f"in fewer frames of data.folders than folds ({ccfg.folds})"
-    lines = [f"data.classes: {c!r} is labelled {rule}: its {n} object{'' if n == 1 else 's'}"
+    rule = class_rule(ccfg.data.split, ccfg.folds)
+    lines = [f"data.classes: {c!r} is not {rule}: its {n} object{'' if n == 1 else 's'}"
              for c, n in ccfg.left_out_classes] + [str(p) for p in rd.problems]
     for line in lines:
         if progress and line not in warned:
