@@ -31,7 +31,7 @@ from ..errors import InputError
 from ..output import claim, clean_stale, locked, write_atomic
 from . import data as data_mod
 from .code_version import learner_version, learning_version
-from .config import LOGIC_SYSTEMS, TUNE_KEYS, Study, StudyConfig, digest, load_study
+from .config import LOGIC_SYSTEMS, TUNE_KEYS, Study, StudyConfig, class_rule, digest, load_study
 from .executor import LocalExecutor
 from .folds import Item, class_task, fold_path, grouped_folds, multiclass_task, split, stratified_folds
 from .report import write_report
@@ -64,7 +64,8 @@ def result_key(cfg: StudyConfig, system: str, fold: int, seen: str | None = None
     relevant["system"] = system
     relevant["fold"] = fold
     if system in LOGIC_SYSTEMS:
-        # workers: speed only; the default perception seed leaves the key as results made before it existed
+        # workers: speed only; the perception seed changes the facts, whose digest the key holds (at its default
+        # it is left out, as keys have always left it)
         relevant["settings"] = {k: v for k, v in d["lv3d"].items()
                                 if k != "workers" and not (k == "perception_seed" and v == 0)}
         if seen is None:
@@ -421,8 +422,6 @@ def _real_examples(ccfg: StudyConfig, progress: bool, warned: set):
     """The labelled objects of the condition's folders; each unusable row of objects.csv, and each class of
     data.classes left out (config.class_rule), one line on stderr unless in ``warned``."""
     from .real_data import real_data
-
-    from .config import class_rule
 
     rd = real_data(ccfg.data.folders, ccfg.data.classes)
     rule = class_rule(ccfg.data.split, ccfg.folds)
