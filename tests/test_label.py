@@ -10,7 +10,7 @@ import pytest
 from lv3d.cli.app import main
 from lv3d.cli.label import inner_pixel
 from lv3d.frame_folder import FrameFolder
-from tests.test_frame_folder import _write_folder
+from tests.test_frame_folder import _write_folder, frames  # noqa: F401  (frames: a fixture)
 
 
 @pytest.fixture(scope="module")
@@ -103,3 +103,22 @@ def test_a_folder_that_cannot_be_labelled_is_one_line(tmp_path, capsys):
     assert main(["label", str(tmp_path / "nowhere"), "--out", str(tmp_path / "o")]) == 2
     assert "not a folder" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_model_learned_on_labelled_frames_proposes_the_classes(frames, unlabelled, tmp_path, capsys):  # noqa: F811
+    model = tmp_path / "model"
+    assert main(["learn", "fit", "--data", str(frames), "--modality", "depth", "--cache", str(tmp_path / "cache"),
+                 "--out", str(model), "--time-limit", "20"]) == 0
+    capsys.readouterr()
+    folder, truth = unlabelled
+    out = tmp_path / "proposal"
+    assert main(["label", str(folder), "--out", str(out), "--model", str(model)]) == 0
+    assert "with the class" in capsys.readouterr().out
+    rows = {(r["frame"], r["object"]): r for r in csv.DictReader((out / "objects.csv").open())}
+    # the rendered cube and prism (object 1 of their frames) get the classes the labelled frames taught
+    assert rows[("a-1", "1")]["shape"] == "box" and rows[("b 2", "1")]["shape"] == "prism"
+    assert rows[("big", "1")]["shape"] == "prism"  # the prism again, at four times the size
+    assert "; model: box " in rows[("a-1", "1")]["notes"]
+    assert all(r["shape"] in ("", "box", "prism") for r in rows.values())
+    assert main(["label", str(folder), "--out", str(tmp_path / "p2"), "--model", str(tmp_path / "nowhere")]) == 2
+

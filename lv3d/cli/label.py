@@ -8,6 +8,10 @@ what perception made of it (its faces by surface, its size). ``DIR/overlays/<fra
 writes its number at that pixel. Fill in each row's class, delete the rows of objects you do not want to label,
 and put the file in FOLDER as its objects.csv; a row whose shape stays empty is left out, with a warning naming
 its line. FOLDER itself is only read.
+
+With ``--model MODEL`` (a model ``lv3d learn fit`` wrote, from frames labelled before), each object's class is
+proposed too: the model's answer on the object's facts, as ``lv3d learn predict`` would give it on the file
+(``notes`` adds the answer's confidence); an object it gives no class to keeps an empty shape.
 """
 
 from __future__ import annotations
@@ -63,6 +67,26 @@ def proposed_rows(name: str, frame, scene) -> list[dict]:
     return rows
 
 
+def model_answers(model, modality: str, frame, name: str, rows: list[dict], seed: int) -> None:
+    """Fill in each row's shape with ``model``'s answer on its object's facts (as ``modality`` sees the frame,
+    perceived and grounded as lv3d learn predict does: lv3d.object_facts.frame_facts) and add the answer to its
+    notes; a row the model answers "unknown" (no program proves it, or no object lies under its pixel) keeps
+    an empty shape."""
+    from ..frame_folder import scene_atom
+    from ..object_facts import example_facts, example_id, frame_facts
+
+    if not rows:
+        return
+    atom, s = scene_atom(name), frame.scale
+    ff = frame_facts(frame, atom, modality, [(r["object"], r["u"] // s, r["v"] // s) for r in rows], seed=seed)
+    for r in rows:
+        facts = example_facts(ff, r["object"], example_id(atom, r["object"]))
+        label, conf = model.predict(facts) if facts.target is not None else ("unknown", 0.0)
+        if label in model.programs:
+            r["shape"] = label
+        r["notes"] += f"; model: {label} {conf:.2f}"
+
+
 def numbered_overlay(frame, scene, rows: list[dict]) -> np.ndarray:
     """(H, W, 3) uint8 BGR: the frame's colour (as read) with each object's segment outlined and its number
     written at its row's pixel."""
@@ -104,13 +128,26 @@ def frame_names(folder: Path) -> list[str]:
               help="Perception's seed (its sample consensus).")
 @click.option("--max-objects", type=click.IntRange(min=1), default=None,
               help="At most this many objects a frame, the largest (default 24).")
-def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None) -> None:
+@click.option("--model", "model_dir", type=click.Path(path_type=Path), default=None,
+              help="A model lv3d learn fit wrote: propose each object's class as its answer.")
+def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None, model_dir: Path | None) -> None:
     """Propose objects.csv for the frames of FOLDER: a row per object depth perception finds, its class to fill in."""
+    from .. import compile_cache
     from ..perception.perceive import perceive
     from ..rgbd import load_real
 
     names = frame_names(folder)
-    check_out(out_dir, (folder,))  # before any work
+    check_out(out_dir, (folder, model_dir))  # before any work
+    model = modality = None
+    if model_dir is not None:
+        from ..learn.model import Model
+
+        compile_cache.enable()  # an entry point that grounds: grounding's compiled programs are kept on disk
+        model = Model.load(model_dir)
+        if not model.programs:
+            raise InputError(model_dir, "the model holds no program")
+        learned = sorted({p.modality for p in model.programs.values() if p.modality})
+        modality = learned[0] if learned else "rgbd"
     rows, overlays, unread, empty = [], {}, [], []
     for name in tqdm(names, desc="frames", unit="frame", disable=None, leave=False):
         try:
@@ -121,6 +158,8 @@ def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None) -> No
             continue
         scene = perceive(frame, "depth", seed=seed, max_objects=max_objects)
         mine = proposed_rows(name, frame, scene)
+        if model is not None:
+            model_answers(model, modality, frame, name, mine, seed)
         if not mine:
             empty.append(name)
         rows += mine
@@ -129,7 +168,7 @@ def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None) -> No
     writer = csv.DictWriter(text, fieldnames=COLUMNS, lineterminator="\n")
     writer.writeheader()
     writer.writerows(rows)
-    with replacing(out_dir, (folder,)) as tmp:
+    with replacing(out_dir, (folder, model_dir)) as tmp:
         (tmp / "objects.csv").write_text(text.getvalue())
         (tmp / "overlays").mkdir()
         for name, image in overlays.items():
@@ -140,7 +179,8 @@ def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None) -> No
 
     left = "".join(f"; {count(len(v), 'frame')} {what}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}"
                    for v, what in ((empty, "with no object"), (unread, "not read")) if v)
+    answered = f", {sum(bool(r['shape']) for r in rows)} with the class {model_dir} answers" if model else ""
     click.echo(f"{out_dir / 'objects.csv'}: {count(len(rows), 'object')} in {count(len(names) - len(unread), 'frame')}"
-               f"{left}. "
+               f"{answered}{left}. "
                f"Fill in each row's shape (delete the rows you do not want; {out_dir / 'overlays'} numbers the "
                f"objects), then put the file in {folder} as objects.csv.")
