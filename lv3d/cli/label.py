@@ -11,7 +11,9 @@ its line. FOLDER itself is only read.
 
 With ``--model MODEL`` (a model ``lv3d learn fit`` wrote, from frames labelled before), each object's class is
 proposed too: the model's answer on the object's facts, as ``lv3d learn predict`` would give it on the file
-(``notes`` adds the answer's confidence); an object it gives no class to keeps an empty shape.
+(``notes`` adds the answer and its confidence); where the answer is no class the model holds a program for (no
+object under the pixel, "unknown", or the class of the training object it resembles most, which it was not
+asked to learn), the shape stays empty.
 """
 
 from __future__ import annotations
@@ -70,8 +72,7 @@ def proposed_rows(name: str, frame, scene) -> list[dict]:
 def model_answers(model, modality: str, frame, name: str, rows: list[dict], seed: int) -> None:
     """Fill in each row's shape with ``model``'s answer on its object's facts (as ``modality`` sees the frame,
     perceived and grounded as lv3d learn predict does: lv3d.object_facts.frame_facts) and add the answer to its
-    notes; a row the model answers "unknown" (no program proves it, or no object lies under its pixel) keeps
-    an empty shape."""
+    notes; a row whose answer is no class the model holds a program for keeps an empty shape."""
     from ..frame_folder import scene_atom
     from ..object_facts import example_facts, example_id, frame_facts
 
