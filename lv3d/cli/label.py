@@ -106,6 +106,10 @@ def numbered_overlay(frame, scene, rows: list[dict]) -> np.ndarray:
     return out
 
 
+def _count(n: int, what: str) -> str:
+    return f"{n} {what}" if n == 1 else f"{n} {what}s"
+
+
 def frame_names(folder: Path) -> list[str]:
     """The frames of ``folder`` in natural order; an InputError naming the folder when it cannot be labelled."""
     from ..frame_folder import natural_key
@@ -175,13 +179,10 @@ def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None, model
         for name, image in overlays.items():
             if not cv2.imwrite(str(tmp / "overlays" / f"{name}.png"), image):
                 raise InputError(out_dir, f"cannot write overlays/{name}.png")
-    def count(n: int, what: str) -> str:
-        return f"{n} {what}" if n == 1 else f"{n} {what}s"
-
-    left = "".join(f"; {count(len(v), 'frame')} {what}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}"
+    left = "".join(f"; {_count(len(v), 'frame')} {what}: {', '.join(v[:5])}{' ...' if len(v) > 5 else ''}"
                    for v, what in ((empty, "with no object"), (unread, "not read")) if v)
     answered = f", {sum(bool(r['shape']) for r in rows)} with the class {model_dir} answers" if model else ""
-    click.echo(f"{out_dir / 'objects.csv'}: {count(len(rows), 'object')} in {count(len(names) - len(unread), 'frame')}"
-               f"{answered}{left}. "
+    frames = _count(len(names) - len(unread), "frame")
+    click.echo(f"{out_dir / 'objects.csv'}: {_count(len(rows), 'object')} in {frames}{answered}{left}. "
                f"Fill in each row's shape (delete the rows you do not want; {out_dir / 'overlays'} numbers the "
                f"objects), then put the file in {folder} as objects.csv.")
