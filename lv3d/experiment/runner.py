@@ -356,9 +356,10 @@ def _run(study: Study, out: Path, progress: bool, executor) -> dict:
         for s in ccfg.systems:
             for k in range(ccfg.folds):
                 path, key = fold_path(out, cname, s, k), result_key(ccfg, s, k, seen.get(s))
-                if _finished(path, key):
+                record = _finished(path, key)
+                if record is not None:
                     if s in LOGIC_SYSTEMS:
-                        _holds_under(path, learner_version())
+                        _holds_under(path, record, learner_version())
                     continue
                 if key in done:  # same system, data and settings in another condition (a baseline in an ablation)
                     record = json.loads(done[key].read_text())
@@ -450,21 +451,21 @@ def _finished_keys(out: Path) -> dict[str, Path]:
     return keys
 
 
-def _holds_under(path: Path, code: str) -> None:
-    """Record in an lv3d fold file, kept because its key matched, that its results hold under lv3d code version
-    ``code`` too (the same facts, the same learning code) where that is not the version that computed them: the
-    report names both (``holds_under``)."""
-    record = json.loads(path.read_text())
+def _holds_under(path: Path, record: dict, code: str) -> None:
+    """Record in the lv3d fold file ``path`` (holding ``record``), kept because its key matched, that its results
+    hold under lv3d code version ``code`` too (the same facts, the same learning code) where that is not the
+    version that computed them: the report names both (``holds_under``)."""
     if record.get("code") in (None, code) or code in record.get("holds_under", []):
         return
-    record["holds_under"] = [*record.get("holds_under", []), code]
-    _write_json(path, record)
+    _write_json(path, {**record, "holds_under": [*record.get("holds_under", []), code]})
 
 
-def _finished(path: Path, key: str) -> bool:
+def _finished(path: Path, key: str) -> dict | None:
+    """The fold file's record where it is finished with ``key``, else None."""
     if not path.is_file():
-        return False
+        return None
     try:
-        return json.loads(path.read_text()).get("key") == key
+        record = json.loads(path.read_text())
+        return record if record.get("key") == key else None
     except (OSError, ValueError, AttributeError):
-        return False
+        return None
