@@ -145,13 +145,10 @@ def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None, model
     check_out(out_dir, (folder, model_dir))  # before any work
     model = modality = None
     if model_dir is not None:
-        from ..learn.model import Model
+        from .learn import load_model
 
         compile_cache.enable()  # an entry point that grounds: grounding's compiled programs are kept on disk
-        model = Model.load(model_dir)
-        if not model.programs:
-            raise InputError(model_dir, "the model holds no program")
-        learned = sorted({p.modality for p in model.programs.values() if p.modality})
+        model, learned = load_model(model_dir)
         modality = learned[0] if learned else "rgbd"
     rows, overlays, unread, empty = [], {}, [], []
     for name in tqdm(names, desc="frames", unit="frame", disable=None, leave=False):

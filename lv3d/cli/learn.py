@@ -169,15 +169,21 @@ def fit(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | 
         click.echo(f"no program for {c}: {why}", err=True)
 
 
-def _model_and_scenes(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, model_dir: Path,
-                      warn: set[str] | None = None):
-    """The model of ``model_dir`` and the scenes of ``data`` (:func:`_examples`, its ``warn``)."""
+def load_model(model_dir: Path):
+    """(the model saved in ``model_dir``, the modalities its programs were learned from, sorted); an InputError
+    naming the folder where it holds no program."""
     from ..learn.model import Model
 
     model = Model.load(model_dir)
-    learned = sorted({p.modality for p in model.programs.values() if p.modality})
     if not model.programs:
         raise InputError(model_dir, "the model holds no program")
+    return model, sorted({p.modality for p in model.programs.values() if p.modality})
+
+
+def _model_and_scenes(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, model_dir: Path,
+                      warn: set[str] | None = None):
+    """The model of ``model_dir`` and the scenes of ``data`` (:func:`_examples`, its ``warn``)."""
+    model, learned = load_model(model_dir)
     if learned and learned != [modality]:
         raise InputError("--modality", f"the model in {model_dir} was learned from {', '.join(learned)} facts; "
                                        f"predict with --modality {learned[0]}")
