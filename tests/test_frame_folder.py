@@ -3,37 +3,12 @@ object, learning from such a folder on the command line and in a study."""
 
 import json
 
-import cv2
-import numpy as np
 import pytest
 
 from lv3d.cli.app import main
 from lv3d.frame_folder import FrameFolder, scene_atom
 from lv3d.object_facts import example_facts, example_id, frame_facts
-
-CLASSES = {"cube": "box", "triangular_prism": "prism"}
-
-
-def _write_folder(folder, frames):
-    """Rendered frames written in the real layout: (name, rendered class, seed) each; objects.csv labels the
-    target at the centre of its faces' pixels."""
-    from lv3d.render.frame import render_scene
-
-    folder.mkdir()
-    intr, rows = {"width": 320, "height": 240, "frames": {}}, ["frame,object,u,v,shape,partial,stacked,notes"]
-    for name, cls, seed in frames:
-        frame, faces = render_scene(cls, seed, "clean", 320, 240)
-        cv2.imwrite(str(folder / f"{name}_rgb.png"), cv2.cvtColor(frame.color, cv2.COLOR_RGB2BGR))
-        cv2.imwrite(str(folder / f"{name}_depth_mm.png"), np.round(frame.depth * 1000).astype(np.uint16))
-        k = frame.intrinsics
-        intr["frames"][name] = {"fx": k.fx, "fy": k.fy, "cx": k.cx, "cy": k.cy, "depth_scale_m": 0.001}
-        v, u = np.nonzero(faces)
-        i = int(np.argmin(np.hypot(u - u.mean(), v - v.mean())))  # a pixel of the object nearest its centre
-        rows.append(f"{name},1,{u[i]},{v[i]},{CLASSES[cls]},no,no,")
-    (folder / "intrinsics.json").write_text(json.dumps(intr))
-    (folder / "objects.csv").write_text("\n".join(rows) + "\n")
-    return folder
-
+from tests.conftest import FOLDER_CLASSES, write_frame_folder
 
 def _with_rows(frames, folder, rows):
     """A copy of the folder ``frames`` at ``folder`` with ``rows`` (objects.csv lines) added to its objects.csv."""
@@ -43,12 +18,6 @@ def _with_rows(frames, folder, rows):
     with (folder / "objects.csv").open("a") as f:
         f.writelines(f"{row}\n" for row in rows)
     return folder
-
-
-@pytest.fixture(scope="module")
-def frames(tmp_path_factory):
-    names = [(f"frame-{i:03d}", cls, 11 + i) for i, cls in enumerate(["cube", "triangular_prism"] * 3)]
-    return _write_folder(tmp_path_factory.mktemp("real") / "frames", names)
 
 
 def test_rows_that_cannot_be_used_are_named_by_file_and_line_and_the_rest_are_read(tmp_path, frames):
@@ -276,8 +245,8 @@ def test_a_study_on_folders_needs_two_classes_it_can_test_in_every_fold(frames, 
 def test_the_demo_learns_from_labelled_frames_and_explains_a_real_object(tmp_path, monkeypatch, capsys):
     from lv3d.cli import demo
 
-    monkeypatch.setitem(CLASSES, "triangular_prism", "cylinder")  # the demo learns box and cylinder
-    folder = _write_folder(tmp_path / "frames", [(f"f{i}", cls, 21 + i)
+    monkeypatch.setitem(FOLDER_CLASSES, "triangular_prism", "cylinder")  # the demo learns box and cylinder
+    folder = write_frame_folder(tmp_path / "frames", [(f"f{i}", cls, 21 + i)
                                                  for i, cls in enumerate(["cube", "triangular_prism"] * 4)])
     got = demo.real_step(folder, tmp_path / "out", seed=0)
     out = capsys.readouterr().out
@@ -292,7 +261,7 @@ def test_a_study_split_by_folder_learns_from_one_folder_and_tests_on_the_other(f
     from lv3d.experiment.config import load_study
     from lv3d.experiment.runner import run_study
 
-    other = _write_folder(tmp_path / "other", [(f"g{i}", cls, 41 + i) for i, cls in enumerate(["cube", "triangular_prism"] * 2)])
+    other = write_frame_folder(tmp_path / "other", [(f"g{i}", cls, 41 + i) for i, cls in enumerate(["cube", "triangular_prism"] * 2)])
     # a ball in one folder only: no fold could both learn and test it
     other = _with_rows(other, tmp_path / "sensor2", ["g0,2,5,5,ball,no,no,"])
     config = tmp_path / "across.yaml"

@@ -10,14 +10,14 @@ import pytest
 from lv3d.cli.app import main
 from lv3d.cli.label import inner_pixel
 from lv3d.frame_folder import FrameFolder
-from tests.test_frame_folder import _write_folder, frames  # noqa: F401  (frames: a fixture)
+from tests.conftest import write_frame_folder
 
 
 @pytest.fixture(scope="module")
 def unlabelled(tmp_path_factory):
     """Two rendered frames in the real layout, their objects.csv removed, and the second also written at four
     times its size (1280x960, read at half of it: lv3d.rgbd.working_factor)."""
-    folder = _write_folder(tmp_path_factory.mktemp("label") / "frames",
+    folder = write_frame_folder(tmp_path_factory.mktemp("label") / "frames",
                            [("a-1", "cube", 11), ("b 2", "triangular_prism", 12)])
     truth = {row["frame"]: (int(row["u"]), int(row["v"])) for row in csv.DictReader((folder / "objects.csv").open())}
     (folder / "objects.csv").unlink()
@@ -105,7 +105,7 @@ def test_a_folder_that_cannot_be_labelled_is_one_line(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
-def test_a_model_learned_on_labelled_frames_proposes_the_classes(frames, unlabelled, tmp_path, capsys):  # noqa: F811
+def test_a_model_learned_on_labelled_frames_proposes_the_classes(frames, unlabelled, tmp_path, capsys):
     model = tmp_path / "model"
     assert main(["learn", "fit", "--data", str(frames), "--modality", "depth", "--cache", str(tmp_path / "cache"),
                  "--out", str(model), "--time-limit", "20"]) == 0
