@@ -4,8 +4,9 @@ version OLD for the same images, modality, refine setting and perception seed, b
     .venv/bin/python scripts/compare_facts.py RUNS OLD NEW     # e.g. RUNS=runs/rerun, OLD and NEW facts versions
 
 A change meant to keep perception's output (a refactor, dead code removed) changes the facts version all the
-same (lv3d/experiment/code_version.py), and every report must then be rerun; this says whether the facts it
-computed are those of the previous version, so that the calibration maps, fitted on them, still hold. The
+same (lv3d/experiment/code_version.py), so every study's facts are computed anew; this says whether they are
+those of the previous version, so that the calibration maps, fitted on them, still hold (the studies keep their
+lv3d results wherever the facts are the same, lv3d/experiment/runner.result_key). The
 facts versions are ``python -c "from lv3d.experiment.code_version import facts_version; print(facts_version())"``
 at each commit.
 
