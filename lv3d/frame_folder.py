@@ -110,21 +110,30 @@ def is_frame_folder(path: Path) -> bool:
     return Path(path).is_dir() and (Path(path) / "objects.csv").is_file()
 
 
+def frame_files(path: Path, labelled: bool = True) -> dict:
+    """The frames of a real-layout folder (lv3d.rgbd.real_frame_files: name -> its files), after checking the
+    folder: it exists, holds intrinsics.json, with ``labelled`` objects.csv too, and at least one frame (a colour
+    image with its depth). An InputError naming the folder otherwise."""
+    path = Path(path)
+    if not path.is_dir():
+        raise InputError(path, "not a folder")
+    for name in ("objects.csv", "intrinsics.json") if labelled else ("intrinsics.json",):
+        if not (path / name).is_file():
+            what = "labelled frames" if labelled else "frames"
+            raise InputError(path, f"no {name} (a folder of {what} needs the layout of docs/real_frames.md)")
+    files = real_frame_files(path)
+    if not files:
+        raise InputError(path, "no frames (<frame>_rgb.png with <frame>_depth_mm.png)")
+    return files
+
+
 class FrameFolder:
-    """A real-layout folder, validated on opening: it exists, holds intrinsics.json, objects.csv and at least
-    one frame (a colour image with its depth)."""
+    """A real-layout folder, validated on opening (:func:`frame_files`): it exists, holds intrinsics.json,
+    objects.csv and at least one frame (a colour image with its depth)."""
 
     def __init__(self, path: Path):
         self.path = Path(path)
-        if not self.path.is_dir():
-            raise InputError(self.path, "not a folder")
-        for name in ("objects.csv", "intrinsics.json"):
-            if not (self.path / name).is_file():
-                raise InputError(self.path, f"no {name} (a folder of labelled frames needs the layout of "
-                                            f"docs/real_frames.md)")
-        self.files = real_frame_files(self.path)
-        if not self.files:
-            raise InputError(self.path, "no frames (<frame>_rgb.png with <frame>_depth_mm.png)")
+        self.files = frame_files(self.path)
 
     @property
     def frames(self) -> list[str]:

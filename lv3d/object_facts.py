@@ -15,7 +15,7 @@ pixel, over :func:`face_cover`), and flag a perceived object that holds another 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import cv2
 import numpy as np
@@ -155,10 +155,18 @@ def frame_facts(frame: RGBD, frame_atom: str, modality: str, labels: list[tuple[
                 refine: bool = True, seed: int = 0) -> FrameFacts:
     """Perceive and ground ``frame`` once as ``modality`` sees it; ``labels``: (object, u, v) of each labelled
     object. Only the labelled objects are refined and kept. ``seed``: perception's (perceive)."""
-    from .describe import describe
     from .perception import perceive
 
-    scene = perceive(frame, modality, scene_id=frame_atom, seed=seed)
+    return labelled_facts(perceive(frame, modality, scene_id=frame_atom, seed=seed), frame, labels, refine=refine)
+
+
+def labelled_facts(scene: Scene, frame: RGBD, labels: list[tuple[int, int, int]], *,
+                   refine: bool = True) -> FrameFacts:
+    """:func:`frame_facts` of a frame already perceived: ``scene`` is ``frame`` perceived (its id the frame's
+    atom, its modality the facts'). The scene is left as it was."""
+    from .describe import describe
+
+    frame_atom, modality = scene.id, scene.modality
     shape = frame.depth.shape
     under: dict[int, str | None] = {}
     boxes: dict[int, list[int] | None] = {}
@@ -170,8 +178,8 @@ def frame_facts(frame: RGBD, frame_atom: str, modality: str, labels: list[tuple[
         return FrameFacts(frame.name, modality, SceneFacts(frame_atom, modality, [], None), under, boxes,
                           "perception found no object in this frame")
     keep = frozenset(i for i in under.values() if i is not None)
-    scene.objects = [o for o in scene.objects if o.id in keep]
-    facts = describe(scene, frame, refine=refine, refine_ids=keep).for_modality(modality)
+    labelled = replace(scene, objects=[o for o in scene.objects if o.id in keep])
+    facts = describe(labelled, frame, refine=refine, refine_ids=keep).for_modality(modality)
     return FrameFacts(frame.name, modality, facts, under, boxes, None)
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from lv3d.cli.app import main
 from lv3d.frame_folder import FrameFolder, scene_atom
-from lv3d.object_facts import example_facts, example_id, frame_facts
+from lv3d.object_facts import example_facts, example_id, frame_facts, labelled_facts
 from tests.conftest import FOLDER_CLASSES, write_frame_folder
 
 def _with_rows(frames, folder, rows):
@@ -78,6 +78,20 @@ def test_each_labelled_object_is_an_example_of_its_own(frames, modality):
     # a label in the image's corner, on no object: an example with no target
     assert ff.under[9] is None and example_facts(ff, 9, example_id(atom, 9)).target is None
     assert json.loads(json.dumps(ff.to_json())) == type(ff).from_json(ff.to_json()).to_json()
+
+
+@pytest.mark.parametrize("modality", ["depth", "rgbd"])
+def test_facts_of_a_frame_already_perceived_are_those_of_perceiving_it(frames, modality):
+    from lv3d.perception import perceive
+
+    folder = FrameFolder(frames)
+    labs = folder.objects()[0][:2]
+    frame, atom = folder.load(labs[0].frame), scene_atom(labs[0].frame)
+    labels = [(lab.object, lab.u, lab.v) for lab in labs if lab.frame == labs[0].frame] + [(9, 2, 2)]
+    scene = perceive(frame, modality, scene_id=atom)
+    before = [o.id for o in scene.objects]
+    assert labelled_facts(scene, frame, labels).to_json() == frame_facts(frame, atom, modality, labels).to_json()
+    assert [o.id for o in scene.objects] == before  # the scene is left as it was
 
 
 def test_learn_fit_predict_and_explain_on_a_folder_of_frames(frames, tmp_path, capsys):

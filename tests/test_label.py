@@ -105,15 +105,26 @@ def test_a_folder_that_cannot_be_labelled_is_one_line(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
-def test_a_model_learned_on_labelled_frames_proposes_the_classes(frames, unlabelled, tmp_path, capsys):
+def test_a_model_learned_on_labelled_frames_proposes_the_classes(frames, unlabelled, tmp_path, capsys, monkeypatch):
+    import importlib
+
+    import lv3d.perception
+
+    perceive_module = importlib.import_module("lv3d.perception.perceive")  # the module: the package names the function
+
+    seen, perceive = [], perceive_module.perceive  # each frame is perceived once, for its rows and its facts alike
+    for where in (lv3d.perception, perceive_module):
+        monkeypatch.setattr(where, "perceive", lambda frame, *a, **k: seen.append(frame.name) or perceive(frame, *a, **k))
     model = tmp_path / "model"
     assert main(["learn", "fit", "--data", str(frames), "--modality", "depth", "--cache", str(tmp_path / "cache"),
                  "--out", str(model), "--time-limit", "20"]) == 0
     capsys.readouterr()
     folder, truth = unlabelled
     out = tmp_path / "proposal"
+    seen.clear()
     assert main(["label", str(folder), "--out", str(out), "--model", str(model)]) == 0
     assert "with the class" in capsys.readouterr().out
+    assert sorted(seen) == ["a-1", "b 2", "big"]
     rows = {(r["frame"], r["object"]): r for r in csv.DictReader((out / "objects.csv").open())}
     # the rendered cube and prism (object 1 of their frames) get the classes the labelled frames taught
     assert rows[("a-1", "1")]["shape"] == "box" and rows[("b 2", "1")]["shape"] == "prism"

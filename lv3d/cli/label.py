@@ -13,7 +13,10 @@ With ``--model MODEL`` (a model ``lv3d learn fit`` wrote, from frames labelled b
 proposed too: the model's answer on the object's facts, as ``lv3d learn predict`` would give it on the file
 (``notes`` adds the answer and its confidence); where the answer is no class the model holds a program for (no
 object under the pixel, "unknown", or the class of the training object it resembles most, which it was not
-asked to learn), the shape stays empty.
+asked to learn), the shape stays empty. Each frame is perceived once: a model of rgbd facts reads the frame as
+rgbd perceives it, whose objects are depth's with their faces fused with colour's (so the rows are those depth
+gives, and ``notes`` counts rgbd's faces; where depth finds no object, rgbd's are colour's); a model of colour alone
+reads the frame perceived a second time, as colour sees it.
 """
 
 from __future__ import annotations
@@ -69,19 +72,23 @@ def proposed_rows(name: str, frame, scene) -> list[dict]:
     return rows
 
 
-def model_answers(model, modality: str, frame, name: str, rows: list[dict], seed: int) -> None:
-    """Fill in each row's shape with ``model``'s answer on its object's facts (as ``modality`` sees the frame,
-    perceived and grounded as lv3d learn predict does: lv3d.object_facts.frame_facts) and add the answer to its
-    notes; a row whose answer is no class the model holds a program for keeps an empty shape."""
-    from ..frame_folder import scene_atom
-    from ..object_facts import example_facts, example_id, frame_facts
+def model_answers(model, modality: str, frame, scene, rows: list[dict], seed: int) -> None:
+    """Fill in each row's shape with ``model``'s answer on its object's facts and add the answer to its notes; a
+    row whose answer is no class the model holds a program for keeps an empty shape. The facts are those lv3d
+    learn predict reads: ``scene`` (the frame perceived as the model's modality sees it, the rows' objects among
+    its objects) grounded (lv3d.object_facts.labelled_facts); for a model of colour alone, whose objects are not
+    depth's, the frame is perceived as colour sees it (lv3d.object_facts.frame_facts, with ``seed``). ``modality``:
+    the one the model's programs were learned from."""
+    from ..object_facts import example_facts, example_id, frame_facts, labelled_facts
 
     if not rows:
         return
-    atom, s = scene_atom(name), frame.scale
-    ff = frame_facts(frame, atom, modality, [(r["object"], r["u"] // s, r["v"] // s) for r in rows], seed=seed)
+    s = frame.scale
+    labels = [(r["object"], r["u"] // s, r["v"] // s) for r in rows]
+    ff = labelled_facts(scene, frame, labels) if scene.modality == modality else \
+        frame_facts(frame, scene.id, modality, labels, seed=seed)
     for r in rows:
-        facts = example_facts(ff, r["object"], example_id(atom, r["object"]))
+        facts = example_facts(ff, r["object"], example_id(scene.id, r["object"]))
         label, conf = model.predict(facts) if facts.target is not None else ("unknown", 0.0)
         if label in model.programs:
             r["shape"] = label
@@ -112,17 +119,9 @@ def _count(n: int, what: str) -> str:
 
 def frame_names(folder: Path) -> list[str]:
     """The frames of ``folder`` in natural order; an InputError naming the folder when it cannot be labelled."""
-    from ..frame_folder import natural_key
-    from ..rgbd import real_frame_files
+    from ..frame_folder import frame_files, natural_key
 
-    if not folder.is_dir():
-        raise InputError(folder, "not a folder")
-    if not (folder / "intrinsics.json").is_file():
-        raise InputError(folder, "no intrinsics.json (a folder of frames needs the layout of docs/real_frames.md)")
-    files = real_frame_files(folder)
-    if not files:
-        raise InputError(folder, "no frames (<frame>_rgb.png with <frame>_depth_mm.png)")
-    return sorted(files, key=natural_key)
+    return sorted(frame_files(folder, labelled=False), key=natural_key)
 
 
 @click.command()
@@ -138,6 +137,7 @@ def frame_names(folder: Path) -> list[str]:
 def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None, model_dir: Path | None) -> None:
     """Propose objects.csv for the frames of FOLDER: a row per object depth perception finds, its class to fill in."""
     from .. import compile_cache
+    from ..frame_folder import scene_atom
     from ..perception.perceive import perceive
     from ..rgbd import load_real
 
@@ -158,10 +158,12 @@ def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None, model
             unread.append(name)
             tqdm.write(f"lv3d: warning: {' '.join(str(e).split())} (frame {name!r} left out)", file=sys.stderr)
             continue
-        scene = perceive(frame, "depth", seed=seed, max_objects=max_objects)
+        # rgbd's objects are depth's (its faces fused with colour's), so a model of rgbd facts reads the same scene
+        scene = perceive(frame, modality if modality in ("depth", "rgbd") else "depth", scene_id=scene_atom(name),
+                         seed=seed, max_objects=max_objects)
         mine = proposed_rows(name, frame, scene)
         if model is not None:
-            model_answers(model, modality, frame, name, mine, seed)
+            model_answers(model, modality, frame, scene, mine, seed)
         if not mine:
             empty.append(name)
         rows += mine
