@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import csv
 import hashlib
-import json
 import re
 from dataclasses import dataclass
 from functools import cached_property
@@ -249,15 +248,16 @@ class FrameFolder:
         return lab
 
     def signature(self) -> str:
-        """A digest of what the folder holds (objects.csv, intrinsics.json, each frame file's name, size and
-        modification time): cached facts of the folder are reused only while it is the same."""
+        """A digest of what the folder holds: the bytes of objects.csv, intrinsics.json and each frame's colour and
+        depth files, with their names. Cached facts of the folder are reused while it holds the same; a copy of it
+        elsewhere, or the same files written anew, is the same folder."""
         h = hashlib.sha256()
         for name in ("objects.csv", "intrinsics.json"):
             h.update((self.path / name).read_bytes())
         for frame in self.frames:
             for p in self.files[frame]:
-                st = p.stat()
-                h.update(json.dumps([p.name, st.st_size, st.st_mtime_ns]).encode())
+                h.update(p.name.encode())
+                h.update(hashlib.sha256(p.read_bytes()).digest())
         return h.hexdigest()[:16]
 
 

@@ -11,8 +11,8 @@ facts versions are ``python -c "from lv3d.experiment.code_version import facts_v
 at each commit.
 
 The caches under RUNS hold ``.../facts/<key>/<version>/<variant>/<id>.json`` (experiments/README.md). A file of
-NEW is paired with OLD's under the same key; where the key differs (a real folder's key digests its path, which a
-worktree changes), with OLD's folder of the same variant holding the same file names. Prints the files alike,
+NEW is paired with OLD's under the same key; where OLD has no folder of that key (another version of the code may
+key the same frames otherwise), with OLD's folder of the same variant holding the same file names. Prints the files alike,
 those that differ (the first ten named) and those with no counterpart; exits 1 where any differ.
 """
 

@@ -57,6 +57,23 @@ def test_a_folder_not_in_the_layout_is_one_clear_error(tmp_path):
         FrameFolder(tmp_path).objects()
 
 
+def test_a_folder_is_known_by_its_content_wherever_it_lies(frames, tmp_path):
+    import os
+    import shutil
+
+    from lv3d.experiment.real_data import real_data
+
+    copy = tmp_path / "elsewhere" / frames.name
+    shutil.copytree(frames, copy)
+    for p in copy.iterdir():  # written anew: other times, the same bytes
+        os.utime(p, ns=(0, 0))
+    key = real_data([frames]).key
+    assert real_data([copy]).key == key  # so its cached facts and study results are kept
+    depth = sorted(copy.glob("*_depth_mm.png"))[0]
+    depth.write_bytes(depth.read_bytes() + b"\0")  # one byte more in one frame: another folder
+    assert real_data([copy]).key != key
+
+
 def test_frame_names_become_distinct_prolog_atoms():
     names = ["learn0", "frame-000000", "frame_000000", "0001", "Frame-000000", "ä"]
     atoms = [scene_atom(n) for n in names]

@@ -9,7 +9,8 @@ test fold), and what each system sees of it is computed once per frame and cache
   rgbd perception found under its pixel (a square of a quarter of the frame's height around the pixel where
   it found none), the input of the statistical baselines.
 
-The folders digest covers each folder's path and content (FrameFolder.signature) and the study classes.
+The folders digest covers each folder's name and content (FrameFolder.signature: its files' bytes, not where it
+lies or when they were written) and the study classes, so a copy of the folders keeps their caches.
 Rows of objects.csv that cannot be used, and objects of classes the study does not learn, are left out
 and counted (``RealData.left_out``); the runner prints the unusable rows, one line each.
 """
@@ -18,6 +19,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -50,11 +52,13 @@ class RealData:
     problems: list[Problem] = field(default_factory=list)
     other_classes: dict[str, int] = field(default_factory=dict)  # class -> objects left out (not a study class)
 
-    @property
+    @cached_property
     def key(self) -> str:
+        """What the examples are made of: each folder's name and content (FrameFolder.signature), not where it lies,
+        and the study's classes."""
         from .config import digest
 
-        return "real-" + digest({"folders": [[str(f.path.resolve()), f.signature()] for f in self.folders],
+        return "real-" + digest({"folders": [[f.name, f.signature()] for f in self.folders],
                                  "classes": sorted({it.cls for it in self.items})})
 
     @property
