@@ -50,10 +50,14 @@ def inner_pixel(mask: np.ndarray) -> tuple[int, int]:
     return int(u), int(v)
 
 
+def _count(n: int, what: str) -> str:
+    return f"{n} {what}" if n == 1 else f"{n} {what}s"
+
+
 def surfaces_note(obj) -> str:
     """What perception made of an object, for the notes column: its faces by surface and its size."""
     kinds = Counter(f.surface or "plane" for f in obj.faces)
-    faces = " + ".join(f"{n} {kind}{'' if n == 1 else 's'}" for kind, n in sorted(kinds.items())) or "no face"
+    faces = " + ".join(_count(n, kind) for kind, n in sorted(kinds.items())) or "no face"
     return f"perceived: {faces}; {obj.pixel_count} px"
 
 
@@ -111,10 +115,6 @@ def numbered_overlay(frame, scene, rows: list[dict]) -> np.ndarray:
         cv2.rectangle(out, (org[0] - 2, org[1] - h - 2), (org[0] + w + 2, org[1] + base), (20, 20, 20), -1)
         cv2.putText(out, label, org, cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv2.LINE_AA)
     return out
-
-
-def _count(n: int, what: str) -> str:
-    return f"{n} {what}" if n == 1 else f"{n} {what}s"
 
 
 def frame_names(folder: Path) -> list[str]:
