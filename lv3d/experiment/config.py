@@ -498,6 +498,13 @@ def set_dotted(cfg: dict, key: str, value, where: str) -> None:
     if not isinstance(key, str) or not key or any(not p for p in key.split(".")):
         raise InputError(where, f"not a dotted key: {key!r}")
     parts = key.split(".")
+    if parts[0] == "sweep" and len(parts) == 2:  # one half of the sweep (--set sweep.values=[1,2]); _expand checks it
+        if parts[1] not in ("param", "values"):
+            raise InputError(where, f"unknown key {key!r}; a sweep has param and values")
+        if not isinstance(cfg.get("sweep"), dict):
+            cfg["sweep"] = {}
+        cfg["sweep"][parts[1]] = value
+        return
     node, schema = cfg, DEFAULTS
     for i, p in enumerate(parts[:-1]):
         free = tuple(parts[:i + 1]) in FREE  # a knob or learner setting: any name, checked later

@@ -52,6 +52,15 @@ def test_sweep_and_conditions_expand(tmp_path):
     p = _write(tmp_path, "sweep: {param: train.positives, values: [1, 4]}\n")
     conds = load_study(p).conditions
     assert list(conds) == ["positives=1", "positives=4"] and conds["positives=4"].train.positives == 4
+    # either half of a sweep can be overridden alone; a sweep without its param is named as such
+    conds = load_study(p, ["sweep.values=[2, 8]"]).conditions
+    assert list(conds) == ["positives=2", "positives=8"] and conds["positives=8"].train.positives == 8
+    conds = load_study(p, ["sweep.param=train.draws"]).conditions
+    assert list(conds) == ["draws=1", "draws=4"] and conds["draws=4"].train.draws == 4
+    with pytest.raises(InputError, match="sweep.valus"):
+        load_study(p, ["sweep.valus=[2]"])
+    with pytest.raises(InputError, match="sweep: must be"):
+        load_study(_write(tmp_path, "name: x\n"), ["sweep.values=[2]"])
     p = _write(tmp_path, "conditions: {full: {}, no_refinement: {lv3d.refine: false}}\n")
     conds = load_study(p).conditions
     assert conds["full"].lv3d.refine is True and conds["no_refinement"].lv3d.refine is False
