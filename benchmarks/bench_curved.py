@@ -4,6 +4,7 @@ size and axis, and boxes kept free of curved faces. Each figure is printed besid
     OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.bench_curved            # 10 scenes a class, clean and realsense
     OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.bench_curved --quick    # 3 a class
     .venv/bin/python -m benchmarks.bench_curved --presets realistic --modalities depth,rgbd --json out/curved.json
+    .venv/bin/python -m benchmarks.bench_curved --polyhedra --set quadrics.max_step_deg=65.0   # depth settings other than the defaults
 
 Scenes: ``--per-class`` of each of cylinder, cone and sphere, and of the boxes cube and cuboid, rendered from
 seeds ``--seed`` on (lv3d.render.render_scene, 640x480), per preset; each perceived once per modality
@@ -55,10 +56,12 @@ import numpy as np
 from tqdm import tqdm
 
 from lv3d import compile_cache
+from lv3d.errors import InputError
 from lv3d.describe import curved_evidence, describe, read_cylinder
 from lv3d.perception import perceive
 from lv3d.perception.depth.quadrics import cone_evidence, sphere_evidence
 from lv3d.render import render_scene
+from benchmarks.bench_real import depth_settings
 from benchmarks.targets import mark, meets
 
 CURVED = ["cylinder", "cone", "sphere"]
@@ -217,7 +220,14 @@ def main(argv=None) -> int:
     ap.add_argument("--polyhedra", action="store_true", help="also the prisms, pyramid and tetrahedron (a diagnostic)")
     ap.add_argument("--min-face-px", type=int, default=200, help="ignore true faces with fewer visible pixels")
     ap.add_argument("--json", type=Path, metavar="FILE", help="write the figures as JSON")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a depth-stage setting other than its default, as bench_real takes it (repeatable)")
     args = ap.parse_args(argv)
+    try:
+        settings = depth_settings(args.set)
+    except InputError as e:
+        print(f"bench_curved.py: error: {e}", file=sys.stderr)
+        return 2
     per_class = 3 if args.quick else args.per_class
     classes = CURVED + BOXES + (POLYHEDRA if args.polyhedra else [])
     modalities = args.modalities.split(",")
@@ -231,7 +241,7 @@ def main(argv=None) -> int:
                 frame, faces_mask = render_scene(cls, args.seed + i, noise=preset)
                 for m in modalities:
                     t = time.perf_counter()
-                    scene = perceive(frame, m, scene_id=f"s{i:06d}")
+                    scene = perceive(frame, m, scene_id=f"s{i:06d}", depth_settings=settings)
                     ms[m].append((time.perf_counter() - t) * 1e3)
                     rows[m].append(evaluate(cls, args.seed + i, scene, frame, faces_mask, args.min_face_px))
                     if m == "rgb":
