@@ -79,42 +79,42 @@ def read_rows(path: Path) -> dict[tuple, dict]:
 
 
 def paired(a: dict[tuple, dict], b: dict[tuple, dict], column: str, modality: str) -> list[tuple[tuple, bool, bool]]:
-    """(frame's key, A's verdict is the wanted one, B's is) for every object of ``modality`` both runs count in
-    ``column``'s figure (a yes/no verdict in both), in a's order."""
-    want = FIGURES[column][1]
+    """(frame's key, A's verdict is yes, B's is) for every object of ``modality`` both runs count in ``column``'s
+    figure (a yes/no verdict in both), in a's order."""
     out = []
     for key, ra in a.items():
         rb = b.get(key)
         if key[3] != modality or rb is None or ra[column] not in ("yes", "no") or rb[column] not in ("yes", "no"):
             continue
-        out.append(((key[0], key[1]), (ra[column] == "yes") == want, (rb[column] == "yes") == want))
+        out.append(((key[0], key[1]), ra[column] == "yes", rb[column] == "yes"))
     return out
 
 
 def compare(pairs: list[tuple[tuple, bool, bool]], want_yes: bool, resamples: int, seed: int) -> dict:
-    """The figure in each run over ``pairs`` (its share of yes), the objects whose verdict went better and worse,
-    the sign test's p and the frame bootstrap's 95 % interval of B - A."""
-    good_a = np.array([ga for _, ga, _ in pairs], bool)
-    good_b = np.array([gb for _, _, gb in pairs], bool)
+    """The figure in each run over ``pairs`` (its share of yes), the objects whose verdict went better and worse
+    (towards ``want_yes`` and away from it), the sign test's p and the frame bootstrap's 95 % interval of B - A."""
+    yes_a = np.array([ya for _, ya, _ in pairs], bool)
+    yes_b = np.array([yb for _, _, yb in pairs], bool)
+    good_a, good_b = yes_a == want_yes, yes_b == want_yes
     n = len(pairs)
     better, worse = int(np.count_nonzero(good_b & ~good_a)), int(np.count_nonzero(good_a & ~good_b))
-    share = (lambda good: float(np.mean(good))) if want_yes else (lambda good: float(np.mean(~good)))
     frames = sorted({f for f, _, _ in pairs})
     index = {f: i for i, f in enumerate(frames)}
     of = np.array([index[f] for f, _, _ in pairs])
     net = np.bincount(of, weights=good_b.astype(float) - good_a.astype(float), minlength=len(frames))
     up, down = int(np.count_nonzero(net > 0)), int(np.count_nonzero(net < 0))
     p = binomtest(min(up, down), up + down, 0.5).pvalue if up + down else 1.0
-    # per frame: objects counted, and the sums of the figure's yes in A and in B
+    # per frame: objects counted, and the figure's yes in A and in B
     count = np.bincount(of, minlength=len(frames))
-    yes_a = np.bincount(of, weights=(good_a if want_yes else ~good_a), minlength=len(frames))
-    yes_b = np.bincount(of, weights=(good_b if want_yes else ~good_b), minlength=len(frames))
+    frame_a = np.bincount(of, weights=yes_a, minlength=len(frames))
+    frame_b = np.bincount(of, weights=yes_b, minlength=len(frames))
     rng = np.random.default_rng(seed)
     draws = rng.integers(0, len(frames), size=(resamples, len(frames)))
     w = np.apply_along_axis(np.bincount, 1, draws, minlength=len(frames))  # (resamples, frames): times drawn
-    diff = (w @ yes_b - w @ yes_a) / np.maximum(w @ count, 1)
+    diff = (w @ frame_b - w @ frame_a) / np.maximum(w @ count, 1)
     lo, hi = np.percentile(diff, [2.5, 97.5])
-    return {"n": n, "a": share(good_a), "b": share(good_b), "better": better, "worse": worse, "frames_up": up,
+    return {"n": n, "a": float(np.mean(yes_a)), "b": float(np.mean(yes_b)), "better": better, "worse": worse,
+            "frames_up": up,
             "frames_down": down, "p": float(p), "interval": (float(lo), float(hi)), "frames": len(frames)}
 
 
