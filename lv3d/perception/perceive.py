@@ -157,7 +157,8 @@ def _unread(frame: RGBD, dres: DepthResult, o: DepthObjectResult, box: tuple[int
     known = [p.plane for p in o.planes] + ([dres.support] if dres.support is not None else [])
     # a face of the object lies within its reach: its median depth and extent (holes.unread_faces)
     return unread_faces(frame.depth, dres.grid, object_px, [p.mask for p in o.planes], known, box, seed=seed,
-                        reach=o.scale, settings=dres.settings.unread, holes=dres.settings.holes)
+                        reach=o.scale, settings=dres.settings.unread, holes=dres.settings.holes,
+                        sensor=dres.settings.sensor)
 
 
 def _fused_objects(frame: RGBD, scene_id: str, dres: DepthResult, timings: dict[str, float]) -> list[SceneObject]:

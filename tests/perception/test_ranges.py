@@ -14,9 +14,10 @@ from lv3d.perception.depth.occlusion import OcclusionSettings
 from lv3d.perception.depth.quadrics import QuadricSettings
 from lv3d.perception.depth.ranges import check_ranges
 from lv3d.perception.depth.stage import DepthSettings
+from lv3d.perception.depth.support import SensorNoise
 
 CLASSES = (ConvexitySettings, CreaseSettings, CurvedSettings, HoleSettings, UnreadSettings, OcclusionSettings, QuadricSettings,
-           DepthSettings)
+           SensorNoise, DepthSettings)
 
 
 @dataclasses.dataclass
@@ -62,3 +63,5 @@ def test_related_bounds():
         HoleSettings(min_fill=0.9, max_fill=0.8)
     with pytest.raises(ValueError, match="half-angles"):
         QuadricSettings(min_half_angle_deg=40.0, max_half_angle_deg=30.0)
+    with pytest.raises(ValueError, match="min_m .* must not exceed max_m"):
+        SensorNoise(min_m=0.04, max_m=0.03)

@@ -36,7 +36,7 @@ from .cloud import PointGrid
 from ..edges import edge_support
 from .ranges import check_ranges
 from ..polygons import area, clockwise, drop_short_sides, rasterize
-from .support import noise_threshold, ransac_plane
+from .support import SENSOR, SensorNoise, ransac_plane
 
 
 # a plane seen within this angle of face-on is one the sensor reads: a RealSense reads to about 78 degrees
@@ -202,19 +202,19 @@ class UnreadFace(NamedTuple):
 def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plane_masks: list[np.ndarray],
                  known: list[Plane], box: tuple[int, int, int, int], seed: int = 0,
                  reach: tuple[float, float] | None = None, settings: UnreadSettings = UNREAD,
-                 holes: HoleSettings = HOLES) -> list[UnreadFace]:
+                 holes: HoleSettings = HOLES, sensor: SensorNoise = SENSOR) -> list[UnreadFace]:
     """Faces of one object that depth alone infers from the holes beside it where no colour confirms them: the
     readings stop at a face's own edges, on the object's neighbouring faces and on the table, so the points just
     outside a hole that is an unread face lie on the face's plane.
 
     A hole of :func:`hole_regions` is taken for a face (thresholds: ``settings``, :class:`UnreadSettings`) when at
-    least ``min_on_plane`` of its rim points (read pixels
-    within 2 px of it, at least the least rim of :func:`hole_sizes`) lie on one plane (RANSAC within the noise
-    threshold of their depth) that is seen at ``min_graze_deg`` or more from face-on (a plane the sensor reads well
-    cannot be the reason for a hole: a blob of missing readings on a face or on the table has that face's or the
-    table's plane as its rim) and stands at least ``min_apart_deg`` from every plane in ``known`` (the object's
-    planes and the support), and when the object makes at most ``max_on_object`` of what surrounds it (a face seen
-    edge-on lies along the object's silhouette; a hole the object surrounds is a blob on one of its faces).
+    least ``min_on_plane`` of its rim points (read pixels within 2 px of it, at least the least rim of
+    :func:`hole_sizes`) lie on one plane (RANSAC within the inlier distance of ``sensor`` at their depth) that is
+    seen at ``min_graze_deg`` or more from face-on (a plane the sensor reads well cannot be the reason for a hole:
+    a blob of missing readings on a face or on the table has that face's or the table's plane as its rim) and
+    stands at least ``min_apart_deg`` from every plane in ``known`` (the object's planes and the support), and
+    when the object makes at most ``max_on_object`` of what surrounds it (a face seen edge-on lies along the
+    object's silhouette; a hole the object surrounds is a blob on one of its faces).
     With ``reach`` (the median depth and the extent of the object's points, metres), a plane whose rim points lie
     (median) farther behind the object's median depth than ``max_behind`` times its extent is no face of it: a
     Kinect's veil of mixed pixels between an object's edge and the background, or the two sides of an occlusion
@@ -253,7 +253,7 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
 
     def face_plane(pts: np.ndarray, need: int) -> tuple[Plane, np.ndarray] | None:
         """The plane of the most of ``pts`` and its inliers, when at least ``need`` and a plane depth missed."""
-        plane, inl = ransac_plane(pts, noise_threshold(float(np.median(pts[:, 2]))), rng)
+        plane, inl = ransac_plane(pts, sensor.inlier_m(float(np.median(pts[:, 2]))), rng)
         if np.count_nonzero(inl) < max(need, 3):
             return None
         ray = pts[inl].mean(axis=0)  # the angle it is seen at, from face-on

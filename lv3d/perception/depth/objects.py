@@ -11,7 +11,7 @@ from scipy import ndimage
 
 from ...plane import Plane
 from .cloud import PointGrid
-from .support import noise_threshold
+from .support import SENSOR, SensorNoise
 
 
 @dataclass(frozen=True)
@@ -57,13 +57,14 @@ def heavy_noise(noise_rel: float, rel_jump: float = _REL_JUMP, jump_sigmas: floa
 def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60, min_height_m: float = 0.015,
                     rel_jump: float = _REL_JUMP, max_border: float = 0.12,
                     band_m: float | None = None, regrow: int = 5, noise_rel: float = 0.0,
-                    jump_sigmas: float = _JUMP_SIGMAS, seed_bands: float = 3.0) -> list[DepthObject]:
+                    jump_sigmas: float = _JUMP_SIGMAS, seed_bands: float = 3.0, sensor: SensorNoise = SENSOR
+                    ) -> list[DepthObject]:
     """Objects above ``support`` on the grid, largest first. Points within the noise band of the support plane
     or below it are removed; the rest splits at depth jumps larger than ``rel_jump`` * depth; pieces with fewer
     than ``min_points`` grid points, lower than ``min_height_m``, or cut by the image border along more than
     ``max_border`` of their outline (walls, furniture, the floor beyond a table: scenery, not objects) are
-    dropped. ``band_m``: the noise band (metres) above the support that counts as support; by default the
-    noise expected of a consumer sensor at the scene's depth (see :func:`support_band`). Each piece then takes
+    dropped. ``band_m``: the noise band (metres) above the support that counts as support; by default 1.5 times
+    the inlier distance of ``sensor`` at the scene's median depth (see :func:`support_band`). Each piece then takes
     back the foreground cells left out of every piece (depth jumps, the opening) within ``regrow`` cells of it.
     Without a support plane every valid point counts as foreground.
 
@@ -77,7 +78,7 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     if support is not None:
         h_above = np.where(valid, grid.xyz @ support.n.astype(np.float32) + np.float32(support.offset), 0)
         z_med = float(np.median(grid.xyz[..., 2][valid])) if valid.any() else 1.0
-        band = 1.5 * noise_threshold(z_med) if band_m is None else band_m
+        band = 1.5 * sensor.inlier_m(z_med) if band_m is None else band_m
         fg = valid & (h_above > band)
     else:
         h_above = np.where(valid, 1.0, 0)
@@ -204,20 +205,21 @@ def _fill_holes(objects: list[DepthObject], valid: np.ndarray) -> list[DepthObje
     return out
 
 
-def support_band(grid: PointGrid, support: Plane, min_band_m: float = 0.004, k: float = 4.0) -> float:
+def support_band(grid: PointGrid, support: Plane, min_band_m: float = 0.004, k: float = 4.0,
+                 sensor: SensorNoise = SENSOR) -> float:
     """The height (metres) above ``support`` within which points are the support itself: ``k`` times the noise (a
     robust standard deviation of the distances to the plane of the grid points near it), between ``min_band_m``
-    and the default band. A fixed band sized for the noisiest sensors cuts the bottom few centimetres off every
-    object of a cleaner depth image; the pixels lost there are the lower parts of the side faces, often all of a
-    small face."""
+    and the default band, 1.5 times the inlier distance of ``sensor`` at the points' median depth. A fixed band
+    sized for the noisiest sensors cuts the bottom few centimetres off every object of a cleaner depth image; the
+    pixels lost there are the lower parts of the side faces, often all of a small face."""
     valid = grid.valid[::4, ::4]  # a few thousand points measure the noise well enough
     pts = grid.xyz[::4, ::4][valid]
     if len(pts) < 50:
-        return 1.5 * noise_threshold(1.0)
+        return 1.5 * sensor.inlier_m(1.0)
     z_med = float(np.median(pts[:, 2]))
-    wide = 1.5 * noise_threshold(z_med)
+    wide = 1.5 * sensor.inlier_m(z_med)
     d = np.abs(pts @ support.n.astype(np.float32) + np.float32(support.offset))
-    near = d[d <= noise_threshold(z_med)]
+    near = d[d <= sensor.inlier_m(z_med)]
     if len(near) < 50:
         return wide
     sigma = 1.4826 * float(np.median(near))  # robust: the near set also holds the feet of objects and walls

@@ -16,7 +16,7 @@ import numpy as np
 from .objects import DepthObject
 from .planes import DepthPlane
 from .ranges import check_ranges
-from .support import noise_threshold
+from .support import SENSOR, SensorNoise
 
 
 @dataclass(frozen=True)
@@ -41,20 +41,21 @@ class OcclusionSettings:
 DEFAULT = OcclusionSettings()
 
 
-def _shared_plane(a: list[DepthPlane], b: list[DepthPlane], cos_min: float) -> tuple[DepthPlane, DepthPlane] | None:
+def _shared_plane(a: list[DepthPlane], b: list[DepthPlane], cos_min: float, sensor: SensorNoise
+                  ) -> tuple[DepthPlane, DepthPlane] | None:
     for p in a:
         for q in b:
             if abs(float(p.plane.n @ q.plane.n)) < cos_min:
                 continue
             big, small = (p, q) if len(p.points) >= len(q.points) else (q, p)
-            dist_m = noise_threshold(float(np.median(big.points[:, 2])))
+            dist_m = sensor.inlier_m(float(np.median(big.points[:, 2])))
             if np.median(np.abs(big.plane.distance(small.points))) <= dist_m:
                 return p, q
     return None
 
 
 def _hidden_between(p: DepthPlane, q: DepthPlane, xyz: np.ndarray, valid: np.ndarray, own: np.ndarray,
-                    settings: OcclusionSettings) -> bool:
+                    settings: OcclusionSettings, sensor: SensorNoise) -> bool:
     """True when the cells on the line between the centroids (on the grid) of ``p``'s and ``q``'s cells, off the
     two pieces (``own``), lie in front of ``p``'s plane (or are unread) for ``hidden_share`` of them, and some
     do lie in front."""
@@ -68,17 +69,19 @@ def _hidden_between(p: DepthPlane, q: DepthPlane, xyz: np.ndarray, valid: np.nda
     cells = ij[off]
     read = valid[cells[:, 0], cells[:, 1]]
     pts = xyz[cells[:, 0], cells[:, 1]].astype(np.float64)
-    dist_m = noise_threshold(float(np.median(p.points[:, 2])))
+    dist_m = sensor.inlier_m(float(np.median(p.points[:, 2])))
     # normals point towards the camera: a point in front of the plane has a positive distance
     front = read & (p.plane.distance(pts) > dist_m)
     return bool(front.any()) and float(np.mean(front | ~read)) >= settings.hidden_share
 
 
 def join_occluded(solids: list[tuple[DepthObject, list[DepthPlane]]], xyz: np.ndarray, valid: np.ndarray,
-                  settings: OcclusionSettings = DEFAULT) -> list[tuple[DepthObject, list[DepthPlane]]]:
+                  settings: OcclusionSettings = DEFAULT, sensor: SensorNoise = SENSOR
+                  ) -> list[tuple[DepthObject, list[DepthPlane]]]:
     """``solids`` (each a depth object with its planes) with every two pieces of one solid hidden in part by
     something in front joined: their masks united, their planes together (the shared plane's two pieces are
-    merged later, with the solid's other coplanar pieces)."""
+    merged later, with the solid's other coplanar pieces). The inlier distance is ``sensor``'s at a piece's
+    median depth (support.SensorNoise)."""
     cos_min = np.cos(np.radians(settings.coplanar_deg))
     solids = list(solids)
     joined = True
@@ -87,8 +90,8 @@ def join_occluded(solids: list[tuple[DepthObject, list[DepthPlane]]], xyz: np.nd
         for i in range(len(solids)):
             for j in range(i + 1, len(solids)):
                 (oa, pa), (ob, pb) = solids[i], solids[j]
-                shared = _shared_plane(pa, pb, cos_min)
-                if shared is None or not _hidden_between(*shared, xyz, valid, oa.mask | ob.mask, settings):
+                shared = _shared_plane(pa, pb, cos_min, sensor)
+                if shared is None or not _hidden_between(*shared, xyz, valid, oa.mask | ob.mask, settings, sensor):
                     continue
                 solids[i] = (DepthObject(oa.mask | ob.mask, max(oa.height_m, ob.height_m)), pa + pb)
                 del solids[j]

@@ -11,7 +11,7 @@ import numpy as np
 
 from ...plane import Plane
 from .cloud import PointGrid, crop_normals
-from .support import noise_threshold, ransac_plane, refine
+from .support import SENSOR, SensorNoise, ransac_plane, refine
 
 
 @dataclass(frozen=True)
@@ -55,8 +55,8 @@ def largest_piece_on(sel: np.ndarray, box: np.ndarray) -> np.ndarray:
 
 def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_planes: int = 6,
                   min_frac: float = 0.035, max_need: int = 1500, min_points: int = 25,
-                  max_angle_deg: float = 20.0, max_misses: int = 3, normals: np.ndarray | None = None
-                  ) -> list[DepthPlane]:
+                  max_angle_deg: float = 20.0, max_misses: int = 3, normals: np.ndarray | None = None,
+                  sensor: SensorNoise = SENSOR) -> list[DepthPlane]:
     """Planes of the object whose grid cells are ``obj_mask`` (h, w) bool, largest first. A plane needs at least
     ``max(min_points, min(min_frac * object size, max_need))`` points in one connected piece: a share of the object
     keeps strips and noise out (depth.py asks more under heavy depth noise), and ``max_need`` lets a large object's
@@ -64,7 +64,8 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     A sample whose plane is too small a piece sets its points aside and the search goes on, ``max_misses`` times
     at most: a curved surface beside the object's planes (a can, a drill, in clutter) must not end the search
     before the planes behind it are found. ``normals``: the object's normals on its bounding box of the grid, as
-    :func:`~lv3d.perception.cloud.crop_normals` gives them with ``within=obj_mask``, where already computed."""
+    :func:`~lv3d.perception.cloud.crop_normals` gives them with ``within=obj_mask``, where already computed.
+    ``sensor``: the inlier distance at the object's median depth (support.SensorNoise)."""
     rng = np.random.default_rng(seed)
     rows, cols = np.flatnonzero(obj_mask.any(axis=1)), np.flatnonzero(obj_mask.any(axis=0))
     if len(rows) == 0:
@@ -81,7 +82,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     nrm = nrm_grid[box].astype(np.float64)
     if len(pts) < min_points:
         return []
-    dist_m = noise_threshold(float(np.median(pts[:, 2])))
+    dist_m = sensor.inlier_m(float(np.median(pts[:, 2])))
     need = max(min_points, min(int(min_frac * len(pts)), max_need))
     free = np.ones(len(pts), bool)
     h, w = box.shape
@@ -176,10 +177,12 @@ def merge_strips(planes: list[DepthPlane], dist_m: float, max_median: float = 0.
     return planes
 
 
-def merge_coplanar(planes: list[DepthPlane], max_deg: float = 8.0) -> list[DepthPlane]:
+def merge_coplanar(planes: list[DepthPlane], max_deg: float = 8.0, sensor: SensorNoise = SENSOR
+                   ) -> list[DepthPlane]:
     """``planes`` of one solid with every pair that is one plane merged and refitted: normals within ``max_deg``
-    and the smaller one's points (median) within the inlier distance of the larger one's plane. A solid has no two faces in
-    one plane; one face seen in two parts (around an occluder, or split by a sample of RANSAC) is one face.
+    and the smaller one's points (median) within the inlier distance (``sensor``) of the larger one's plane. A
+    solid has no two faces in one plane; one face seen in two parts (around an occluder, or split by a sample of
+    RANSAC) is one face.
     ``max_deg``: twice the normal error of a plane fitted to a few hundred noisy points, well below any
     polyhedron's edge (the hexagonal prism's sides turn by 60 deg)."""
     planes = sorted(planes, key=lambda p: -len(p.points))
@@ -192,7 +195,7 @@ def merge_coplanar(planes: list[DepthPlane], max_deg: float = 8.0) -> list[Depth
                 a, b = planes[i], planes[j]
                 if abs(float(a.plane.n @ b.plane.n)) < cos_max:
                     continue
-                dist_m = noise_threshold(float(np.median(np.concatenate([a.points[:, 2], b.points[:, 2]]))))
+                dist_m = sensor.inlier_m(float(np.median(np.concatenate([a.points[:, 2], b.points[:, 2]]))))
                 if np.median(np.abs(a.plane.distance(b.points))) > dist_m:
                     continue  # the smaller piece off the larger's plane (the better measured of the two)
                 pts = np.concatenate([a.points, b.points])

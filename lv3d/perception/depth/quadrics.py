@@ -38,6 +38,7 @@ from .curved import explained_share as _share
 from .curved import plane_ms
 from .planes import largest_piece_on
 from .ranges import check_ranges
+from .support import SENSOR, SensorNoise
 
 
 @dataclass(frozen=True)
@@ -682,18 +683,17 @@ def leaves_room(mask: np.ndarray, nrm_box: np.ndarray, rows: np.ndarray, cols: n
 
 def quadric_faces(xyz: np.ndarray, mask: np.ndarray, nrm_box: np.ndarray, planes: list,
                   adjacency: list[tuple[int, int]], cell_rel: float, min_cells: int, seed: int,
-                  scale: tuple[float, float], settings: QuadricSettings = DEFAULT, room: bool | None = None
-                  ) -> tuple[list, list[tuple[int, int]], list[QuadricFace], int]:
+                  scale: tuple[float, float], settings: QuadricSettings = DEFAULT, room: bool | None = None,
+                  sensor: SensorNoise = SENSOR) -> tuple[list, list[tuple[int, int]], list[QuadricFace], int]:
     """The depth stage's view of :func:`object_quadrics` for one object: ``xyz`` (h, w, 3) the grid's points,
     ``mask`` (h, w) the object's cells, ``nrm_box`` its normals on its bounding box of the grid, ``planes`` its
     DepthPlanes (each with a grid ``mask`` and a ``plane``) touching in pairs ``adjacency``, ``cell_rel`` a grid
     cell's width as a fraction of the depth, ``min_cells`` the fewest cells of a face, ``scale`` the object's
-    median depth and extent (objects.object_scale). The inlier distance is the sensor's noise at the object's
-    median depth (support.noise_threshold), as for cylinders. Returns the planes
+    median depth and extent (objects.object_scale). The inlier distance is ``sensor``'s at the object's median
+    depth (support.SensorNoise), as for cylinders. Returns the planes
     kept and their adjacency, the faces (each one connected piece of cells no kept plane holds) and the count of
     fits that did not converge. ``room``: :func:`leaves_room` of the object where the caller already asked it."""
     from .planes import largest_piece
-    from .support import noise_threshold
 
     rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
     if len(rows) == 0:
@@ -708,7 +708,7 @@ def quadric_faces(xyz: np.ndarray, mask: np.ndarray, nrm_box: np.ndarray, planes
     for k, p in enumerate(planes):
         plane_of[p.mask[i0:i1, j0:j1][box]] = k
     z, extent = scale
-    found = object_quadrics(pts, nrm, box, plane_of, [p.plane for p in planes], noise_threshold(z), extent,
+    found = object_quadrics(pts, nrm, box, plane_of, [p.plane for p in planes], sensor.inlier_m(z), extent,
                             cell_rel * z, min_cells, seed, settings)
     if not found.faces:
         return planes, list(adjacency), [], found.unconverged

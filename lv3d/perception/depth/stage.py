@@ -32,7 +32,7 @@ from .planes import DepthPlane, largest_piece, merge_coplanar, object_planes, pl
 from .plane_outline import simplify_on_plane
 from ..polygons import merge_close_corners
 from .snap import add_triple_corners, snap_polygons
-from .support import noise_threshold
+from .support import SENSOR, SensorNoise
 
 
 @dataclass(frozen=True)
@@ -72,6 +72,7 @@ class DepthSettings:
     (holes.UnreadSettings; perceive asks it of each object).
     ``holes``: which regions without readings beside an object may be faces, for those and for the faces colour
     confirms under rgbd (holes.HoleSettings).
+    ``sensor``: the depth noise every fit allows for, the inlier distance at a depth (support.SensorNoise).
     """
 
     stride: int = 1
@@ -93,6 +94,7 @@ class DepthSettings:
     occlusion: OcclusionSettings = field(default_factory=OcclusionSettings)
     unread: UnreadSettings = field(default_factory=UnreadSettings)
     holes: HoleSettings = field(default_factory=HoleSettings)
+    sensor: SensorNoise = field(default_factory=SensorNoise)
 
     def __post_init__(self) -> None:
         check_ranges(self, counts={"stride": 1, "max_objects": 1}, positive=("seed_bands",),
@@ -145,7 +147,7 @@ def depth_scene(frame: RGBD, seed: int = 0, max_objects: int | None = None,
     t1 = time.perf_counter()
     support = _support(grid, seed, settings)
     t2 = time.perf_counter()
-    band = support_band(grid, support) if support is not None else None
+    band = support_band(grid, support, sensor=settings.sensor) if support is not None else None
     # depth noise as a fraction of depth (sigma / z), measured on the frame: object cuts must stand out of it
     noise_rel = slope_noise(frame.depth, frame.intrinsics) / frame.intrinsics.fx
     cells = grid.valid.size
@@ -153,14 +155,14 @@ def depth_scene(frame: RGBD, seed: int = 0, max_objects: int | None = None,
                            min_points=max(1, round(settings.min_object_frac * cells)),
                            max_border=settings.max_border,
                            regrow=max(1, round(settings.regrow_frac * float(np.hypot(*grid.shape)))),
-                           seed_bands=settings.seed_bands)
+                           seed_bands=settings.seed_bands, sensor=settings.sensor)
     plane_args = {"min_frac": settings.noisy_plane_share if heavy_noise(noise_rel) else settings.plane_share,
                   "max_need": max(1, round(settings.plane_max_frac * cells)),
                   "min_points": max(3, round(settings.plane_min_frac * cells))}
     normals = _Normals(grid)
     solids = _solids(grid, support, objs, seed, plane_args, settings, normals,
                      max(1, round(settings.min_object_frac * cells)))
-    solids = join_occluded(solids, grid.xyz, grid.valid, settings.occlusion)
+    solids = join_occluded(solids, grid.xyz, grid.valid, settings.occlusion, settings.sensor)
     solids.sort(key=lambda op: (-op[0].size, int(np.argmax(op[0].mask))))
     dropped = max(0, len(solids) - settings.max_objects)
     solids = solids[:settings.max_objects]
@@ -171,7 +173,7 @@ def depth_scene(frame: RGBD, seed: int = 0, max_objects: int | None = None,
     unconverged = 0
     for k, (o, planes) in enumerate(solids):
         ta = time.perf_counter()
-        planes = merge_coplanar(planes)
+        planes = merge_coplanar(planes, sensor=settings.sensor)
         adj = plane_adjacency(planes)
         # whether the planes leave room for a curved surface: asked once, of the planes both searches start from
         room = _room(o.mask, normals(o.mask), planes, adj, settings.quadrics)
@@ -180,12 +182,12 @@ def depth_scene(frame: RGBD, seed: int = 0, max_objects: int | None = None,
         scale = object_scale(own.astype(np.float64))
         planes, adj, quads, failed = quadric_faces(grid.xyz, o.mask, normals(o.mask), planes, adj,
                                                    stride / frame.intrinsics.fx, _plane_need(o, plane_args), seed + k,
-                                                   scale, settings.quadrics, room=room)
+                                                   scale, settings.quadrics, room=room, sensor=settings.sensor)
         unconverged += failed
         # (a sphere or a cone that replaced planes leaves others: the question is asked again of those)
         planes, adj, curved = _curved(grid, o, planes, adj, settings.curved, normals, stride / frame.intrinsics.fx,
                                       _plane_need(o, plane_args), seed + k, settings.quadrics, scale,
-                                      room=None if quads else room)
+                                      room=None if quads else room, sensor=settings.sensor)
         curved = quads + [c for c in curved if not any(np.any(c.mask & q.mask) for q in quads)]
         curved_adj = _touching(planes, curved, o.mask)
         tb = time.perf_counter()
@@ -194,7 +196,7 @@ def depth_scene(frame: RGBD, seed: int = 0, max_objects: int | None = None,
             # sides along a neighbour or the support plane go onto the planes' intersection line
             z = float(np.median(planes[0].points[:, 2]))
             polys = snap_polygons(polys, [p.plane for p in planes], adj, support, frame.intrinsics,
-                                  2.5 * noise_threshold(z))
+                                  2.5 * settings.sensor.inlier_m(z))
             polys = add_triple_corners(polys, [p.plane for p in planes], adj, frame.intrinsics)
             # corners judged on the face's plane, where an edge-on face is not squeezed
             polys = [None if q is None else simplify_on_plane(q, p.plane, frame.intrinsics)
@@ -258,7 +260,8 @@ def _solids(grid: PointGrid, support: Plane | None, objs: list[DepthObject], see
     todo = [(o, True) for o in objs]
     while todo:
         o, whole = todo.pop(0)
-        planes = object_planes(grid, o.mask, seed=seed + len(out), normals=normals(o.mask), **plane_args)
+        planes = object_planes(grid, o.mask, seed=seed + len(out), normals=normals(o.mask), sensor=settings.sensor,
+                               **plane_args)
         pieces = split_at_concave(grid, o.mask, planes, settings.convexity)
         by_planes = len(pieces) > 1
         if not by_planes and whole:
@@ -280,14 +283,15 @@ def _room(mask: np.ndarray, nrm_box: np.ndarray, planes: list[DepthPlane], adj: 
 
 def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list[tuple[int, int]],
             settings: CurvedSettings, normals: _Normals, cell_rel: float, min_cells: int, seed: int, room_settings,
-            scale: tuple[float, float], room: bool | None = None
+            scale: tuple[float, float], room: bool | None = None, sensor: SensorNoise = SENSOR
             ) -> tuple[list[DepthPlane], list[tuple[int, int]], list[CurvedFace]]:
     """The object's planes and their adjacency with the planes its cylindrical faces replace left out, and those
     faces (curved.object_cylinders); the inputs unchanged when there is none. ``cell_rel``: a grid cell's width as
     a fraction of the depth (stride / fx); ``min_cells``: the fewest cells of a face, as of a plane; ``scale``: the
     object's median depth and extent (objects.object_scale). The sample
     consensus of cylinders runs only where the planes leave room for a curved surface (quadrics.leaves_room with
-    ``room_settings``; ``room``: its answer where already known); the fan of planes always."""
+    ``room_settings``; ``room``: its answer where already known); the fan of planes always. The inlier distance
+    is ``sensor``'s at the object's median depth (support.SensorNoise)."""
     if not planes:
         return planes, adj, []
     m = o.mask
@@ -302,8 +306,8 @@ def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list
     z, extent = scale
     if room is None:
         room = leaves_room(m, normals(m), rows, cols, planes, adj, room_settings)
-    found = object_cylinders(pts, nrm, box, plane_of, [p.plane for p in planes], noise_threshold(z), extent, cell_rel * z,
-                             min_cells, seed, settings, adj, sample=room)
+    found = object_cylinders(pts, nrm, box, plane_of, [p.plane for p in planes], sensor.inlier_m(z), extent,
+                             cell_rel * z, min_cells, seed, settings, adj, sample=room)
     if not found:
         return planes, adj, []
     gone = {k for _, _, fan in found for k in fan}
@@ -341,4 +345,4 @@ def _support(grid: PointGrid, seed: int, settings: DepthSettings = DEFAULT) -> P
 
     # every other grid point is plenty for the support plane
     return support_plane(grid.xyz[::2, ::2][grid.valid[::2, ::2]].astype(np.float64), seed=seed,
-                         stand_rel=settings.support_stand_rel, inner=settings.support_inner)
+                         stand_rel=settings.support_stand_rel, inner=settings.support_inner, sensor=settings.sensor)

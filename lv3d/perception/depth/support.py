@@ -8,11 +8,14 @@ must be reproducible bit for bit.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import cv2
 import numpy as np
 from matplotlib.path import Path
 
 from ...plane import Plane
+from .ranges import check_ranges
 
 
 def refine(points: np.ndarray) -> Plane:
@@ -72,14 +75,55 @@ def ransac_plane(points: np.ndarray, dist_m: float, rng: np.random.Generator, it
     return plane, mask
 
 
-def noise_threshold(z_m: float) -> float:
-    """Inlier distance (metres) at depth ``z_m``: depth noise of consumer sensors grows about as z^2."""
-    return float(np.clip(0.004 + 0.004 * z_m ** 2, 0.005, 0.03))
+@dataclass(frozen=True)
+class SensorNoise:
+    """The depth sensor's noise as the depth stage allows for it: the inlier distance at depth z (metres), the
+    farthest a reading may lie from a plane, sphere, cone or cylinder and still be on it, is
+    ``base_m + per_m2 * z**2`` clipped to [``min_m``, ``max_m``]; the support's noise band and the snapping of
+    polygon sides onto planes' intersections are multiples of it.
+
+    ``base_m`` / ``per_m2`` (metres / metres per square metre of depth): a triangulating sensor (structured light,
+    active stereo) reads depth from disparity, so its depth error is the disparity error times z^2 / (focal
+    length x baseline) and grows as z^2; 4 mm + 4 mm/m^2 gives 6 mm at 0.7 m and 8 mm at 1 m, which holds a
+    face's readings on the Kinect and RealSense dev frames together with the sensors' depth steps and slow
+    warps across a face. On those frames the distance scaled by 0.6 splits faces (boxes with more than 3 faces
+    0.101 -> 0.188) and by 1.5 merges a can's facets into fewer, flatter planes (cylinders read 0.662 -> 0.594;
+    docs/perception.md, "Measured and not kept").
+    ``min_m`` / ``max_m`` (metres): the distance near the camera is no tighter than a sensor's depth steps
+    there, and far away no looser than a small object's depth.
+
+    A model of the sensor, not a measurement of the frame: :func:`~lv3d.perception.depth.cloud.slope_noise`
+    measures the frame's pixel-to-pixel noise from second differences, which reads 0 on depth stored in whole
+    millimetres (over half of those differences are 0 on the real dev frames). A sensor far from these (a
+    time-of-flight camera, a noisier stereo pair) takes its own values (``bench_real --set sensor.base_m=...``).
+    """
+
+    base_m: float = 0.004
+    per_m2: float = 0.004
+    min_m: float = 0.005
+    max_m: float = 0.03
+
+    def __post_init__(self) -> None:
+        check_ranges(self, positive=("min_m", "max_m"))
+        for name in ("base_m", "per_m2"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float)) or isinstance(v, bool) or not 0 <= v < np.inf:
+                raise ValueError(f"{name} is a number of at least 0, got {v!r}")
+        if self.min_m > self.max_m:
+            raise ValueError(f"min_m ({self.min_m!r}) must not exceed max_m ({self.max_m!r})")
+
+    def inlier_m(self, z_m: float) -> float:
+        """The inlier distance (metres) at depth ``z_m`` (metres)."""
+        return float(np.clip(self.base_m + self.per_m2 * z_m ** 2, self.min_m, self.max_m))
+
+
+SENSOR = SensorNoise()
 
 
 def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up: float = 0.3,
                   min_frac: float = 0.08, max_points: int = 4000, min_share: float = 0.35,
-                  stand_rel: float = 0.1, min_standing: float = 0.01, inner: float = 0.85) -> Plane | None:
+                  stand_rel: float = 0.1, min_standing: float = 0.01, inner: float = 0.85,
+                  sensor: SensorNoise = SENSOR) -> Plane | None:
     """The support plane of camera-frame points (m, 3) metres, or None if no plane holds ``min_frac`` of them.
 
     Up to ``max_planes`` planes are peeled off by RANSAC; the candidates are those whose normal points up in the
@@ -90,13 +134,13 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
     table's legs there, and an object's top face only what is stacked on it. Where no candidate has
     ``min_standing`` of the points standing on it (an empty table), the nearest of the candidates holding
     ``min_share`` of the largest one's points wins (a table stands above the floor). Without an upward plane
-    the largest plane wins."""
+    the largest plane wins. Inlier distances are ``sensor``'s (:class:`SensorNoise`)."""
     rng = np.random.default_rng(seed)
     if len(points) > max_points:
         points = points[np.sort(rng.choice(len(points), max_points, replace=False))]
     if len(points) < 50:
         return None
-    dist_m = noise_threshold(float(np.median(points[:, 2])))
+    dist_m = sensor.inlier_m(float(np.median(points[:, 2])))
     remaining = points
     found: list[tuple[Plane, int]] = []
     inliers: list[np.ndarray] = []
@@ -118,7 +162,7 @@ def support_plane(points: np.ndarray, seed: int = 0, max_planes: int = 4, min_up
         cands = [(p, q) for (p, _), q in zip(found, inliers) if -p.normal[1] >= min_up]
         # readings of a plane's own surface lie within a few noise widths of it at its own depth (a far floor's
         # noise is wider than the inlier distance at the scene's median depth): objects stand beyond twice that
-        standing = [_standing(p, q, remaining, max(dist_m, 2 * noise_threshold(float(np.median(q[:, 2])))), top,
+        standing = [_standing(p, q, remaining, max(dist_m, 2 * sensor.inlier_m(float(np.median(q[:, 2])))), top,
                               [c for c in cands if c[0] is not p], inner) for p, q in cands]
         if max(standing) >= min_standing * len(points):
             return up[int(np.argmax(standing))][0]
