@@ -673,48 +673,20 @@ def write_overlay(path: Path, frame, scene, labels: list, label_img: np.ndarray 
 
 def depth_settings(overrides: list[str]):
     """lv3d.perception.depth.DEFAULT with each ``KEY=VALUE`` of ``overrides`` (``--set``) applied: KEY a field of
-    DepthSettings (``stride``) or of one of its parts (``quadrics.fit_cells``), VALUE parsed as YAML. InputError
-    naming the key for an unknown key or a value the settings refuse."""
-    from dataclasses import fields, is_dataclass, replace
-
+    DepthSettings (``stride``) or of one of its parts (``quadrics.fit_cells``), VALUE parsed as YAML
+    (lv3d.perception.depth.with_overrides). InputError naming the key for an unknown key or a value the settings
+    refuse."""
     from lv3d.experiment.config import parse_override
-    from lv3d.perception.depth import DEFAULT
+    from lv3d.perception.depth import DEFAULT, with_overrides
 
     settings = DEFAULT
     for text in overrides:
         key, value = parse_override(text)
-        *path, name = key.split(".")
-        parts = [settings]
-        for p in path:
-            inner = getattr(parts[-1], p, None)
-            if not is_dataclass(inner):
-                raise InputError("--set", f"{key}: {p!r} is no part of the depth settings")
-            parts.append(inner)
-        if name not in {f.name for f in fields(parts[-1])}:
-            known = ", ".join(f.name for f in fields(parts[-1]))
-            raise InputError("--set", f"{key}: unknown setting {name!r}; known here: {known}")
-        was = getattr(parts[-1], name)
-        if not _same_kind(value, was):
-            raise InputError("--set", f"{key}: must be of type {type(was).__name__}, as its default {was!r}, "
-                                      f"got {value!r}")
         try:
-            new = replace(parts[-1], **{name: value})
-            for outer, p in zip(reversed(parts[:-1]), reversed(path)):
-                new = replace(outer, **{p: new})
-        except (TypeError, ValueError) as e:
-            raise InputError("--set", f"{key}: {e}") from None
-        settings = new
+            settings = with_overrides({key: value}, settings)
+        except ValueError as e:
+            raise InputError("--set", str(e)) from None
     return settings
-
-
-def _same_kind(value, default) -> bool:
-    """Whether ``value`` may stand for a setting whose default is ``default``: a bool for a bool, a whole number
-    (not a bool) for a whole number, any number (not a bool) for a float, else the default's own type."""
-    if isinstance(default, bool) or isinstance(value, bool):
-        return isinstance(value, bool) and isinstance(default, bool)
-    if isinstance(default, float):
-        return isinstance(value, (int, float))
-    return isinstance(value, type(default))
 
 
 class CompileClock:

@@ -15,6 +15,7 @@ pixel, over :func:`face_cover`), and flag a perceived object that holds another 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import cv2
@@ -152,12 +153,16 @@ class FrameFacts:
 
 
 def frame_facts(frame: RGBD, frame_atom: str, modality: str, labels: list[tuple[int, int, int]], *,
-                refine: bool = True, seed: int = 0) -> FrameFacts:
+                refine: bool = True, seed: int = 0, depth: Mapping[str, object] | None = None) -> FrameFacts:
     """Perceive and ground ``frame`` once as ``modality`` sees it; ``labels``: (object, u, v) of each labelled
-    object. Only the labelled objects are refined and kept. ``seed``: perception's (perceive)."""
+    object. Only the labelled objects are refined and kept. ``seed``: perception's (perceive); ``depth``: depth
+    settings other than the defaults (lv3d.pipeline.scene_facts)."""
     from .perception import perceive
+    from .perception.depth import DEFAULT, with_overrides
 
-    return labelled_facts(perceive(frame, modality, scene_id=frame_atom, seed=seed), frame, labels, refine=refine)
+    settings = with_overrides(depth) if depth else DEFAULT
+    return labelled_facts(perceive(frame, modality, scene_id=frame_atom, seed=seed, depth_settings=settings), frame,
+                          labels, refine=refine)
 
 
 def labelled_facts(scene: Scene, frame: RGBD, labels: list[tuple[int, int, int]], *,

@@ -2,16 +2,18 @@
 concave creases) -> planes per solid -> boundary polygons, plane adjacency.
 
 Its thresholds live in one frozen :class:`DepthSettings`, in scale-free units: fractions of the image (its cell
-count or diagonal), fractions of an object's points or of the depth, multiples of the frame's measured noise,
-angles. Pixel counts are derived from them for the frame at hand, so the same settings hold at 320x240 and at
-1280x960.
+count or diagonal), fractions of an object's points or of the depth, multiples of the sensor's noise (its model,
+support.SensorNoise, or the noise measured on the frame), angles. Pixel counts are derived from them for the
+frame at hand, so the same settings hold at 320x240 and at 1280x960. :func:`with_overrides` makes settings other
+than the defaults from ``{key: value}`` (the benchmarks' and the studies' way to set them).
 """
 
 from __future__ import annotations
 
 import hashlib
 import time
-from dataclasses import dataclass, field, replace
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, is_dataclass, replace
 
 import cv2
 import numpy as np
@@ -103,6 +105,46 @@ class DepthSettings:
 
 
 DEFAULT = DepthSettings()
+
+
+def with_overrides(overrides: Mapping[str, object], base: DepthSettings = DEFAULT) -> DepthSettings:
+    """``base`` with each ``{key: value}`` of ``overrides`` applied: a key names a field of DepthSettings
+    (``stride``) or of one of its parts (``sensor.base_m``, ``quadrics.fit_cells``); a value has its default's
+    kind (a whole number for a count, any number for a float). ValueError naming the key for an unknown key, a
+    value of another kind or one the settings refuse."""
+    settings = base
+    for key, value in overrides.items():
+        *path, name = str(key).split(".")
+        parts = [settings]
+        for p in path:
+            inner = getattr(parts[-1], p, None)
+            if not is_dataclass(inner):
+                raise ValueError(f"{key}: {p!r} is no part of the depth settings")
+            parts.append(inner)
+        if name not in {f.name for f in fields(parts[-1])}:
+            known = ", ".join(f.name for f in fields(parts[-1]))
+            raise ValueError(f"{key}: unknown setting {name!r}; known here: {known}")
+        was = getattr(parts[-1], name)
+        if not _same_kind(value, was):
+            raise ValueError(f"{key}: must be of type {type(was).__name__}, as its default {was!r}, got {value!r}")
+        try:
+            new = replace(parts[-1], **{name: value})
+            for outer, p in zip(reversed(parts[:-1]), reversed(path)):
+                new = replace(outer, **{p: new})
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"{key}: {e}") from None
+        settings = new
+    return settings
+
+
+def _same_kind(value, default) -> bool:
+    """Whether ``value`` may stand for a setting whose default is ``default``: a bool for a bool, a whole number
+    (not a bool) for a whole number, any number (not a bool) for a float, else the default's own type."""
+    if isinstance(default, bool) or isinstance(value, bool):
+        return isinstance(value, bool) and isinstance(default, bool)
+    if isinstance(default, float):
+        return isinstance(value, (int, float))
+    return isinstance(value, type(default))
 
 
 @dataclass(frozen=True)

@@ -88,14 +88,16 @@ class SensorNoise:
     face's readings on the Kinect and RealSense dev frames together with the sensors' depth steps and slow
     warps across a face. On those frames the distance scaled by 0.6 splits faces (boxes with more than 3 faces
     0.101 -> 0.188) and by 1.5 merges a can's facets into fewer, flatter planes (cylinders read 0.662 -> 0.594;
-    docs/perception.md, "Measured and not kept").
-    ``min_m`` / ``max_m`` (metres): the distance near the camera is no tighter than a sensor's depth steps
-    there, and far away no looser than a small object's depth.
+    docs/perception.md, "The sensor's noise is a model").
+    ``min_m`` / ``max_m`` (metres): the distance stays within 5 mm to 3 cm, so within 0.5 to 2.6 m of the
+    camera; the labelled objects of the dev frames stand at 0.5 to 1.1 m, and the z^2 law is not carried far
+    beyond them.
 
     A model of the sensor, not a measurement of the frame: :func:`~lv3d.perception.depth.cloud.slope_noise`
     measures the frame's pixel-to-pixel noise from second differences, which reads 0 on depth stored in whole
     millimetres (over half of those differences are 0 on the real dev frames). A sensor far from these (a
-    time-of-flight camera, a noisier stereo pair) takes its own values (``bench_real --set sensor.base_m=...``).
+    time-of-flight camera, a noisier stereo pair) takes its own values: ``--set sensor.base_m=...`` in the
+    benchmarks, ``lv3d.depth`` in a study's configuration (lv3d.experiment.config).
     """
 
     base_m: float = 0.004
