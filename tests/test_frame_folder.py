@@ -111,6 +111,28 @@ def test_facts_of_a_frame_already_perceived_are_those_of_perceiving_it(frames, m
     assert [o.id for o in scene.objects] == before  # the scene is left as it was
 
 
+def test_the_facts_of_real_frames_follow_the_study_depth_settings(frames, tmp_path, monkeypatch):
+    """A study's ``lv3d.depth`` reaches perception of each frame, and its facts are cached apart."""
+    import lv3d.object_facts as object_facts
+    from lv3d.experiment.data import facts_variant
+    from lv3d.experiment.real_data import ensure_frame_facts, real_data
+
+    rd = real_data([frames])
+    depth = {"max_objects": 1, "sensor.base_m": 0.005}
+    given = []
+    real = object_facts.frame_facts
+
+    def recording(frame, atom, modality, labels, *, refine=True, seed=0, depth=None):
+        given.append(depth)
+        return real(frame, atom, modality, labels, refine=refine, seed=seed, depth=depth)
+
+    monkeypatch.setattr(object_facts, "frame_facts", recording)
+    got = ensure_frame_facts(rd, tmp_path, "v", "depth", False, depth=depth)
+    assert set(got) == set(rd.frames) and given == [depth] * len(rd.frames)
+    assert [p.name for p in (tmp_path / rd.key / "v").iterdir()] == [facts_variant("depth", False, 0, depth)]
+    assert all(len(ff.facts.objects()) <= 1 for ff in got.values())
+
+
 def test_learn_fit_predict_and_explain_on_a_folder_of_frames(frames, tmp_path, capsys):
     cache, model = tmp_path / "cache", tmp_path / "model"
     args = ["--data", str(frames), "--modality", "depth", "--cache", str(cache)]

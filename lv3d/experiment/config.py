@@ -218,6 +218,8 @@ class Lv3dConfig:
     confidences: bool = _bool(True, doc="facts keep their confidences (false: every confidence is 1)")
     perception_seed: int = _int(0, 0, 2 ** 31 - 1, doc="seed of perception's sample consensus (0: as lv3d extract)")
     settings: dict = _spec({}, "mapping", doc="learner settings (lv3d.learn.settings), e.g. {time_limit: 20}")
+    depth: dict = _spec({}, "mapping", doc="depth-stage settings other than the defaults, by dotted key "
+                                           "(lv3d.perception.depth.with_overrides), e.g. {sensor.base_m: 0.006}")
     workers: int = _int(1, 1, MAX_WORKERS, doc="processes computing facts")
 
 
@@ -273,8 +275,10 @@ class StatsConfig:
 
 SECTIONS = {"data": DataConfig, "train": TrainConfig, "lv3d": Lv3dConfig, "baselines": BaselineConfig,
             "stats": StatsConfig}
-# mappings whose keys are names checked elsewhere (noise knobs, learner settings), not schema keys
-FREE = {("data", "noise_overrides"), ("lv3d", "settings")}
+# mappings whose keys are names checked elsewhere (noise knobs, learner settings, depth settings), not schema keys
+FREE = {("data", "noise_overrides"), ("lv3d", "settings"), ("lv3d", "depth")}
+# a free mapping whose keys are dotted themselves (``lv3d.depth.sensor.base_m`` sets its key ``sensor.base_m``)
+DOTTED_FREE = ("lv3d", "depth")
 
 
 @dataclass(frozen=True)
@@ -354,6 +358,30 @@ def check_learner_settings(settings: dict, where: str) -> dict:
     from ..learn.settings import check_settings
 
     return check_settings(settings, where, prefix="lv3d.settings.")
+
+
+def check_depth_settings(depth: dict, where: str) -> dict:
+    """``lv3d.depth`` as one flat mapping of dotted keys, sorted (nested mappings, ``{sensor: {base_m: 0.006}}``,
+    are flattened): InputError naming the key the depth settings refuse (lv3d.perception.depth.with_overrides)."""
+    from ..perception.depth import with_overrides
+
+    flat: dict = {}
+
+    def walk(node: dict, prefix: str) -> None:
+        for k, v in node.items():
+            key = f"{prefix}{k}"
+            if isinstance(v, dict):
+                walk(v, key + ".")
+            else:
+                flat[key] = v
+
+    walk(depth, "")
+    flat = dict(sorted(flat.items()))
+    try:
+        with_overrides(flat)
+    except ValueError as e:
+        raise InputError(where, f"lv3d.depth.{e}") from None
+    return flat
 
 
 # ---- building a StudyConfig from mappings ---------------------------------------------------------------
@@ -450,7 +478,8 @@ def from_dict(cfg: dict, where: str) -> StudyConfig:
         raise InputError(where, f"data.per_class: {d.per_class} images of {len(d.classes)} classes exceed the "
                                 f"{MAX_DATASET_IMAGES} images a data set may hold (lv3d.limits)")
     check_noise(d, where)
-    lv = replace(study.lv3d, settings=check_learner_settings(study.lv3d.settings, where))
+    lv = replace(study.lv3d, settings=check_learner_settings(study.lv3d.settings, where),
+                 depth=check_depth_settings(study.lv3d.depth, where))
     if b.tree_cells > b.image_size or b.image_size % b.tree_cells:
         raise InputError(where, f"baselines.tree_cells: must divide baselines.image_size ({b.image_size}), "
                                 f"got {b.tree_cells}")
@@ -486,7 +515,7 @@ def _check_keys(cfg: dict, schema: dict, where: str, prefix: str = "") -> None:
 def _merge(base: dict, over: dict) -> dict:
     out = copy.deepcopy(base)
     for k, v in over.items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict) and k not in ("noise_overrides", "settings"):
+        if isinstance(v, dict) and isinstance(out.get(k), dict) and k not in ("noise_overrides", "settings", "depth"):
             out[k] = _merge(out[k], v)
         else:
             out[k] = copy.deepcopy(v)
@@ -507,6 +536,11 @@ def set_dotted(cfg: dict, key: str, value, where: str) -> None:
         return
     node, schema = cfg, DEFAULTS
     for i, p in enumerate(parts[:-1]):
+        if tuple(parts[:i + 1]) == DOTTED_FREE:  # a depth setting: the rest of the key is its own key
+            if not isinstance(node.get(p), dict):
+                node[p] = {}
+            node[p][".".join(parts[i + 1:])] = value
+            return
         free = tuple(parts[:i + 1]) in FREE  # a knob or learner setting: any name, checked later
         if schema is None or p not in schema or not isinstance(schema[p], dict) or (free and i != len(parts) - 2):
             raise InputError(where, f"unknown key {key!r}")

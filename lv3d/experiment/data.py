@@ -84,26 +84,35 @@ def seed_suffix(seed: int) -> str:
     return f"-seed{seed}" if seed else ""
 
 
-def facts_variant(modality: str, refine: bool, seed: int = 0) -> str:
-    """The cache folder of one way of computing facts: ``<modality>-refine<0|1>`` with :func:`seed_suffix`."""
-    return f"{modality}-refine{int(refine)}" + seed_suffix(seed)
+def depth_suffix(depth: dict | None) -> str:
+    """What a cache name gains for depth settings other than the defaults (``lv3d.depth``, flat and sorted):
+    ``-depth<8 hex digits of their digest>`` (the default's names stay)."""
+    return f"-depth{digest(dict(depth))[:8]}" if depth else ""
+
+
+def facts_variant(modality: str, refine: bool, seed: int = 0, depth: dict | None = None) -> str:
+    """The cache folder of one way of computing facts: ``<modality>-refine<0|1>`` with :func:`seed_suffix` and
+    :func:`depth_suffix`."""
+    return f"{modality}-refine{int(refine)}" + seed_suffix(seed) + depth_suffix(depth)
 
 
 def facts_dir(cfg: StudyConfig, out: Path, modality: str, refine: bool) -> Path:
     root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else Path(out) / "facts"
-    return root / digest(data_key(cfg)) / facts_version() / facts_variant(modality, refine, cfg.lv3d.perception_seed)
+    lv = cfg.lv3d
+    return root / digest(data_key(cfg)) / facts_version() / facts_variant(modality, refine, lv.perception_seed,
+                                                                          lv.depth)
 
 
 def facts_job(job: tuple, shared=None) -> dict:
     """The cache record of one image's facts: ``{"facts": ..., "error": None or why the pipeline found
     nothing}`` (runs in a worker; the caller writes it)."""
-    item_dir, scene_id, modality, refine, seed = job
+    item_dir, scene_id, modality, refine, seed, depth = job
     from ..pipeline import scene_facts
     from ..rgbd import load_item
 
     try:
         facts = scene_facts(load_item(Path(item_dir)), scene_id, modality, refine=refine, confidences=True,
-                            seed=seed)
+                            seed=seed, depth=depth)
         return {"facts": facts.to_json(), "error": None}
     except InputError as e:  # e.g. no object found: the system sees an empty scene, and we count it
         return {"facts": SceneFacts(scene_id, modality, [], None).to_json(), "error": str(e)}
@@ -136,7 +145,8 @@ def ensure_facts(cfg: StudyConfig, out: Path, data: Path, items: list[Item], mod
     clean_stale(dest)
     have = {it.id: _read_facts(dest / f"{it.id}.json") for it in items}
     todo = [it for it in items if have[it.id] is None]
-    jobs = [(str(Path(data) / it.dir), it.id, modality, refine, cfg.lv3d.perception_seed) for it in todo]
+    jobs = [(str(Path(data) / it.dir), it.id, modality, refine, cfg.lv3d.perception_seed, cfg.lv3d.depth)
+            for it in todo]
     for name, record in cache_missing(dest, [it.id for it in todo], facts_job, jobs,
                                       f"facts {modality} refine={refine}", workers, executor):
         have[name] = (SceneFacts.from_json(record["facts"], name), record["error"])

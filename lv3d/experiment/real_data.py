@@ -104,10 +104,10 @@ def _frame_job(job: tuple, shared=None) -> dict:
     """The cache record of one frame for one modality (runs in a worker)."""
     from ..object_facts import FrameFacts, frame_facts
 
-    folder, frame, atom, labels, modality, refine, seed = job
+    folder, frame, atom, labels, modality, refine, seed, depth = job
     try:
         rgbd = FrameFolder(Path(folder)).load(frame)
-        return frame_facts(rgbd, atom, modality, labels, refine=refine, seed=seed).to_json()
+        return frame_facts(rgbd, atom, modality, labels, refine=refine, seed=seed, depth=depth).to_json()
     except InputError as e:  # a frame that cannot be read: its examples get no facts, and we count why
         return FrameFacts(frame, modality, SceneFacts(atom, modality, [], None),
                           {o: None for o, _, _ in labels}, {o: None for o, _, _ in labels}, str(e)).to_json()
@@ -123,20 +123,20 @@ def _read_record(path: Path):
 
 
 def ensure_frame_facts(rd: RealData, root: Path, version: str, modality: str, refine: bool, workers: int = 1,
-                       executor=None, seed: int = 0) -> dict:
+                       executor=None, seed: int = 0, depth: dict | None = None) -> dict:
     """{frame atom: FrameFacts} for every frame with a labelled object, computed where the cache lacks it;
-    ``seed``: perception's."""
+    ``seed``: perception's; ``depth``: depth settings other than the defaults (``lv3d.depth``)."""
     from .data import facts_variant
     from .executor import cache_missing
     from ..object_facts import FrameFacts
 
-    dest = Path(root) / rd.key / version / facts_variant(modality, refine, seed)
+    dest = Path(root) / rd.key / version / facts_variant(modality, refine, seed, depth)
     dest.mkdir(parents=True, exist_ok=True)
     clean_stale(dest)
     have = {a: _read_record(dest / f"{a}.json") for a in rd.frames}
     todo = [a for a in rd.frames if have[a] is None]
     jobs = [(str(rd.frames[a][0].path), rd.frames[a][1], a, [(o.object, o.u, o.v) for o in rd.labels[a]],
-             modality, refine, seed) for a in todo]
+             modality, refine, seed, depth or {}) for a in todo]
     for name, record in cache_missing(dest, todo, _frame_job, jobs, f"facts {modality} refine={refine}", workers,
                                       executor):
         have[name] = FrameFacts.from_json(record, name)

@@ -64,10 +64,11 @@ def result_key(cfg: StudyConfig, system: str, fold: int, seen: str | None = None
     relevant["system"] = system
     relevant["fold"] = fold
     if system in LOGIC_SYSTEMS:
-        # workers: speed only; the perception seed changes the facts, whose digest the key holds (at its default
-        # it is left out, as keys have always left it)
+        # workers: speed only; the perception seed and the depth settings change the facts, whose digest the key
+        # holds (at their defaults they are left out, as keys have always left them)
         relevant["settings"] = {k: v for k, v in d["lv3d"].items()
-                                if k != "workers" and not (k == "perception_seed" and v == 0)}
+                                if k != "workers" and not (k == "perception_seed" and v == 0)
+                                and not (k == "depth" and not v)}
         if seen is None:
             raise ValueError(f"the key of an {system} result needs the digest of its facts")
         relevant["code"] = learning_version()  # a change to the learning code or to a fact recomputes
@@ -236,7 +237,7 @@ class _RealInputs:
             root = Path(cfg.data.cache).expanduser() / "facts" if cfg.data.cache else Path(self.out) / "facts"
             self._frames[modality] = ensure_frame_facts(self.rd, root, facts_version(), modality, lv.refine,
                                                         lv.workers, executor=self.executor,
-                                                        seed=lv.perception_seed)
+                                                        seed=lv.perception_seed, depth=lv.depth)
         return self._frames[modality]
 
     def for_system(self, name: str) -> dict:

@@ -47,7 +47,7 @@ def write_dataset(out: Path, classes, per_class: int, seed: int) -> Path:
     return out
 
 
-def fake_scene_facts(frame, scene_id, modality, refine=True, confidences=True, seed=0):
+def fake_scene_facts(frame, scene_id, modality, refine=True, confidences=True, seed=0, depth=None):
     """Facts read off the synthetic meta: one object with one face of the drawn side count."""
     sides = frame.meta["truth"]["sides"]
     pred = {3: "triangle", 4: "quadrilateral", 5: "pentagon"}[sides]

@@ -219,7 +219,7 @@ def test_the_perception_seed_reaches_perception_and_keys_its_facts(tmp_path, tin
 
     seeds = []
 
-    def recording(frame, scene_id, modality, refine=True, confidences=True, seed=0):
+    def recording(frame, scene_id, modality, refine=True, confidences=True, seed=0, depth=None):
         seeds.append(seed)
         return fake_scene_facts(frame, scene_id, modality, refine, confidences, seed)
 
@@ -239,6 +239,49 @@ def test_the_perception_seed_reaches_perception_and_keys_its_facts(tmp_path, tin
     assert result_key(other, "lv3d-depth", 0, "f") != result_key(ccfg, "lv3d-depth", 0, "f")
     # rendered images do not depend on perception: the baselines' keys stay
     assert result_key(other, "tree-rgbd", 0) == result_key(ccfg, "tree-rgbd", 0)
+
+
+def test_depth_settings_reach_perception_and_key_their_facts(tmp_path, tiny_config, fake_world, monkeypatch):
+    import re
+
+    import pytest
+
+    from lv3d.errors import InputError
+    from lv3d.experiment.config import load_study
+    from lv3d.experiment.data import depth_suffix, facts_variant
+    from lv3d.experiment.runner import result_key
+    from tests.experiment.conftest import fake_scene_facts
+
+    given = []
+
+    def recording(frame, scene_id, modality, refine=True, confidences=True, seed=0, depth=None):
+        given.append(depth)
+        return fake_scene_facts(frame, scene_id, modality, refine, confidences, seed)
+
+    monkeypatch.setattr("lv3d.pipeline.scene_facts", recording)
+    sets = ["systems=[lv3d-depth]", "folds=2"]
+    # a dotted key, a nested mapping: one flat mapping of dotted keys
+    deeper = load_study(tiny_config, sets + ["lv3d.depth={sensor: {per_m2: 0.01}}", "lv3d.depth.sensor.base_m=0.006"])
+    depth = deeper.conditions["base"].lv3d.depth
+    assert depth == {"sensor.base_m": 0.006, "sensor.per_m2": 0.01}
+    run_study(tiny_config, tmp_path / "s", sets + ["lv3d.depth.sensor.base_m=0.006", "lv3d.depth.sensor.per_m2=0.01"],
+              progress=False)
+    assert given and all(d == depth for d in given)
+    facts = tmp_path / "s" / "facts"
+    assert {p.name for p in facts.glob("*/*/*")} == {facts_variant("depth", True, 0, depth)}
+    assert facts_variant("depth", True, 0, depth) == "depth-refine1" + depth_suffix(depth) != "depth-refine1"
+    assert facts_variant("depth", True, 0, {}) == "depth-refine1"  # the default's folders keep their names
+    # at the default the keys are those of results made before the option existed
+    ccfg = load_study(tiny_config, sets).conditions["base"].to_dict()
+    before = {**ccfg, "lv3d": {k: v for k, v in ccfg["lv3d"].items() if k != "depth"}}
+    assert result_key(ccfg, "lv3d-depth", 0, "f") == result_key(before, "lv3d-depth", 0, "f")
+    other = {**ccfg, "lv3d": {**ccfg["lv3d"], "depth": depth}}
+    assert result_key(other, "lv3d-depth", 0, "f") != result_key(ccfg, "lv3d-depth", 0, "f")
+    for bad, says in (("lv3d.depth.sensor.nope=1", "lv3d.depth.sensor.nope: unknown setting 'nope'"),
+                      ("lv3d.depth.stride=0.5", "lv3d.depth.stride: must be of type int"),
+                      ("lv3d.depth.sensor.min_m=0.5", "lv3d.depth.sensor.min_m: min_m (0.5) must not exceed")):
+        with pytest.raises(InputError, match=re.escape(says)):
+            load_study(tiny_config, sets + [bad])
 
 
 def test_lv3d_results_are_kept_while_their_facts_and_learning_code_are(tmp_path, tiny_config, fake_world,
@@ -266,7 +309,7 @@ def test_lv3d_results_are_kept_while_their_facts_and_learning_code_are(tmp_path,
     run_study(tiny_config, out, sets, progress=False)
     assert json.loads(fold.read_text())["holds_under"] == ["newversion00"]  # said once
     # a fact changed: the lv3d results are computed again, the baseline's kept
-    def other_facts(frame, scene_id, modality, refine=True, confidences=True, seed=0):
+    def other_facts(frame, scene_id, modality, refine=True, confidences=True, seed=0, depth=None):
         sf = fake_scene_facts(frame, scene_id, modality, refine, confidences, seed)
         return type(sf)(sf.scene, sf.modality, [*sf.facts[:-1], Fact(sf.facts[-1].pred, sf.facts[-1].args, 0.8)],
                         sf.target)
