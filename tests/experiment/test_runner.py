@@ -264,6 +264,9 @@ def test_depth_settings_reach_perception_and_key_their_facts(tmp_path, tiny_conf
     deeper = load_study(tiny_config, sets + ["lv3d.depth={sensor: {per_m2: 0.01}}", "lv3d.depth.sensor.base_m=0.006"])
     depth = deeper.conditions["base"].lv3d.depth
     assert depth == {"sensor.base_m": 0.006, "sensor.per_m2": 0.01}
+    swept = load_study(tiny_config, sets + ["sweep={param: lv3d.depth.sensor.base_m, values: [0.004, 0.006]}"])
+    assert {n: c.lv3d.depth for n, c in swept.conditions.items()} == {
+        "base_m=0.004": {"sensor.base_m": 0.004}, "base_m=0.006": {"sensor.base_m": 0.006}}
     run_study(tiny_config, tmp_path / "s", sets + ["lv3d.depth.sensor.base_m=0.006", "lv3d.depth.sensor.per_m2=0.01"],
               progress=False)
     assert given and all(d == depth for d in given)
