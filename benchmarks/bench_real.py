@@ -676,17 +676,9 @@ def depth_settings(overrides: list[str]):
     DepthSettings (``stride``) or of one of its parts (``quadrics.fit_cells``), VALUE parsed as YAML
     (lv3d.perception.depth.with_overrides). InputError naming the key for an unknown key or a value the settings
     refuse."""
-    from lv3d.experiment.config import parse_override
-    from lv3d.perception.depth import DEFAULT, with_overrides
+    from lv3d.cli.depth_set import depth_settings as settings_of
 
-    settings = DEFAULT
-    for text in overrides:
-        key, value = parse_override(text)
-        try:
-            settings = with_overrides({key: value}, settings)
-        except ValueError as e:
-            raise InputError("--set", str(e)) from None
-    return settings
+    return settings_of(overrides, "--set")
 
 
 class CompileClock:

@@ -68,14 +68,17 @@ def default_cache() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "lv3d"
 
 
-def read_examples(data, modality: str, *, facts: str = "pipeline", cache: str | Path | None = None) -> Examples:
+def read_examples(data, modality: str, *, facts: str = "pipeline", cache: str | Path | None = None,
+                  depth: dict | None = None) -> Examples:
     """The examples of ``data`` as a system that sees ``modality`` (rgb, depth, rgbd) gets them: a folder of
     labelled real frames (objects.csv), a list of such folders (their examples together, in their order; a frame
     whose name an earlier folder has is named with its folder's name in front), or a rendered data set
     (manifest.json).
     ``facts``: from perception and grounding ("pipeline") or, on a rendered data set, from its ground truth
-    ("truth"). ``cache``: the folder caching real frames' facts (default :func:`default_cache`). InputError for
-    data that is none of these, or malformed."""
+    ("truth"). ``cache``: the folder caching real frames' facts (default :func:`default_cache`). ``depth``: depth
+    settings other than the defaults, ``{key: value}`` (``{"sensor.base_m": 0.006}``, the keys of
+    lv3d.perception.depth.with_overrides), for frames of another sensor; facts made with them are cached apart.
+    InputError for data that is none of these, or malformed, or depth settings the depth stage refuses."""
     paths = [Path(d) for d in data] if isinstance(data, (list, tuple)) else [Path(data)]
     if not paths:
         raise InputError("--data", "no data given")
@@ -83,31 +86,38 @@ def read_examples(data, modality: str, *, facts: str = "pipeline", cache: str | 
         raise InputError("--modality", f"must be one of {', '.join(MODALITIES)}, got {modality!r}")
     if facts not in SOURCES:
         raise InputError("--facts", f"must be one of {', '.join(SOURCES)}, got {facts!r}")
+    if depth:
+        from .experiment.config import check_depth_settings
+
+        depth = check_depth_settings(depth, "depth settings", prefix="")
+        if facts == "truth":
+            raise InputError("--facts", "ground-truth facts are not perceived: depth settings do not apply to them")
     real = [is_frame_folder(p) for p in paths]
     if all(real):
         if facts == "truth":
             raise InputError("--facts", f"{paths[0]} holds real frames: they have no ground-truth facts (use pipeline)")
-        return _frame_folder_examples(paths, modality, Path(cache).expanduser() if cache else default_cache())
+        return _frame_folder_examples(paths, modality, Path(cache).expanduser() if cache else default_cache(),
+                                      depth or None)
     if len(paths) > 1:
         other = paths[real.index(False)]
         raise InputError(other, "not a folder of labelled frames (no objects.csv): several --data must all be "
                                 "such folders (a rendered data set is read alone)")
-    return _dataset_examples(paths[0], modality, facts)
+    return _dataset_examples(paths[0], modality, facts, depth or None)
 
 
-def _frame_folder_examples(folders: list[Path], modality: str, cache: Path) -> Examples:
+def _frame_folder_examples(folders: list[Path], modality: str, cache: Path, depth: dict | None) -> Examples:
     from .experiment.code_version import facts_version
     from .experiment.real_data import ensure_frame_facts, example_facts_of, real_data
 
     rd = real_data([str(f) for f in folders])
     warnings = [ExampleWarning(None, f"{p} (left out)") for p in rd.problems]
-    frames = ensure_frame_facts(rd, cache / "facts", facts_version(), modality, True)
+    frames = ensure_frame_facts(rd, cache / "facts", facts_version(), modality, True, depth=depth)
     facts, errors = example_facts_of(rd, frames)
     warnings += [ExampleWarning(i, f"{errors[i]} (example {i} has no object)") for i in sorted(errors)]
     return Examples([facts[it.id] for it in rd.items], [it.cls for it in rd.items], warnings)
 
 
-def _dataset_examples(data: Path, modality: str, facts: str) -> Examples:
+def _dataset_examples(data: Path, modality: str, facts: str, depth: dict | None) -> Examples:
     manifest = data / "manifest.json"
     if not manifest.is_file():
         raise InputError(data, "not a data set (no manifest.json) nor a folder of labelled frames (no objects.csv)")
@@ -134,7 +144,7 @@ def _dataset_examples(data: Path, modality: str, facts: str) -> Examples:
             from .rgbd import load_item
 
             try:
-                scenes.append(scene_facts(load_item(item_dir), it["id"], modality))
+                scenes.append(scene_facts(load_item(item_dir), it["id"], modality, depth=depth))
             except InputError as e:  # no object found: the image is kept without a target, and counted
                 warnings.append(ExampleWarning(it["id"], f"{item_dir}: {e.problem} (no example)"))
                 scenes.append(SceneFacts(it["id"], modality, [], None))

@@ -7,7 +7,7 @@ import pytest
 
 from lv3d.cli.app import main
 from lv3d.frame_folder import FrameFolder, scene_atom
-from lv3d.object_facts import example_facts, example_id, frame_facts, labelled_facts
+from lv3d.object_facts import FrameFacts, example_facts, example_id, frame_facts, labelled_facts
 from tests.conftest import FOLDER_CLASSES, write_frame_folder
 
 def _with_rows(frames, folder, rows):
@@ -164,6 +164,33 @@ def test_learn_fit_predict_and_explain_on_a_folder_of_frames(frames, tmp_path, c
     assert capsys.readouterr().out.startswith(f"{ex} (box): {ex}_o is a box")
     assert main(["learn", "fit", *args, "--facts", "truth", "--out", str(tmp_path / "m2")]) == 2
     assert "no ground-truth facts" in capsys.readouterr().err
+
+
+def test_learn_takes_depth_settings_keeps_their_facts_apart_and_the_model_remembers_them(frames, tmp_path, capsys):
+    """--depth-set reaches perception of every frame (max_objects=1 leaves one object a frame), its facts are
+    cached apart from the defaults', the model records them, and predict says when its examples' differ."""
+    from lv3d.experiment.data import facts_variant
+
+    cache, model = tmp_path / "cache", tmp_path / "model"
+    args = ["--data", str(frames), "--modality", "depth", "--cache", str(cache)]
+    depth = {"max_objects": 1, "sensor.base_m": 0.005}
+    sets = ["--depth-set", "sensor.base_m=0.005", "--depth-set", "max_objects=1"]
+    assert main(["learn", "fit", *args, *sets, "--out", str(model), "--time-limit", "20"]) == 0
+    assert "learned from 6 examples" in capsys.readouterr().out
+    assert json.loads((model / "depth_settings.json").read_text()) == depth
+    variants = {p.name for p in cache.glob("facts/*/*/*")}
+    assert variants == {facts_variant("depth", True, 0, depth)} and "-depth" in variants.pop()
+    frames_facts = [FrameFacts.from_json(json.loads(p.read_text())) for p in cache.glob("facts/*/*/*/*.json")]
+    assert len(frames_facts) == 6 and all(sum(f.pred == "object" for f in ff.facts.facts) == 1 for ff in frames_facts)
+    assert main(["learn", "predict", *args, *sets, "--model", str(model)]) == 0
+    out = capsys.readouterr()
+    assert out.out.splitlines()[-1].startswith("accuracy ") and "note" not in out.err
+    assert main(["learn", "predict", *args, "--model", str(model)]) == 0  # the defaults: facts made anew, and said
+    err = capsys.readouterr().err
+    assert "learned from facts made with the depth settings max_objects=1 sensor.base_m=0.005; these examples' " \
+           "are made with the defaults" in err
+    assert main(["learn", "explain", *args, "--depth-set", "sensor.nope=1", "--model", str(model)]) == 2
+    assert "--depth-set: sensor.nope: unknown setting 'nope'" in capsys.readouterr().err
 
 
 def test_a_script_reads_the_examples_of_a_folder_learns_and_explains(frames, tmp_path):

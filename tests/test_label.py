@@ -57,6 +57,13 @@ def test_a_row_per_perceived_object_whose_filled_in_file_is_read_back_onto_the_s
     assert {r["frame"] for r in rows} == {"a-1", "b 2", "big"}
     assert all(r["shape"] == "" and r["notes"].startswith("perceived: ") for r in rows)
     assert sorted(p.name for p in (out / "overlays").iterdir()) == ["a-1.png", "b 2.png", "big.png"]
+    # with depth settings of its own: perception keeps one object a frame
+    assert main(["label", str(folder), "--out", str(tmp_path / "one"), "--depth-set", "max_objects=1"]) == 0
+    assert sorted(r["frame"] for r in csv.DictReader((tmp_path / "one" / "objects.csv").open())) == \
+        ["a-1", "b 2", "big"]
+    assert main(["label", str(folder), "--out", str(tmp_path / "bad"), "--depth-set", "nope=1"]) == 2
+    assert "--depth-set: nope: unknown setting 'nope'" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()
     first = {r["frame"]: r for r in rows if r["object"] == "1"}
     # the frame at four times the size (1280x960) is read at half of it: its object's pixel is a cell of that grid,
     # in the pixels of its files, and lies where the small frame's does (within two of its cells)

@@ -81,14 +81,14 @@ def test_learn_fit_replaces_its_own_output(tmp_path, capsys, monkeypatch):
     from lv3d.facts import SceneFacts
 
     one = SceneFacts("s0", "rgbd", [], "s0_o1")
-    monkeypatch.setattr(learn_cli, "_examples", lambda *a: Examples([one], ["cube"]))
+    monkeypatch.setattr(learn_cli, "_examples", lambda *a, **k: Examples([one], ["cube"]))
     monkeypatch.setattr(Model, "fit", classmethod(lambda cls, *a, **k: Fitted(next(runs))))
     data = tmp_path / "data"
     data.mkdir()
     out = tmp_path / "model"
     for _ in range(2):
         assert main(["learn", "fit", "--data", str(data), "--out", str(out)]) == 0
-    assert sorted(p.name for p in out.iterdir()) == [MARKER, "run2.pl"]
+    assert sorted(p.name for p in out.iterdir()) == [MARKER, "depth_settings.json", "run2.pl"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["data", "model"]  # no temporary or old folder
 
 

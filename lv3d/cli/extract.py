@@ -11,6 +11,7 @@ import cv2
 from .. import compile_cache
 from ..errors import InputError
 from ..output import check_out, replacing
+from .depth_set import depth_set_option, depth_settings
 
 
 @click.command()
@@ -31,8 +32,10 @@ from ..output import check_out, replacing
 @click.option("--max-objects", type=click.IntRange(min=1), default=None,
               help="Describe at most this many objects found by depth, the largest (default 24); the output says "
               "how many were left out.")
+@depth_set_option
 def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scale: float | None, modality: str,
-            scene_id: str | None, out_dir: Path, facts: bool, max_objects: int | None) -> None:
+            scene_id: str | None, out_dir: Path, facts: bool, max_objects: int | None,
+            depth_set: tuple[str, ...]) -> None:
     """Find objects, faces and planes in one frame COLOR; write OUT/scene.json and OUT/overlay.png."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     from ..rgbd import load_frame, read_intrinsics
@@ -53,6 +56,7 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
     for image in (color, depth if modality != "rgb" else None):
         if image is not None and not Path(image).is_file():
             raise InputError(image, "image not found")
+    settings = depth_settings(depth_set)
     inputs = (color, depth, intrinsics)
     check_out(out_dir, inputs)  # before any work: a file, a folder lv3d did not write or one holding an input
     frame_name = Path(color).stem.removesuffix("_rgb")
@@ -61,7 +65,7 @@ def extract(color: Path, depth: Path | None, intrinsics: Path | None, depth_scal
     k, scale = read_intrinsics(intrinsics, frame_name) if intrinsics is not None else (None, 0.001)
     frame = load_frame(color, depth if modality != "rgb" else None, k,
                        depth_scale if depth_scale is not None else scale, name=frame_name)
-    scene = perceive(frame, modality, scene_id=scene_id, max_objects=max_objects)
+    scene = perceive(frame, modality, scene_id=scene_id, max_objects=max_objects, depth_settings=settings)
     if not scene.objects:
         raise InputError(color, "no object found in this frame")
     facts_obj = None

@@ -34,6 +34,7 @@ from tqdm import tqdm
 
 from ..errors import InputError
 from ..output import check_out, replacing
+from .depth_set import depth_overrides, depth_set_option
 
 COLUMNS = ("frame", "object", "u", "v", "shape", "partial", "stacked", "notes")
 _PALETTE_BGR = ((0, 220, 255), (255, 160, 0), (80, 255, 80), (255, 80, 255), (80, 80, 255), (255, 255, 80))
@@ -76,13 +77,14 @@ def proposed_rows(name: str, frame, scene) -> list[dict]:
     return rows
 
 
-def model_answers(model, modality: str, frame, scene, rows: list[dict], seed: int) -> None:
+def model_answers(model, modality: str, frame, scene, rows: list[dict], seed: int, depth: dict | None = None
+                  ) -> None:
     """Fill in each row's shape with ``model``'s answer on its object's facts and add the answer to its notes; a
     row whose answer is no class the model holds a program for keeps an empty shape. The facts are those lv3d
     learn predict reads: ``scene`` (the frame perceived as the model's modality sees it, the rows' objects among
     its objects) grounded (lv3d.object_facts.labelled_facts); for a model of colour alone, whose objects are not
-    depth's, the frame is perceived as colour sees it (lv3d.object_facts.frame_facts, with ``seed``). ``modality``:
-    the one the model's programs were learned from."""
+    depth's, the frame is perceived as colour sees it (lv3d.object_facts.frame_facts, with ``seed`` and the depth
+    settings ``depth``). ``modality``: the one the model's programs were learned from."""
     from ..object_facts import example_facts, example_id, frame_facts, labelled_facts
 
     if not rows:
@@ -90,7 +92,7 @@ def model_answers(model, modality: str, frame, scene, rows: list[dict], seed: in
     s = frame.scale
     labels = [(r["object"], r["u"] // s, r["v"] // s) for r in rows]
     ff = labelled_facts(scene, frame, labels) if scene.modality == modality else \
-        frame_facts(frame, scene.id, modality, labels, seed=seed)
+        frame_facts(frame, scene.id, modality, labels, seed=seed, depth=depth)
     for r in rows:
         facts = example_facts(ff, r["object"], example_id(scene.id, r["object"]))
         label, conf = model.predict(facts) if facts.target is not None else ("unknown", 0.0)
@@ -134,14 +136,19 @@ def frame_names(folder: Path) -> list[str]:
               help="At most this many objects a frame, the largest (default 24).")
 @click.option("--model", "model_dir", type=click.Path(path_type=Path), default=None,
               help="A model lv3d learn fit wrote: propose each object's class as its answer.")
-def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None, model_dir: Path | None) -> None:
+@depth_set_option
+def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None, model_dir: Path | None,
+          depth_set: tuple[str, ...]) -> None:
     """Propose objects.csv for the frames of FOLDER: a row per object depth perception finds, its class to fill in."""
     from .. import compile_cache
     from ..frame_folder import scene_atom
+    from ..perception.depth import with_overrides
     from ..perception.perceive import perceive
     from ..rgbd import load_real
 
     names = frame_names(folder)
+    depth = depth_overrides(depth_set)
+    settings = with_overrides(depth)
     check_out(out_dir, (folder, model_dir))  # before any work
     model = modality = None
     if model_dir is not None:
@@ -160,10 +167,10 @@ def label(folder: Path, out_dir: Path, seed: int, max_objects: int | None, model
             continue
         # rgbd's objects are depth's (its faces fused with colour's), so a model of rgbd facts reads the same scene
         scene = perceive(frame, modality if modality in ("depth", "rgbd") else "depth", scene_id=scene_atom(name),
-                         seed=seed, max_objects=max_objects)
+                         seed=seed, max_objects=max_objects, depth_settings=settings)
         mine = proposed_rows(name, frame, scene)
         if model is not None:
-            model_answers(model, modality, frame, scene, mine, seed)
+            model_answers(model, modality, frame, scene, mine, seed, depth)
         if not mine:
             empty.append(name)
         rows += mine

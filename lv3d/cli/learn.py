@@ -13,6 +13,7 @@ import click
 from .. import compile_cache
 from ..errors import InputError
 from ..facts import MODALITIES
+from .depth_set import depth_overrides, depth_set_option, model_depth, save_with_model, shown
 
 
 def _setting(text: str) -> tuple[str, object]:
@@ -86,12 +87,13 @@ def _named(data: tuple[Path, ...]) -> str:
 
 
 def _examples(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None = None,
-              warn: set[str] | None = None):
-    """The examples of a data set or of folders of labelled real frames (lv3d.examples.read_examples), each
-    warning of reading them one line (an example's only where ``warn`` holds its id, where given)."""
+              warn: set[str] | None = None, depth: dict | None = None):
+    """The examples of a data set or of folders of labelled real frames (lv3d.examples.read_examples, with the
+    depth settings ``depth``), each warning of reading them one line (an example's only where ``warn`` holds its
+    id, where given)."""
     from ..examples import read_examples
 
-    ex = read_examples(list(data), modality, facts=facts or "pipeline", cache=cache)
+    ex = read_examples(list(data), modality, facts=facts or "pipeline", cache=cache, depth=depth)
     for w in ex.warnings:
         if warn is None or w.example is None or w.example in warn:
             click.echo(f"lv3d: warning: {w}", err=True)
@@ -114,25 +116,27 @@ _cache = click.option("--cache", type=click.Path(path_type=Path), default=None,
 @_modality
 @_facts
 @_cache
+@depth_set_option
 @click.option("--classes", default=None, help="comma-separated classes to learn (default: every class in the data "
                                                "but other, objects.csv's catch-all shape)")
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="directory for the programs")
 @click.option("--seed", type=click.IntRange(0, 2 ** 32 - 1), default=0, show_default=True)
 @click.option("--time-limit", type=click.FloatRange(0, 86400, min_open=True), default=None, help="seconds per class")
-def fit(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, classes: str | None, out: Path, seed: int,
-        time_limit: float | None):
-    """Learn one program per class and save them as .pl files in OUT. Examples where perception found no
-    object are left out (counted)."""
+def fit(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, depth_set: tuple[str, ...],
+        classes: str | None, out: Path, seed: int, time_limit: float | None):
+    """Learn one program per class and save them as .pl files in OUT (with the depth settings the facts were
+    made with, depth_settings.json). Examples where perception found no object are left out (counted)."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     from ..experiment.config import OTHER_SHAPE
     from ..learn.model import Model
     from ..output import check_out, replacing
 
     check_out(out, data)  # before any work: a file, a folder lv3d did not write or one holding the data
+    depth = depth_overrides(depth_set)
     wanted = [c.strip() for c in classes.split(",") if c.strip()] if classes is not None else None
     if wanted is not None and not wanted:
         raise InputError("--classes", "no class given")
-    ex = _examples(data, modality, facts, cache)
+    ex = _examples(data, modality, facts, cache, depth=depth)
     for c in wanted or ():
         if c not in ex.labels:
             raise InputError("--classes", f"no example of {_named(data)} is a {c!r}; its classes: {', '.join(sorted(set(ex.labels)))}")
@@ -156,6 +160,8 @@ def fit(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | 
         raise click.ClickException(f"no program learned for any class ({why})")
     with replacing(out, data) as tmp:  # written beside OUT, then moved into its place
         model.save(tmp)
+        if facts != "truth":
+            save_with_model(tmp, depth)
     click.echo(f"% learned from {len(scenes)} examples ({', '.join(f'{c} {labels.count(c)}' for c in sorted(present))})")
     for c, p in model.programs.items():
         if p.target != c:
@@ -181,13 +187,20 @@ def load_model(model_dir: Path):
 
 
 def _model_and_scenes(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, model_dir: Path,
-                      warn: set[str] | None = None):
-    """The model of ``model_dir`` and the scenes of ``data`` (:func:`_examples`, its ``warn``)."""
+                      depth_set: tuple[str, ...] = (), warn: set[str] | None = None):
+    """The model of ``model_dir`` and the scenes of ``data`` (:func:`_examples`, its ``warn``, with the depth
+    settings of ``depth_set``). Depth settings other than those the model's facts were made with are one note
+    line, not an error: frames of another sensor are read with that sensor's settings."""
     model, learned = load_model(model_dir)
     if learned and learned != [modality]:
         raise InputError("--modality", f"the model in {model_dir} was learned from {', '.join(learned)} facts; "
                                        f"predict with --modality {learned[0]}")
-    ex = _examples(data, modality, facts, cache, warn)
+    depth = depth_overrides(depth_set)
+    fitted = model_depth(model_dir)
+    if fitted is not None and facts != "truth" and fitted != depth:
+        click.echo(f"lv3d: note: the model in {model_dir} learned from facts made with the depth settings "
+                   f"{shown(fitted)}; these examples' are made with {shown(depth)}", err=True)
+    ex = _examples(data, modality, facts, cache, warn, depth)
     scenes, labels = ex.scenes, ex.labels
     return model, scenes, labels
 
@@ -197,15 +210,17 @@ def _model_and_scenes(data: tuple[Path, ...], modality: str, facts: str | None, 
 @_modality
 @_facts
 @_cache
+@depth_set_option
 @click.option("--model", "model_dir", type=click.Path(path_type=Path), required=True)
 @click.option("--explain/--no-explain", default=False, help="print each answer's proof")
-def predict(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, model_dir: Path, explain: bool):
+def predict(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, depth_set: tuple[str, ...],
+            model_dir: Path, explain: bool):
     """Classify every example of a data set or folder with saved programs; print accuracy, over the examples of
     the classes the model holds a program for, each class's, and their mean (balanced accuracy). An example where perception found no object
     is answered "unknown" (and counts as wrong); examples of other classes are answered but left out of the
     accuracy (the model cannot name them), and counted."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
-    model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir)
+    model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir, depth_set)
     held = set(model.programs)
     right: Counter = Counter()
     seen: Counter = Counter()
@@ -241,18 +256,20 @@ def predict(data: tuple[Path, ...], modality: str, facts: str | None, cache: Pat
 @_modality
 @_facts
 @_cache
+@depth_set_option
 @click.option("--model", "model_dir", type=click.Path(path_type=Path), required=True)
 @click.option("--example", "examples", multiple=True, metavar="ID",
               help="explain this example only (an id predict prints, or FRAME_xOBJECT with the frame's file "
                    "name; repeatable; default: every example)")
-def explain(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, model_dir: Path,
-            examples: tuple[str, ...]):
+def explain(data: tuple[Path, ...], modality: str, facts: str | None, cache: Path | None, depth_set: tuple[str, ...],
+            model_dir: Path, examples: tuple[str, ...]):
     """Print why each example gets its label: the program that proves it and the facts (with confidences)
     the proof used."""
     compile_cache.enable()  # an entry point: grounding's compiled programs are kept on disk
     examples = tuple(_example_atom(e) for e in examples)
     # the examples asked for: only their own "no object" warnings (each is answered so below as well)
-    model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir, set(examples) or None)
+    model, scenes, labels = _model_and_scenes(data, modality, facts, cache, model_dir, depth_set,
+                                              set(examples) or None)
     by_id = {s.scene: (s, y) for s, y in zip(scenes, labels)}
     unknown = [e for e in examples if e not in by_id]
     if unknown:

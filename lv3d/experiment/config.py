@@ -360,10 +360,14 @@ def check_learner_settings(settings: dict, where: str) -> dict:
     return check_settings(settings, where, prefix="lv3d.settings.")
 
 
-def check_depth_settings(depth: dict, where: str) -> dict:
-    """``lv3d.depth`` as one flat mapping of dotted keys, sorted (nested mappings, ``{sensor: {base_m: 0.006}}``,
-    are flattened): InputError naming the key the depth settings refuse (lv3d.perception.depth.with_overrides)."""
+def check_depth_settings(depth: dict, where: str, prefix: str = "lv3d.depth.") -> dict:
+    """``lv3d.depth`` (or any mapping of depth settings) as one flat mapping of dotted keys, sorted (nested
+    mappings, ``{sensor: {base_m: 0.006}}``, are flattened): InputError at ``where`` naming the key (after
+    ``prefix``) the depth settings refuse (lv3d.perception.depth.with_overrides)."""
     from ..perception.depth import with_overrides
+
+    if not isinstance(depth, dict):
+        raise InputError(where, f"depth settings must be a mapping of setting to value, got {depth!r}")
 
     flat: dict = {}
 
@@ -380,7 +384,7 @@ def check_depth_settings(depth: dict, where: str) -> dict:
     try:
         with_overrides(flat)
     except ValueError as e:
-        raise InputError(where, f"lv3d.depth.{e}") from None
+        raise InputError(where, f"{prefix}{e}") from None
     return flat
 
 
@@ -561,15 +565,15 @@ def _yaml_value(raw: str):
     return yaml.safe_load(raw)
 
 
-def parse_override(text: str) -> tuple[str, object]:
-    """``key=value`` with the value parsed as YAML (``8``, ``false``, ``[1, 2]``)."""
+def parse_override(text: str, option: str = "--set") -> tuple[str, object]:
+    """``key=value`` with the value parsed as YAML (``8``, ``false``, ``[1, 2]``); InputError naming ``option``."""
     if "=" not in text:
-        raise InputError("--set", f"expected key=value, got {text!r}")
+        raise InputError(option, f"expected key=value, got {text!r}")
     key, raw = text.split("=", 1)
     try:
         return key.strip(), _yaml_value(raw)
     except yaml.YAMLError as e:
-        raise InputError("--set", f"cannot parse the value of {key!r}: {str(e).splitlines()[0]}") from None
+        raise InputError(option, f"cannot parse the value of {key!r}: {str(e).splitlines()[0]}") from None
 
 
 class _Loader(yaml.SafeLoader):

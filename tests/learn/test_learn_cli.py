@@ -42,6 +42,24 @@ def test_learn_fit_then_predict_on_a_rendered_data_set(tmp_path, capsys):
     assert "accuracy 6/6" in capsys.readouterr().out
 
 
+def test_the_examples_of_a_rendered_data_set_follow_the_depth_settings(tmp_path, monkeypatch):
+    import lv3d.pipeline as pipeline
+    from lv3d.errors import InputError
+    from lv3d.examples import read_examples
+    from lv3d.render.dataset import make_dataset
+
+    data = make_dataset(tmp_path / "data", ["cube", "square_pyramid"], 1, "clean", 3, workers=1, width=320,
+                        height=240, progress=False)
+    seen, real = [], pipeline.scene_facts
+    monkeypatch.setattr(pipeline, "scene_facts", lambda *a, **k: seen.append(k.get("depth")) or real(*a, **k))
+    ex = read_examples(data, "depth", depth={"sensor": {"base_m": 0.005}})  # nested or dotted, as a study takes them
+    assert seen == [{"sensor.base_m": 0.005}] * 2 and all(s.target for s in ex.scenes)
+    with pytest.raises(InputError, match="depth settings do not apply"):
+        read_examples(data, "depth", facts="truth", depth={"sensor.base_m": 0.005})
+    with pytest.raises(InputError, match="sensor.nope: unknown setting 'nope'"):
+        read_examples(data, "depth", depth={"sensor.nope": 1})
+
+
 def test_mil_noisy_and_a_goal_without_program(capsys):
     assert main(["mil", str(prolog.source("tasks/noisy_grandparent.pl"))]) == 1
     assert capsys.readouterr().out.strip() == "% unable to learn a solution"

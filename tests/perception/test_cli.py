@@ -117,3 +117,28 @@ def test_extract_names_the_scene_after_a_frame_whose_name_is_no_prolog_atom(tmp_
     assert scene["id"].startswith("frame_000000_") and scene["target"].startswith(scene["id"])
     facts = json.loads((out / "facts.json").read_text())
     assert facts["scene"] == scene["id"] and facts["facts"]
+
+
+def test_extract_perceives_with_the_depth_settings_given_and_refuses_a_bad_one(tmp_path, capsys, monkeypatch):
+    import importlib
+
+    from lv3d.perception.depth import with_overrides
+    from lv3d.render import noise_config, render_scene
+
+    frame = render_scene("cube", 0, noise_config("clean", stacked=1.0))[0]  # a box on a box: two objects
+    c, d, k = _write_frame(tmp_path, frame)
+    module = importlib.import_module("lv3d.perception.perceive")
+    seen, perceive = [], module.perceive
+    monkeypatch.setattr(module, "perceive", lambda *a, **kw: seen.append(kw["depth_settings"]) or perceive(*a, **kw))
+    args = ["extract", str(c), "--depth", str(d), "--intrinsics", str(k), "--modality", "depth"]
+    assert main([*args, "--depth-set", "max_objects=1", "--depth-set", "sensor.base_m=0.005",
+                 "--out", str(tmp_path / "out")]) == 0
+    assert seen == [with_overrides({"max_objects": 1, "sensor.base_m": 0.005})]
+    assert "1 smaller objects left out" in capsys.readouterr().out  # the setting took: one object described
+    for bad, says in (("sensor.nope=1", "--depth-set: sensor.nope: unknown setting 'nope'"),
+                      ("max_objects=many", "--depth-set: max_objects: must be of type int"),
+                      ("stride", "--depth-set: expected key=value")):
+        assert main([*args, "--depth-set", bad, "--out", str(tmp_path / "bad")]) == 2
+        err = capsys.readouterr().err
+        assert says in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "bad").exists()  # refused before any output
