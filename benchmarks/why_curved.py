@@ -32,7 +32,11 @@ object it prints:
   candidates only: the cylinder's systematic misfit over the cells the planes held, mm, <= ``misfit_ratio``
   times the planes'), ``track`` (arc deg >= ``min_arc_deg``, gap deg <= ``max_gap_deg``), ``profile`` (normal
   arc deg >= ``sample_arc_deg``, dip >= ``min_dip``), ``sphere`` (insides only: share of the sphere's residual
-  variance explained >= ``min_share``), ``share`` (curved_share >= ``min_share``).
+  variance explained >= ``min_share``), ``share`` (curved_share >= ``min_share``). After them, whatever they
+  decided, ``two planes``: a measurement and no test, the cylinder's systematic misfit over all its cells
+  (:func:`lv3d.perception.depth.curved.misfit`, mm) beside the best pair of planes' (:func:`two_planes`: its cells
+  split at one position around the axis, a least-squares plane on each side), and their ratio; under 1 the
+  cylinder fits its cells better than a box's two faces meeting at an edge would.
   The first test that fails is a candidate's verdict. The depth stage's own verdict is kept beside it: a row
   where the two differ says ``DIFFERS``;
 - the object's surfaces as the depth stage left them (planes, cylinders, cones, spheres).
@@ -68,7 +72,8 @@ from benchmarks.bench_real import _one_core, named_folders, depth_settings
 from lv3d.errors import InputError
 from lv3d.frame_folder import FrameFolder
 
-TESTS = ("cells", "rms", "misfit", "track", "profile", "sphere", "normals", "planes", "spread", "over cylinder",
+TESTS = ("cells", "rms", "misfit", "track", "profile", "sphere", "two planes", "normals", "planes", "spread",
+         "over cylinder",
          "over plane", "share")
 
 
@@ -124,10 +129,53 @@ def _size_and_fit(tests: _Tests, min_cells: int, res: np.ndarray, dist_m: float)
     return rms if ok else None
 
 
+def two_planes(cyl, pts: np.ndarray, bin_deg: float, splits: int = 17) -> float:
+    """The systematic misfit (curved.misfit, metres) of the best pair of planes over points (m, 3) on or near a
+    cylinder: the points cut at one position around its axis (``splits`` positions, at the 10th to the 90th
+    percentile of the points' angles, unwrapped at their widest gap), a least-squares plane fitted to each side,
+    residuals signed positive towards the camera. What a box's two faces meeting at an edge leave; inf with
+    fewer than 10 points a side at every cut."""
+    from lv3d.perception.depth import curved
+    from lv3d.perception.depth.support import refine
+
+    _, b1, b2 = curved.axis_basis(cyl.axis)
+    d = pts - np.asarray(cyl.point)
+    theta = np.degrees(np.arctan2(d @ b2, d @ b1))
+    order = np.sort(theta)
+    gaps = np.diff(np.concatenate([order, order[:1] + 360.0]))
+    theta = (theta - order[(int(np.argmax(gaps)) + 1) % len(order)]) % 360.0
+    best = np.inf
+    for cut in np.quantile(theta, np.linspace(0.1, 0.9, splits)):
+        left = theta < cut
+        if min(np.count_nonzero(left), np.count_nonzero(~left)) < 10:
+            continue
+        res = np.empty(len(pts))
+        for side in (left, ~left):
+            plane = refine(pts[side])
+            r = plane.distance(pts[side])
+            res[side] = -r if float(plane.n @ pts[side].mean(axis=0)) > 0 else r
+        best = min(best, curved.misfit(cyl, pts, res, bin_deg))
+    return best
+
+
 def gate_tests(cyl, pts: np.ndarray, nrm: np.ndarray, plane_fit, dist_m: float, min_cells: int, settings,
                side: float) -> list[tuple[str, str, str, bool]]:
     """The acceptance tests of curved._stands on one candidate, in its order, each as (name, value, limit,
-    passed), up to the first that fails."""
+    passed), up to the first that fails; then ``two planes``, a measurement that always passes
+    (:func:`two_planes`)."""
+    tests = _gate_tests(cyl, pts, nrm, plane_fit, dist_m, min_cells, settings, side)
+    from lv3d.perception.depth import curved
+
+    bin_deg = settings.max_gap_deg / 2
+    mine = curved.misfit(cyl, pts, side * (cyl.radial(pts)[0] - cyl.radius), bin_deg)
+    theirs = two_planes(cyl, pts, bin_deg)
+    ratio = mine / theirs if theirs > 0 else np.inf
+    tests("two planes", f"{1e3 * mine:.2f} mm / {1e3 * theirs:.2f} mm = {ratio:.2f}", "a measurement", True)
+    return tests
+
+
+def _gate_tests(cyl, pts: np.ndarray, nrm: np.ndarray, plane_fit, dist_m: float, min_cells: int, settings,
+                side: float) -> _Tests:
     from lv3d.perception.depth import curved
     from lv3d.sphere import algebraic_sphere
 
@@ -354,6 +402,16 @@ def summary(rows: list[dict], shapes: tuple[str, ...]) -> str:
         by = Counter((c.origin, c.verdict) for c in cands)
         lines.append("candidates by origin and verdict: " + ", ".join(f"{o} {v} {n}" for (o, v), n in
                                                                       sorted(by.items())))
+    ratios: dict[str, list[float]] = {}
+    for r in rows:
+        for c in r["candidates"]:
+            got = [v for name, v, _, _ in c.tests if name == "two planes"]
+            if c.verdict == "stands" and got:
+                ratios.setdefault(r["shape"], []).append(float(got[0].rsplit("= ", 1)[1]))
+    if ratios:
+        lines.append("cylinders that stand, their misfit over the best two planes' (median [least, most]): " +
+                     ", ".join(f"on a {k} {np.median(v):.2f} [{min(v):.2f}, {max(v):.2f}] of {len(v)}"
+                               for k, v in sorted(ratios.items())))
     differ = sum(not c.agrees for c in cands)
     lines.append(f"verdicts that differ from the depth stage's: {differ}")
     return "\n".join(lines)
