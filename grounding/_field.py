@@ -162,11 +162,17 @@ def _normal_image(win: tuple[int, int, int, int], z: np.ndarray, valid: np.ndarr
     dv = np.zeros_like(pts)
     du[:, 1:-1] = pts[:, 2:] - pts[:, :-2]
     dv[1:-1] = pts[2:] - pts[:-2]
-    n = np.cross(du, dv)
-    n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-12)
+    # du x dv and its length written out, the same numbers as np.cross and np.linalg.norm (the same products, the
+    # squares added left to right as numpy's reduce adds them) at a fraction of their cost on an image
+    n = np.empty_like(du)
+    n[..., 0] = du[..., 1] * dv[..., 2] - du[..., 2] * dv[..., 1]
+    n[..., 1] = du[..., 2] * dv[..., 0] - du[..., 0] * dv[..., 2]
+    n[..., 2] = du[..., 0] * dv[..., 1] - du[..., 1] * dv[..., 0]
+    x, y, z = n[..., 0], n[..., 1], n[..., 2]
+    n /= np.maximum(np.sqrt(x * x + y * y + z * z), 1e-12)[..., None]
     img = np.clip((n + 1.0) * 127.5, 0, 255)
     if near is not None:
         logz = np.log(np.maximum(pts[..., 2], 1e-3))
         img = np.concatenate([img, np.clip((logz - near) * 400.0, 0, 255)[..., None]], -1)
-    img[~valid_c] = 0
+    np.copyto(img, 0, where=~valid_c[..., None])
     return img.astype(np.uint8)

@@ -158,9 +158,9 @@ def frame_facts(frame: RGBD, frame_atom: str, modality: str, labels: list[tuple[
     object. Only the labelled objects are refined and kept. ``seed``: perception's (perceive); ``depth``: depth
     settings other than the defaults (lv3d.pipeline.scene_facts)."""
     from .perception import perceive
-    from .perception.depth import DEFAULT, with_overrides
+    from .perception.depth import with_overrides
 
-    settings = with_overrides(depth) if depth else DEFAULT
+    settings = with_overrides(depth or {})
     return labelled_facts(perceive(frame, modality, scene_id=frame_atom, seed=seed, depth_settings=settings), frame,
                           labels, refine=refine)
 

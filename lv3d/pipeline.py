@@ -23,9 +23,9 @@ def scene_facts(frame: RGBD, scene_id: str, modality: str, *, refine: bool = Tru
     """
     from .describe import describe
     from .perception import perceive
-    from .perception.depth import DEFAULT, with_overrides
+    from .perception.depth import with_overrides
 
-    settings = with_overrides(depth) if depth else DEFAULT
+    settings = with_overrides(depth or {})
     scene = perceive(frame, modality, scene_id=scene_id, seed=seed, depth_settings=settings)
     facts = describe(scene, frame, refine=refine)
     if not confidences:

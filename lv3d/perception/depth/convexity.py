@@ -28,7 +28,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..distance import euclidean_distance
-from .cloud import PointGrid
+from .cloud import PointGrid, cell_rows
 from .planes import DepthPlane
 from .ranges import check_ranges
 
@@ -89,23 +89,25 @@ def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, offsets:
     masks = [labels == a for a in range(1, k + 1)]
     sizes = [int(np.count_nonzero(m)) for m in masks]
     touch = [cv2.dilate(m.view(np.uint8), np.ones((3, 3), np.uint8), iterations=2).view(bool) for m in masks]
+    # each patch's normal: that of its first cell in row-major order (every cell of a patch holds its plane's)
+    first = [normals.reshape(-1, normals.shape[-1])[int(np.argmax(m))] for m in masks]
     out = []
     for a in range(k):
         for b in range(a + 1, k):
             contact = np.count_nonzero(touch[a] & masks[b])
             if contact < max(3, settings.contact_frac * 4 * np.sqrt(min(sizes[a], sizes[b]))):
                 continue
-            if not _meet(xyz, touch[b] & masks[a], normals[masks[b]][0], offsets[b + 1], settings) or \
-                    not _meet(xyz, touch[a] & masks[b], normals[masks[a]][0], offsets[a + 1], settings):
+            if not _meet(xyz, touch[b] & masks[a], first[b], offsets[b + 1], settings) or \
+                    not _meet(xyz, touch[a] & masks[b], first[a], offsets[a + 1], settings):
                 continue
             near_b = within(b) & masks[a]
             near_a = within(a) & masks[b]
-            na, nb = normals[near_b].sum(axis=0), normals[near_a].sum(axis=0)
+            na, nb = cell_rows(normals, near_b).sum(axis=0), cell_rows(normals, near_a).sum(axis=0)
             la, lb = np.linalg.norm(na), np.linalg.norm(nb)
             if la == 0 or lb == 0:
                 continue
             na, nb = na / la, nb / lb
-            ca, cb = xyz[near_b].mean(axis=0), xyz[near_a].mean(axis=0)
+            ca, cb = cell_rows(xyz, near_b).mean(axis=0), cell_rows(xyz, near_a).mean(axis=0)
             angle = float(np.degrees(np.arccos(np.clip(na @ nb, -1.0, 1.0))))
             convex = float((na - nb) @ (ca - cb)) > 0
             if convex and not _sane(na, nb, ca - cb, angle):
@@ -129,7 +131,7 @@ def _sane(na: np.ndarray, nb: np.ndarray, d: np.ndarray, angle_deg: float) -> bo
 
 def _meet(xyz: np.ndarray, along: np.ndarray, n: np.ndarray, d: float, settings: ConvexitySettings) -> bool:
     """True when the cells ``along`` a junction lie (median) within ``max_gap_rel`` of their depth of plane (n, d)."""
-    p = xyz[along]
+    p = cell_rows(xyz, along)
     if len(p) == 0:
         return False
     return bool(np.median(np.abs(p @ n + d) / p[:, 2]) <= settings.max_gap_rel)

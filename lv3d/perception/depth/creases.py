@@ -33,7 +33,7 @@ from scipy import ndimage
 from skimage.segmentation import watershed
 
 from ..distance import euclidean_distance
-from .cloud import PointGrid
+from .cloud import PointGrid, known
 from .ranges import check_ranges
 
 
@@ -88,7 +88,7 @@ def crease_cells(xyz: np.ndarray, normals: np.ndarray, mask: np.ndarray, baselin
     """(h, w) bool: the cells of ``mask`` on a concave crease (module docstring, step 1); ``xyz`` and ``normals``
     (h, w, 3) on the same crop, normals zero where unknown."""
     b = max(1, int(baseline))
-    ok = mask & (np.linalg.norm(normals, axis=2) > 0)
+    ok = mask & known(normals)
     out = np.zeros(mask.shape, bool)
     cos_max = np.cos(np.radians(crease_deg))
     for axis in (0, 1):
@@ -172,7 +172,7 @@ def _bends(labels: np.ndarray, a: int, b: int, xyz: np.ndarray, normals: np.ndar
     lab, nrm, pts = labels[i0:i1, j0:j1], normals[i0:i1, j0:j1], xyz[i0:i1, j0:j1]
     for this, other in ((a, b), (b, a)):
         far = cv2.distanceTransform((lab != other).astype(np.uint8), cv2.DIST_L2, 3)
-        near = (lab == this) & (far <= band) & (np.linalg.norm(nrm, axis=2) > 0)
+        near = (lab == this) & (far <= band) & known(nrm)
         if not near.any():
             return False
         n = nrm[near].sum(axis=0)

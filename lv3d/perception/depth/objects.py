@@ -10,7 +10,7 @@ import numpy as np
 from scipy import ndimage
 
 from ...plane import Plane
-from .cloud import PointGrid
+from .cloud import PointGrid, cell_rows
 from .support import SENSOR, SensorNoise
 
 
@@ -213,7 +213,7 @@ def support_band(grid: PointGrid, support: Plane, min_band_m: float = 0.004, k: 
     sized for the noisiest sensors cuts the bottom few centimetres off every object of a cleaner depth image; the
     pixels lost there are the lower parts of the side faces, often all of a small face."""
     valid = grid.valid[::4, ::4]  # a few thousand points measure the noise well enough
-    pts = grid.xyz[::4, ::4][valid]
+    pts = cell_rows(grid.xyz[::4, ::4], valid)
     if len(pts) < 50:
         return 1.5 * sensor.inlier_m(1.0)
     z_med = float(np.median(pts[:, 2]))

@@ -10,7 +10,7 @@ import cv2
 import numpy as np
 
 from ...plane import Plane
-from .cloud import PointGrid, crop_normals
+from .cloud import PointGrid, cell_rows, crop_normals
 from .support import SENSOR, SensorNoise, ransac_plane, refine
 
 
@@ -73,13 +73,13 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
     # work on the object's bounding box of the grid: connected components there are cheap
     i0, j0, i1, j1 = rows[0], cols[0], rows[-1] + 1, cols[-1] + 1
     box = obj_mask[i0:i1, j0:j1]
-    pts = grid.xyz[i0:i1, j0:j1][box].astype(np.float64)
+    pts = cell_rows(grid.xyz[i0:i1, j0:j1], box).astype(np.float64)
     nrm_grid = grid.normals[i0:i1, j0:j1] if normals is None else normals
     if not nrm_grid.any():
         # from the object's points alone: along its silhouette, normals mixed with the table's points agree with
         # none of its faces, and the score below would give a face's silhouette strip to its neighbour
         nrm_grid = crop_normals(grid, i0, j0, i1, j1, within=obj_mask)
-    nrm = nrm_grid[box].astype(np.float64)
+    nrm = cell_rows(nrm_grid, box).astype(np.float64)
     if len(pts) < min_points:
         return []
     dist_m = sensor.inlier_m(float(np.median(pts[:, 2])))
@@ -94,7 +94,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
         idx = np.nonzero(free & tried)[0]
         if len(idx) < need:
             break
-        plane, inl = ransac_plane(pts[idx], dist_m, rng, iterations=96, normals=nrm[idx], max_angle_deg=max_angle_deg)
+        plane, inl = ransac_plane(np.take(pts, idx, axis=0), dist_m, rng, iterations=96, normals=np.take(nrm, idx, axis=0), max_angle_deg=max_angle_deg)
         m = np.zeros((h, w), bool)
         m.flat[flat[idx[inl]]] = True
         piece = largest_piece(m)
@@ -105,7 +105,7 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
                 break
             tried[idx[inl]] = False
             continue
-        plane = refine(pts[sel])
+        plane = refine(np.compress(sel, pts, axis=0))
         planes.append(plane)
         free &= ~sel
     if not planes:
@@ -125,9 +125,10 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
         sel = m[box]
         if np.count_nonzero(sel) < need:
             continue
-        p = refine(pts[sel])
-        rms = float(np.sqrt(np.mean(p.distance(pts[sel]) ** 2)))
-        pieces.append(DepthPlane(p, m, pts[sel].astype(np.float32), rms))
+        mine = np.compress(sel, pts, axis=0)
+        p = refine(mine)
+        rms = float(np.sqrt(np.mean(p.distance(mine) ** 2)))
+        pieces.append(DepthPlane(p, m, mine.astype(np.float32), rms))
     out = []
     for d in merge_strips(pieces, dist_m):
         full = np.zeros(obj_mask.shape, bool)

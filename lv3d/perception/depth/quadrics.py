@@ -35,6 +35,7 @@ from ...plane import row_norms
 from ...sphere import Sphere, algebraic_sphere
 from .curved import axis_basis, axis_terms
 from .curved import explained_share as _share
+from .cloud import cell_rows
 from .curved import plane_ms
 from .planes import largest_piece_on
 from .ranges import check_ranges
@@ -702,8 +703,8 @@ def quadric_faces(xyz: np.ndarray, mask: np.ndarray, nrm_box: np.ndarray, planes
         return planes, list(adjacency), [], 0
     i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
     box = mask[i0:i1, j0:j1]
-    nrm = nrm_box[box].astype(np.float64)
-    pts = xyz[i0:i1, j0:j1][box].astype(np.float64)
+    nrm = cell_rows(nrm_box, box).astype(np.float64)
+    pts = cell_rows(xyz[i0:i1, j0:j1], box).astype(np.float64)
     plane_of = np.full(len(pts), -1)
     for k, p in enumerate(planes):
         plane_of[p.mask[i0:i1, j0:j1][box]] = k

@@ -21,7 +21,7 @@ import numpy as np
 from ...plane import Plane
 from ...rgbd import RGBD
 from ..boundary import mask_polygon
-from .cloud import PointGrid, crop_normals, point_grid, slope_noise
+from .cloud import PointGrid, cell_rows, crop_normals, point_grid, slope_noise
 from .convexity import ConvexitySettings, split_at_concave
 from .creases import CreaseSettings, split_at_creases
 from .curved import CurvedFace, CurvedSettings, object_cylinders
@@ -220,7 +220,7 @@ def depth_scene(frame: RGBD, seed: int = 0, max_objects: int | None = None,
         # whether the planes leave room for a curved surface: asked once, of the planes both searches start from
         room = _room(o.mask, normals(o.mask), planes, adj, settings.quadrics)
         # a sphere or a cone first: the cylinder search would read a cone's side as a cylinder
-        own = grid.xyz[o.mask]  # the object's points, (m, 3) metres
+        own = cell_rows(grid.xyz, o.mask)  # the object's points, (m, 3) metres
         scale = object_scale(own.astype(np.float64))
         planes, adj, quads, failed = quadric_faces(grid.xyz, o.mask, normals(o.mask), planes, adj,
                                                    stride / frame.intrinsics.fx, _plane_need(o, plane_args), seed + k,
@@ -340,8 +340,8 @@ def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list
     rows, cols = np.flatnonzero(m.any(axis=1)), np.flatnonzero(m.any(axis=0))
     i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
     box = m[i0:i1, j0:j1]
-    nrm = normals(m)[box].astype(np.float64)
-    pts = grid.xyz[i0:i1, j0:j1][box].astype(np.float64)
+    nrm = cell_rows(normals(m), box).astype(np.float64)
+    pts = cell_rows(grid.xyz[i0:i1, j0:j1], box).astype(np.float64)
     plane_of = np.full(len(pts), -1)
     for k, p in enumerate(planes):
         plane_of[p.mask[i0:i1, j0:j1][box]] = k
@@ -364,8 +364,9 @@ def _curved(grid: PointGrid, o: DepthObject, planes: list[DepthPlane], adj: list
         face = largest_piece(face)
         if not face.any():
             continue
-        r, _ = cyl.radial(grid.xyz[face].astype(np.float64))
-        curved.append(CurvedFace(cyl, face, grid.xyz[face].astype(np.float32),
+        on_face = cell_rows(grid.xyz, face)
+        r, _ = cyl.radial(on_face.astype(np.float64))
+        curved.append(CurvedFace(cyl, face, on_face.astype(np.float32),
                                  float(np.sqrt(np.mean((r - cyl.radius) ** 2)))))
     index = {k: i for i, k in enumerate(keep)}
     return kept, [(index[a], index[b]) for a, b in adj if a in index and b in index], curved
@@ -379,12 +380,12 @@ def _plane_need(o: DepthObject, plane_args: dict) -> int:
 def _height(grid: PointGrid, support: Plane | None, mask: np.ndarray) -> float:
     if support is None:
         return float("inf")
-    return float(np.percentile(grid.xyz[mask].astype(np.float64) @ support.n + support.offset, 95))
+    return float(np.percentile(cell_rows(grid.xyz, mask).astype(np.float64) @ support.n + support.offset, 95))
 
 
 def _support(grid: PointGrid, seed: int, settings: DepthSettings = DEFAULT) -> Plane | None:
     from .support import support_plane
 
     # every other grid point is plenty for the support plane
-    return support_plane(grid.xyz[::2, ::2][grid.valid[::2, ::2]].astype(np.float64), seed=seed,
+    return support_plane(cell_rows(grid.xyz[::2, ::2], grid.valid[::2, ::2]).astype(np.float64), seed=seed,
                          stand_rel=settings.support_stand_rel, inner=settings.support_inner, sensor=settings.sensor)

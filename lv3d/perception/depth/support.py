@@ -71,7 +71,7 @@ def ransac_plane(points: np.ndarray, dist_m: float, rng: np.random.Generator, it
             mask = new
             break  # a stable inlier set refits to the same plane
         mask = new
-        plane = refine(points[mask])
+        plane = refine(np.compress(mask, points, axis=0))
     return plane, mask
 
 
