@@ -151,9 +151,10 @@ def two_planes(cyl, pts: np.ndarray, bin_deg: float, splits: int = 17) -> float:
             continue
         res = np.empty(len(pts))
         for side in (left, ~left):
-            plane = refine(pts[side])
-            r = plane.distance(pts[side])
-            res[side] = -r if float(plane.n @ pts[side].mean(axis=0)) > 0 else r
+            part = pts[side]
+            plane = refine(part)
+            r = plane.distance(part)
+            res[side] = -r if float(plane.n @ part.mean(axis=0)) > 0 else r
         best = min(best, curved.misfit(cyl, pts, res, bin_deg))
     return best
 

@@ -371,9 +371,9 @@ def check_depth_settings(depth: dict, where: str, prefix: str = "lv3d.depth.") -
 
     flat: dict = {}
 
-    def walk(node: dict, prefix: str) -> None:
+    def walk(node: dict, above: str) -> None:
         for k, v in node.items():
-            key = f"{prefix}{k}"
+            key = f"{above}{k}"
             if isinstance(v, dict):
                 walk(v, key + ".")
             else:

@@ -123,6 +123,20 @@ def fake_world(monkeypatch):
     return FakeModel
 
 
+@pytest.fixture
+def perceived_with(fake_world, monkeypatch):
+    """The perception seed and depth settings of each call of lv3d.pipeline.scene_facts, as (seed, depth), the
+    facts those of :func:`fake_scene_facts`."""
+    calls = []
+
+    def recording(frame, scene_id, modality, refine=True, confidences=True, seed=0, depth=None):
+        calls.append((seed, depth))
+        return fake_scene_facts(frame, scene_id, modality, refine, confidences, seed)
+
+    monkeypatch.setattr("lv3d.pipeline.scene_facts", recording)
+    return calls
+
+
 TINY = """\
 name: tiny
 seed: 3

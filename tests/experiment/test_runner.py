@@ -211,21 +211,14 @@ def test_draws_must_be_a_positive_integer(tmp_path, tiny_config):
             load_study(tiny_config, [f"train.draws={bad}"])
 
 
-def test_the_perception_seed_reaches_perception_and_keys_its_facts(tmp_path, tiny_config, fake_world, monkeypatch):
+def test_the_perception_seed_reaches_perception_and_keys_its_facts(tmp_path, tiny_config, perceived_with):
     from lv3d.experiment.config import load_study
     from lv3d.experiment.data import facts_variant
     from lv3d.experiment.runner import result_key
-    from tests.experiment.conftest import fake_scene_facts
 
-    seeds = []
-
-    def recording(frame, scene_id, modality, refine=True, confidences=True, seed=0, depth=None):
-        seeds.append(seed)
-        return fake_scene_facts(frame, scene_id, modality, refine, confidences, seed)
-
-    monkeypatch.setattr("lv3d.pipeline.scene_facts", recording)
     sets = ["systems=[lv3d-depth]", "folds=2"]
     run_study(tiny_config, tmp_path / "s", sets + ["lv3d.perception_seed=7"], progress=False)
+    seeds = [seed for seed, _ in perceived_with]
     assert seeds and set(seeds) == {7}
     facts = tmp_path / "s" / "facts"
     assert {p.name for p in facts.glob("*/*/*")} == {facts_variant("depth", True, 7)} == {"depth-refine1-seed7"}
@@ -241,7 +234,7 @@ def test_the_perception_seed_reaches_perception_and_keys_its_facts(tmp_path, tin
     assert result_key(other, "tree-rgbd", 0) == result_key(ccfg, "tree-rgbd", 0)
 
 
-def test_depth_settings_reach_perception_and_key_their_facts(tmp_path, tiny_config, fake_world, monkeypatch):
+def test_depth_settings_reach_perception_and_key_their_facts(tmp_path, tiny_config, perceived_with):
     import re
 
     import pytest
@@ -250,15 +243,7 @@ def test_depth_settings_reach_perception_and_key_their_facts(tmp_path, tiny_conf
     from lv3d.experiment.config import load_study
     from lv3d.experiment.data import depth_suffix, facts_variant
     from lv3d.experiment.runner import result_key
-    from tests.experiment.conftest import fake_scene_facts
 
-    given = []
-
-    def recording(frame, scene_id, modality, refine=True, confidences=True, seed=0, depth=None):
-        given.append(depth)
-        return fake_scene_facts(frame, scene_id, modality, refine, confidences, seed)
-
-    monkeypatch.setattr("lv3d.pipeline.scene_facts", recording)
     sets = ["systems=[lv3d-depth]", "folds=2"]
     # a dotted key, a nested mapping: one flat mapping of dotted keys
     deeper = load_study(tiny_config, sets + ["lv3d.depth={sensor: {per_m2: 0.01}}", "lv3d.depth.sensor.base_m=0.006"])
@@ -269,6 +254,7 @@ def test_depth_settings_reach_perception_and_key_their_facts(tmp_path, tiny_conf
         "base_m=0.004": {"sensor.base_m": 0.004}, "base_m=0.006": {"sensor.base_m": 0.006}}
     run_study(tiny_config, tmp_path / "s", sets + ["lv3d.depth.sensor.base_m=0.006", "lv3d.depth.sensor.per_m2=0.01"],
               progress=False)
+    given = [d for _, d in perceived_with]
     assert given and all(d == depth for d in given)
     facts = tmp_path / "s" / "facts"
     assert {p.name for p in facts.glob("*/*/*")} == {facts_variant("depth", True, 0, depth)}
