@@ -170,9 +170,17 @@ def _normal_image(win: tuple[int, int, int, int], z: np.ndarray, valid: np.ndarr
     n[..., 2] = du[..., 0] * dv[..., 1] - du[..., 1] * dv[..., 0]
     x, y, z = n[..., 0], n[..., 1], n[..., 2]
     n /= np.maximum(np.sqrt(x * x + y * y + z * z), 1e-12)[..., None]
-    img = np.clip((n + 1.0) * 127.5, 0, 255)
+    # the channels written into one image, each by the operations (in float32) that clipping them apart and
+    # stacking them would do: the stacked copy of the window costs as much as its arithmetic
+    img = np.empty(n.shape[:2] + (3 if near is None else 4,), np.float32)
+    rgb = img[..., :3]
+    np.add(n, 1.0, out=rgb)
+    rgb *= 127.5
+    np.clip(rgb, 0, 255, out=rgb)
     if near is not None:
         logz = np.log(np.maximum(pts[..., 2], 1e-3))
-        img = np.concatenate([img, np.clip((logz - near) * 400.0, 0, 255)[..., None]], -1)
+        logz -= near
+        logz *= 400.0
+        np.clip(logz, 0, 255, out=img[..., 3])
     np.copyto(img, 0, where=~valid_c[..., None])
     return img.astype(np.uint8)

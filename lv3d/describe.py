@@ -21,6 +21,7 @@ from .cylinder import Cylinder
 from .facts import PREDICATES, REGULAR_CORNERS, Fact, SceneFacts, regular_corner_range
 from .interval import probability_between
 from .perception.polygons import area
+from .plane import column_means
 from .rgbd import RGBD
 from .scene import Face, Scene, SceneObject
 
@@ -636,7 +637,7 @@ def plane_gap_mm(a: FaceResult, b: FaceResult) -> float | None:
     perception split) lie a few mm apart, two faces of a solid centimetres."""
     if a.plane is None or b.plane is None:
         return None
-    ca, cb = a.face.points.mean(axis=0), b.face.points.mean(axis=0)
+    ca, cb = column_means(a.face.points), column_means(b.face.points)
     return 1e3 * max(abs(float(ca @ b.plane[:3] + b.plane[3])), abs(float(cb @ a.plane[:3] + a.plane[3])))
 
 

@@ -145,3 +145,35 @@ def _normal_image_of(depth, intr):
     zs = cv2.GaussianBlur(z, (0, 0), 2.0) / np.maximum(wsum, 1e-6)
     near = float(np.log(np.maximum(zs[valid].min(), 1e-3)))
     return _normal_image((0, 0, depth.shape[1], depth.shape[0]), z, valid, wsum, near, intr, 2.0)
+
+
+def test_normal_image_is_the_one_its_channels_stacked_give():
+    """The normal image written channel by channel into one array is the image that clipping the normals and the
+    log depth apart and stacking them gives, bit for bit (with log depth and without)."""
+    import cv2
+
+    from grounding._field import _normal_image
+
+    rng = np.random.default_rng(7)
+    v, u = np.mgrid[0:120, 0:160].astype(np.float32)
+    depth = (0.9 + 0.0007 * u - 0.0004 * v + rng.normal(0, 0.002, u.shape)).astype(np.float32)
+    depth[30:45, 70:95] = 0
+    intr = (150.0, 150.0, 80.0, 60.0)
+    valid = depth > 0
+    z = np.where(valid, depth, np.float32(0.0))
+    wsum = cv2.GaussianBlur(valid.astype(np.float32), (0, 0), 2.0)
+    pts = np.stack([(u - intr[2]) / intr[0] * z, (v - intr[3]) / intr[1] * z, z], -1)
+    pts = cv2.GaussianBlur(pts, (0, 0), 2.0) / np.maximum(wsum, 1e-6)[..., None]
+    du, dv = np.zeros_like(pts), np.zeros_like(pts)
+    du[:, 1:-1] = pts[:, 2:] - pts[:, :-2]
+    dv[1:-1] = pts[2:] - pts[:-2]
+    n = np.cross(du, dv)
+    n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-12)
+    for near in (None, float(np.log(0.85))):
+        want = np.clip((n + 1.0) * 127.5, 0, 255)
+        if near is not None:
+            logz = np.log(np.maximum(pts[..., 2], 1e-3))
+            want = np.concatenate([want, np.clip((logz - near) * 400.0, 0, 255)[..., None]], -1)
+        want[~valid] = 0
+        got = _normal_image((0, 0, 160, 120), z, valid, wsum, near, intr, 2.0)
+        np.testing.assert_array_equal(got, want.astype(np.uint8))

@@ -27,6 +27,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from ...plane import column_means, column_sums
 from ..distance import euclidean_distance
 from .cloud import PointGrid, cell_rows
 from .planes import DepthPlane
@@ -102,12 +103,12 @@ def junctions(labels: np.ndarray, xyz: np.ndarray, normals: np.ndarray, offsets:
                 continue
             near_b = within(b) & masks[a]
             near_a = within(a) & masks[b]
-            na, nb = cell_rows(normals, near_b).sum(axis=0), cell_rows(normals, near_a).sum(axis=0)
+            na, nb = column_sums(cell_rows(normals, near_b)), column_sums(cell_rows(normals, near_a))
             la, lb = np.linalg.norm(na), np.linalg.norm(nb)
             if la == 0 or lb == 0:
                 continue
             na, nb = na / la, nb / lb
-            ca, cb = cell_rows(xyz, near_b).mean(axis=0), cell_rows(xyz, near_a).mean(axis=0)
+            ca, cb = column_means(cell_rows(xyz, near_b)), column_means(cell_rows(xyz, near_a))
             angle = float(np.degrees(np.arccos(np.clip(na @ nb, -1.0, 1.0))))
             convex = float((na - nb) @ (ca - cb)) > 0
             if convex and not _sane(na, nb, ca - cb, angle):

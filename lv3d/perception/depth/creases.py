@@ -32,6 +32,7 @@ import numpy as np
 from scipy import ndimage
 from skimage.segmentation import watershed
 
+from ...plane import column_means, column_sums
 from ..distance import euclidean_distance
 from .cloud import PointGrid, known
 from .ranges import check_ranges
@@ -175,11 +176,11 @@ def _bends(labels: np.ndarray, a: int, b: int, xyz: np.ndarray, normals: np.ndar
         near = (lab == this) & (far <= band) & known(nrm)
         if not near.any():
             return False
-        n = nrm[near].sum(axis=0)
+        n = column_sums(nrm[near])
         norm = np.linalg.norm(n)
         if norm == 0:
             return False
-        sides.append((n / norm, pts[near].mean(axis=0)))
+        sides.append((n / norm, column_means(pts[near])))
     (na, ca), (nb, cb) = sides
     return float((na - nb) @ (ca - cb)) < 0 and float(na @ nb) < np.cos(np.radians(bend_deg))
 

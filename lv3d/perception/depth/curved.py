@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...cylinder import Cylinder
-from ...plane import row_norms
+from ...plane import column_means, row_norms
 from ...sphere import algebraic_sphere
 from .planes import largest_piece_on
 from .ranges import check_ranges
@@ -247,7 +247,7 @@ def axis_terms(pts: np.ndarray, nrm: np.ndarray, origins: np.ndarray, axes: np.n
     with its offset from the line (k, s) (the distance times the cosine between the normal and the direction
     away from the line), and each point's position along each line from its origin (k, s). Products of (k, 3)
     by (3, s) matrices, coordinates about the points' mean."""
-    o = pts.mean(axis=0)
+    o = column_means(pts)
     p, c = pts - o, origins - o
     along = axes @ p.T - np.einsum("kj,kj->k", c, axes)[:, None]              # (k, s): d . a
     dd = np.einsum("sj,sj->s", p, p)[None, :] - 2.0 * (c @ p.T) + np.einsum("kj,kj->k", c, c)[:, None]
@@ -318,7 +318,7 @@ def object_cylinders(pts: np.ndarray, nrm: np.ndarray, box: np.ndarray, plane_of
         mine = plane_of == k
         if mine.any():
             res[mine] = p.distance(pts[mine])
-            if float(p.n @ pts[mine].mean(axis=0)) > 0:
+            if float(p.n @ column_means(pts[mine])) > 0:
                 res[mine] *= -1.0
     out = []
 
@@ -426,7 +426,7 @@ def misfit(cyl: Cylinder, pts: np.ndarray, res: np.ndarray, bin_deg: float) -> f
 
 def plane_ms(pts: np.ndarray) -> float:
     """Mean square distance of points (m, 3) from their least-squares plane."""
-    centred = pts - pts.mean(axis=0)
+    centred = pts - column_means(pts)
     return float(np.linalg.svd(centred, compute_uv=False)[-1] ** 2 / len(pts))
 
 

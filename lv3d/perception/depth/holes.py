@@ -28,7 +28,7 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from ...plane import Plane, angle_deg
+from ...plane import Plane, angle_deg, column_means
 from ...rgbd import RGBD
 from ...scene import Face
 from ..boundary import grow_convex
@@ -256,7 +256,7 @@ def unread_faces(depth: np.ndarray, grid: PointGrid, object_px: np.ndarray, plan
         plane, inl = ransac_plane(pts, sensor.inlier_m(float(np.median(pts[:, 2]))), rng)
         if np.count_nonzero(inl) < max(need, 3):
             return None
-        ray = pts[inl].mean(axis=0)  # the angle it is seen at, from face-on
+        ray = column_means(pts[inl])  # the angle it is seen at, from face-on
         if np.degrees(np.arccos(min(1.0, abs(float(plane.n @ ray)) / float(np.linalg.norm(ray))))) < min_graze_deg:
             return None
         if any(angle_deg(plane, q) < min_apart_deg for q in known):

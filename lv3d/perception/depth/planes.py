@@ -94,7 +94,8 @@ def object_planes(grid: PointGrid, obj_mask: np.ndarray, seed: int = 0, max_plan
         idx = np.nonzero(free & tried)[0]
         if len(idx) < need:
             break
-        plane, inl = ransac_plane(np.take(pts, idx, axis=0), dist_m, rng, iterations=96, normals=np.take(nrm, idx, axis=0), max_angle_deg=max_angle_deg)
+        plane, inl = ransac_plane(np.take(pts, idx, axis=0), dist_m, rng, iterations=96,
+                                  normals=np.take(nrm, idx, axis=0), max_angle_deg=max_angle_deg)
         m = np.zeros((h, w), bool)
         m.flat[flat[idx[inl]]] = True
         piece = largest_piece(m)

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ...cone import Cone
-from ...plane import row_norms
+from ...plane import column_means, row_norms
 from ...sphere import Sphere, algebraic_sphere
 from .curved import axis_basis, axis_terms
 from .curved import explained_share as _share
@@ -312,7 +312,7 @@ def sample_sphere(pts: np.ndarray, nrm: np.ndarray, dist_m: float, cos_min: floa
     # each centre k against each scored point s in (k, s) products (coordinates about the points' mean):
     # |p - c|^2 = |p|^2 - 2 c . p + |c|^2, and the normal's dot with p - c
     sp, sn = pts[score], nrm[score]
-    o = sp.mean(axis=0)
+    o = column_means(sp)
     q, co = sp - o, c - o
     cq = co @ q.T
     rr = np.sqrt(np.maximum(np.einsum("sj,sj->s", q, q)[None, :] - 2.0 * cq + np.einsum("kj,kj->k", co, co)[:, None],

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, fields, is_dataclass, replace
 import cv2
 import numpy as np
 
-from ...plane import Plane
+from ...plane import Plane, column_means
 from ...rgbd import RGBD
 from ..boundary import mask_polygon
 from .cloud import PointGrid, cell_rows, crop_normals, point_grid, slope_noise
@@ -251,7 +251,7 @@ def depth_scene(frame: RGBD, seed: int = 0, max_objects: int | None = None,
         (i0, j0), (i1, j1) = ij.min(axis=0), ij.max(axis=0)
         box = (int(j0 * stride), int(i0 * stride), min(w, int((j1 + 1) * stride)), min(h, int((i1 + 1) * stride)))
         curved_polys = [mask_polygon(c.mask, stride, (h, w), convex=False) for c in curved]
-        results.append(DepthObjectResult(o, planes, polys, adj, own.mean(axis=0).astype(np.float64), box,
+        results.append(DepthObjectResult(o, planes, polys, adj, column_means(own).astype(np.float64), box,
                                          scale, curved, curved_polys, curved_adj))
     timings = {"cloud": (t1 - t0) * 1e3, "support": (t2 - t1) * 1e3, "objects": (t3 - t2) * 1e3,
                "planes": t_planes * 1e3, "boundary": t_boundary * 1e3}

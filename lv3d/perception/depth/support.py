@@ -14,13 +14,13 @@ import cv2
 import numpy as np
 from matplotlib.path import Path
 
-from ...plane import Plane
+from ...plane import Plane, column_means
 from .ranges import check_ranges
 
 
 def refine(points: np.ndarray) -> Plane:
     """Least-squares plane through points (m, 3): the smallest principal direction of their scatter."""
-    c = points.sum(axis=0) / len(points)  # what mean() computes, without its wrapper's overhead
+    c = column_means(points)
     q = points - c
     _, vecs = np.linalg.eigh(q.T @ q)  # 3x3 scatter: cheaper than an SVD of all the points
     n = vecs[:, 0]
