@@ -64,3 +64,33 @@ def test_merge_close_corners_keeps_sides_it_can_measure():
     assert len(merge_close_corners(strip, 3.0)) == 4
     tiny = np.array([[0, 0], [2, 0], [1, 1]], float)  # never fewer than three corners
     assert len(merge_close_corners(tiny, 3.0)) == 3
+
+
+def test_polygon_fast_forms_are_numpys_general_calls_bit_for_bit():
+    """following / preceding are np.roll's arrays, pair_dots the two products added as numpy's sum adds them, and
+    distance_to_segments the numbers of its general form (sums over an axis two long, a squared offset)."""
+    from lv3d.perception.polygons import distance_to_segments, following, pair_dots, preceding
+
+    rng = np.random.default_rng(3)
+    for n in (1, 3, 4, 9, 40):
+        p = rng.uniform(-300, 300, (n, 2))
+        np.testing.assert_array_equal(following(p), np.roll(p, -1, axis=0))
+        np.testing.assert_array_equal(preceding(p), np.roll(p, 1, axis=0))
+        np.testing.assert_array_equal(following(p[:, 0]), np.roll(p[:, 0], -1))
+        q = rng.uniform(-300, 300, (25, 2))
+        steps = following(p) - p
+        rel = q[:, None, :] - p[None]
+        assert pair_dots(rel, steps[None]).tobytes() == (rel * steps[None]).sum(-1).tobytes()
+        t = np.clip((rel * steps[None]).sum(-1) / np.maximum((steps * steps).sum(-1), 1e-12), 0.0, 1.0)
+        want = np.sqrt(((rel - t[..., None] * steps[None]) ** 2).sum(-1)).min(axis=1)
+        assert distance_to_segments(q, p, steps).tobytes() == want.tobytes()
+
+
+def test_chromaticity_is_the_share_of_the_channel_sum():
+    from lv3d.perception.rgb.background import chromaticity
+
+    color = np.random.default_rng(4).integers(0, 256, (30, 40, 3), dtype=np.uint8)
+    color[0, 0] = 0
+    c = color.astype(np.float32)
+    want = c[..., :2] / np.maximum(c.sum(axis=2, keepdims=True), 1.0)
+    assert chromaticity(color).tobytes() == want.tobytes()

@@ -77,7 +77,8 @@ def segment_objects(grid: PointGrid, support: Plane | None, min_points: int = 60
     valid = grid.valid
     if support is not None:
         h_above = np.where(valid, grid.xyz @ support.n.astype(np.float32) + np.float32(support.offset), 0)
-        z_med = float(np.median(grid.xyz[..., 2][valid])) if valid.any() else 1.0
+        # the depths gathered by np.compress: the same values as indexing the grid's strided depth by the mask
+        z_med = float(np.median(np.compress(valid.ravel(), grid.xyz[..., 2].ravel()))) if valid.any() else 1.0
         band = 1.5 * sensor.inlier_m(z_med) if band_m is None else band_m
         fg = valid & (h_above > band)
     else:

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...outline_ellipse import OutlineEllipse
-from ..polygons import area, outline_distance
+from ..polygons import area, outline_distance, pair_dots
 
 
 @dataclass(frozen=True)
@@ -100,7 +100,7 @@ def _curve_distance(points: np.ndarray, ring: np.ndarray) -> np.ndarray:
     for a, b in ((i - 1) % k, i), (i, (i + 1) % k):
         start, step = ring[a], ring[b] - ring[a]
         rel = points - start
-        t = np.clip((rel * step).sum(1) / np.maximum((step * step).sum(1), 1e-12), 0.0, 1.0)
+        t = np.clip(pair_dots(rel, step) / np.maximum(pair_dots(step, step), 1e-12), 0.0, 1.0)
         best = np.minimum(best, np.hypot(*(rel - t[:, None] * step).T))
     return best
 

@@ -86,8 +86,9 @@ def build_graph(segs: np.ndarray, reach_px: float = 10.0, rel_reach: float = 0.3
     node_pos_along = np.concatenate([s_ij, t_ij])
     node_junction = np.concatenate([np.arange(len(ii)), np.arange(len(ii))])
     # merge junctions closer than merge_px into vertices
-    diff = pts[:, None, :] - pts[None, :, :]
-    close = np.hypot(diff[..., 0], diff[..., 1]) <= merge_px
+    # the pairs' offsets a coordinate at a time: the numbers of pts[:, None] - pts[None], without its (n, n, 2)
+    u, v = pts[:, 0], pts[:, 1]
+    close = np.hypot(u[:, None] - u[None, :], v[:, None] - v[None, :]) <= merge_px
     a, b = np.nonzero(np.triu(close, 1))
     lab = union_find_labels(len(pts), np.stack([a, b], axis=1))
     uniq, vid = np.unique(lab, return_inverse=True)

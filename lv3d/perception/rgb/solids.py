@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..polygons import outline_distance, sample_boundary
+from ..polygons import following, outline_distance, pair_dots, sample_boundary
 
 
 @dataclass(frozen=True)
@@ -134,12 +134,12 @@ def group_solids(polys: list[np.ndarray], pairs: list[tuple[int, int]], shape: t
 def _signed_area(p: np.ndarray) -> float:
     """Shoelace area (px^2), positive clockwise in the image."""
     x, y = np.asarray(p, np.float64).T
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+    return 0.5 * float(np.dot(x, following(y)) - np.dot(following(x), y))
 
 
 def _group(members: list[int], poly: np.ndarray, area: float) -> _Group:
     """A group of faces ``members`` whose outline together is ``poly`` (clockwise) and area ``area`` (px^2)."""
-    step = np.roll(poly, -1, axis=0) - poly
+    step = following(poly) - poly
     count = np.maximum(1, np.ceil(np.hypot(*step.T)).astype(int))  # sample_boundary's samples per side
     heading = step / np.maximum(np.hypot(*step.T), 1e-9)[:, None]
     return _Group(members, poly, sample_boundary(poly, 1.0), np.repeat(heading, count, axis=0), area)
@@ -185,9 +185,9 @@ def _along(small: _Group, large: _Group, touch: float, align_deg: float) -> np.n
     """(m,) bool: the points of ``small``'s outline that run along ``large``'s: within ``touch`` px of a side of
     it that runs within ``align_deg`` of their own side's direction."""
     a = large.poly
-    step = np.roll(a, -1, axis=0) - a
+    step = following(a) - a
     rel = small.outline[:, None, :] - a[None]
-    t = np.clip((rel * step[None]).sum(-1) / np.maximum((step * step).sum(-1), 1e-12), 0.0, 1.0)
+    t = np.clip(pair_dots(rel, step[None]) / np.maximum(pair_dots(step, step), 1e-12), 0.0, 1.0)
     dist = np.hypot(*(rel - t[..., None] * step[None]).transpose(2, 0, 1))
     side = np.argmin(dist, axis=1)
     k = np.arange(len(side))

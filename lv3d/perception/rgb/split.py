@@ -13,15 +13,15 @@ import functools
 import cv2
 import numpy as np
 
-from ..polygons import area, outline_distance, pixel_values, signed_area
+from ..polygons import area, following, outline_distance, pixel_values, preceding, signed_area
 
 
 def reflex_corners(poly: np.ndarray, tol_deg: float = 4.0) -> list[int]:
     """Indices of the corners of ``poly`` (n, 2) where it turns against its orientation by more than
     ``tol_deg`` degrees."""
     p = np.asarray(poly, np.float64)
-    d_in = p - np.roll(p, 1, axis=0)
-    d_out = np.roll(p, -1, axis=0) - p
+    d_in = p - preceding(p)
+    d_out = following(p) - p
     cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
     sin = cross / np.maximum(np.linalg.norm(d_in, axis=1) * np.linalg.norm(d_out, axis=1), 1e-9)
     sign = 1.0 if signed_area(p) > 0 else -1.0
